@@ -1,0 +1,147 @@
+//! Bars and their ends.
+
+use crate::error::{positive, ModelError};
+use std::fmt;
+
+/// A homogeneous elastic bar: `u_tt = c^2 u_xx` on `x in [0, length]`.
+///
+/// All quantities are non-dimensional (formulation §1): the paper scales by bar 1, so bar 1 is
+/// usually `Bar::unit()`. The mass per unit length is `stiffness / wave_speed^2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bar {
+    length: f64,
+    wave_speed: f64,
+    stiffness: f64,
+}
+
+impl Bar {
+    /// A bar of the given length `l`, wave speed `c` and axial stiffness `EA`.
+    ///
+    /// # Errors
+    /// [`ModelError::NotPositive`] if any value is not strictly positive and finite.
+    pub fn new(length: f64, wave_speed: f64, stiffness: f64) -> Result<Self, ModelError> {
+        Ok(Self {
+            length: positive("bar length", length)?,
+            wave_speed: positive("bar wave speed", wave_speed)?,
+            stiffness: positive("bar axial stiffness", stiffness)?,
+        })
+    }
+
+    /// The reference bar: length 1, wave speed 1, stiffness 1.
+    pub fn unit() -> Self {
+        Self {
+            length: 1.0,
+            wave_speed: 1.0,
+            stiffness: 1.0,
+        }
+    }
+
+    /// Length `l`.
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// Wave speed `c`.
+    pub fn wave_speed(&self) -> f64 {
+        self.wave_speed
+    }
+
+    /// Axial stiffness `EA`.
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
+    /// Mass per unit length `EA / c^2`.
+    pub fn mass_per_length(&self) -> f64 {
+        self.stiffness / (self.wave_speed * self.wave_speed)
+    }
+
+    /// Wave number `k = omega / c` of a harmonic of angular frequency `omega`.
+    pub fn wavenumber(&self, omega: f64) -> f64 {
+        omega / self.wave_speed
+    }
+}
+
+/// Identifies a bar inside one assembly; minted by
+/// [`AssemblyBuilder::add_bar`](crate::system::AssemblyBuilder::add_bar).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BarId(pub(crate) usize);
+
+impl BarId {
+    /// Position of the bar in its assembly (0-based, in the order bars were added).
+    pub fn index(self) -> usize {
+        self.0
+    }
+
+    /// The end at `x = 0`.
+    pub fn left(self) -> EndRef {
+        EndRef {
+            bar: self,
+            end: End::Left,
+        }
+    }
+
+    /// The end at `x = l`.
+    pub fn right(self) -> EndRef {
+        EndRef {
+            bar: self,
+            end: End::Right,
+        }
+    }
+}
+
+/// One of the two ends of a bar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum End {
+    /// The end at `x = 0`, outward normal `-1`.
+    Left,
+    /// The end at `x = l`, outward normal `+1`.
+    Right,
+}
+
+impl End {
+    /// Outward normal `n`: `-1` at `x = 0`, `+1` at `x = l`.
+    pub fn normal(self) -> f64 {
+        match self {
+            End::Left => -1.0,
+            End::Right => 1.0,
+        }
+    }
+}
+
+/// An end of a given bar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct EndRef {
+    /// The bar.
+    pub bar: BarId,
+    /// Which end.
+    pub end: End,
+}
+
+impl fmt::Display for EndRef {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let side = match self.end {
+            End::Left => "left (x = 0)",
+            End::Right => "right (x = l)",
+        };
+        write!(f, "{} of bar {}", side, self.bar.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_bars() {
+        assert!(matches!(
+            Bar::new(0.0, 1.0, 1.0),
+            Err(ModelError::NotPositive { what: "bar length", .. })
+        ));
+        assert!(Bar::new(1.0, f64::NAN, 1.0).is_err());
+        assert!(Bar::new(1.0, 1.0, f64::INFINITY).is_err());
+        assert!(Bar::new(1.0, 1.0, -2.0).is_err());
+        let b = Bar::new(2.0, 2.0, 8.0).unwrap();
+        assert_eq!(b.mass_per_length(), 2.0);
+    }
+}

@@ -1,0 +1,283 @@
+//! Sequential (natural-parameter) continuation.
+
+use super::{AtParameter, ContinuationProblem, Point};
+use crate::error::{ContinuationError, SolveError};
+use crate::solve::{norm, NonlinearSolver};
+use std::ops::ControlFlow;
+
+/// How the next starting guess is formed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Predictor {
+    /// The last converged solution (default; the paper's choice).
+    #[default]
+    Constant,
+    /// Linear extrapolation through the last two converged solutions (secant).
+    Secant,
+}
+
+/// Options of the [`Sequential`] driver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SequentialOptions {
+    /// Predictor (default [`Predictor::Constant`]).
+    pub predictor: Predictor,
+    /// Stop with [`ContinuationError::Stalled`] after this many consecutive failed steps
+    /// (default 40; `usize::MAX` never stops).
+    pub max_consecutive_failures: usize,
+}
+
+impl Default for SequentialOptions {
+    fn default() -> Self {
+        Self {
+            predictor: Predictor::Constant,
+            max_consecutive_failures: 40,
+        }
+    }
+}
+
+/// What one call of [`Sequential::step`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepOutcome {
+    /// The solver converged at the next parameter value.
+    Converged(Point),
+    /// The solver failed there; the branch goes on from the last converged point.
+    Failed(Point),
+    /// Every parameter value has been visited.
+    Finished,
+    /// Too many consecutive failures.
+    Stalled(ContinuationError),
+}
+
+/// Sequential continuation over a fixed list of parameter values: at each value, solve
+/// `F(x, lambda) = 0` from the predicted guess. Failed steps are reported and skipped; the
+/// next step starts again from the last converged solution.
+pub struct Sequential<P, S> {
+    problem: P,
+    solver: S,
+    values: Vec<f64>,
+    options: SequentialOptions,
+    next: usize,
+    last: Vec<f64>,
+    last_lambda: f64,
+    previous: Option<(Vec<f64>, f64)>,
+    failures: usize,
+    stalled: bool,
+    accept: Option<Acceptance>,
+}
+
+/// A test that a converged solution `(x, lambda)` belongs to the branch.
+type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
+
+impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
+    /// A driver visiting `values` in order from the guess `start`.
+    ///
+    /// # Errors
+    /// [`ContinuationError::InvalidOption`] for an empty or non-finite list,
+    /// [`ContinuationError::Dimension`] for a wrong-sized start.
+    pub fn new(
+        problem: P,
+        solver: S,
+        start: Vec<f64>,
+        values: Vec<f64>,
+        options: SequentialOptions,
+    ) -> Result<Self, ContinuationError> {
+        if values.is_empty() {
+            return Err(ContinuationError::InvalidOption {
+                what: "number of parameter values",
+                value: 0.0,
+            });
+        }
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(ContinuationError::InvalidOption {
+                what: "parameter value",
+                value: *v,
+            });
+        }
+        if start.len() != problem.dimension() {
+            return Err(ContinuationError::Dimension {
+                got: start.len(),
+                expected: problem.dimension(),
+            });
+        }
+        Ok(Self {
+            last_lambda: values[0],
+            problem,
+            solver,
+            values,
+            options,
+            next: 0,
+            last: start,
+            previous: None,
+            failures: 0,
+            stalled: false,
+            accept: None,
+        })
+    }
+
+    /// Adds a test a converged solution must pass to join the branch (for instance "not the
+    /// state of rest"). A rejected point is reported with `converged = false` and no error,
+    /// and counts as a failure.
+    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'static) -> Self {
+        self.accept = Some(Box::new(accept));
+        self
+    }
+
+    /// `steps` equispaced values from `start` to `end` inclusive.
+    ///
+    /// # Errors
+    /// [`ContinuationError::InvalidOption`] for non-finite ends or fewer than 2 steps.
+    pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
+        for v in [start, end] {
+            if !v.is_finite() {
+                return Err(ContinuationError::InvalidOption {
+                    what: "range end",
+                    value: v,
+                });
+            }
+        }
+        if steps < 2 {
+            return Err(ContinuationError::InvalidOption {
+                what: "steps (at least 2)",
+                value: steps as f64,
+            });
+        }
+        let h = (end - start) / (steps - 1) as f64;
+        Ok((0..steps).map(|i| start + h * i as f64).collect())
+    }
+
+    /// The problem (for post-processing between steps).
+    pub fn problem_mut(&mut self) -> &mut P {
+        &mut self.problem
+    }
+
+    /// The last converged solution (or the start) and its parameter.
+    pub fn last_converged(&self) -> (&[f64], f64) {
+        (&self.last, self.last_lambda)
+    }
+
+    fn predict(&self, lambda: f64) -> Vec<f64> {
+        match (self.options.predictor, &self.previous) {
+            (Predictor::Secant, Some((prev, prev_lambda))) if *prev_lambda != self.last_lambda => {
+                let s = (lambda - self.last_lambda) / (self.last_lambda - prev_lambda);
+                self.last
+                    .iter()
+                    .zip(prev)
+                    .map(|(a, b)| a + s * (a - b))
+                    .collect()
+            }
+            _ => self.last.clone(),
+        }
+    }
+
+    /// Solves at the next parameter value.
+    pub fn step(&mut self) -> StepOutcome {
+        if self.stalled {
+            return StepOutcome::Finished;
+        }
+        let Some(&lambda) = self.values.get(self.next) else {
+            return StepOutcome::Finished;
+        };
+        let step = self.next;
+        self.next += 1;
+        let mut x = self.predict(lambda);
+        let mut frozen = AtParameter {
+            problem: &mut self.problem,
+            lambda,
+        };
+        let result = self.solver.solve(&mut frozen, &mut x);
+        let accepted = match (&result, self.accept.as_mut()) {
+            (Ok(_), Some(accept)) => accept(&x, lambda),
+            _ => true,
+        };
+        match result {
+            Ok(info) if accepted => {
+                self.failures = 0;
+                self.previous = Some((std::mem::replace(&mut self.last, x.clone()), self.last_lambda));
+                self.last_lambda = lambda;
+                StepOutcome::Converged(Point {
+                    step,
+                    lambda,
+                    x,
+                    residual_norm: info.residual_norm,
+                    iterations: info.iterations,
+                    converged: true,
+                    error: None,
+                })
+            }
+            other => {
+                let (error, solved) = match other {
+                    Ok(info) => (None, Some(info)),
+                    Err(e) => (Some(e), None),
+                };
+                self.failures += 1;
+                let mut f = vec![0.0; x.len()];
+                self.problem.residual(&x, lambda, &mut f);
+                let iterations = match (&error, solved) {
+                    (_, Some(info)) => info.iterations,
+                    (Some(SolveError::MaxIterations { iterations, .. }), _) => *iterations,
+                    (
+                        Some(
+                            SolveError::LineSearch { iteration, .. }
+                            | SolveError::SingularJacobian { iteration, .. }
+                            | SolveError::TrustRegion { iteration, .. }
+                            | SolveError::NonFinite { iteration, .. },
+                        ),
+                        _,
+                    ) => *iteration,
+                    _ => 0,
+                };
+                let point = Point {
+                    step,
+                    lambda,
+                    x,
+                    residual_norm: norm(&f),
+                    iterations,
+                    converged: false,
+                    error,
+                };
+                if self.failures >= self.options.max_consecutive_failures {
+                    self.stalled = true;
+                    return StepOutcome::Stalled(ContinuationError::Stalled {
+                        failures: self.failures,
+                        parameter: lambda,
+                    });
+                }
+                StepOutcome::Failed(point)
+            }
+        }
+    }
+
+    /// Runs to the end, handing every point to `observer`; the observer stops the run by
+    /// returning `ControlFlow::Break(())`. Returns the number of steps taken.
+    ///
+    /// # Errors
+    /// [`ContinuationError::Stalled`] if too many consecutive steps failed.
+    pub fn run(
+        &mut self,
+        mut observer: impl FnMut(&Point) -> ControlFlow<()>,
+    ) -> Result<usize, ContinuationError> {
+        let mut taken = 0;
+        loop {
+            let point = match self.step() {
+                StepOutcome::Converged(p) | StepOutcome::Failed(p) => p,
+                StepOutcome::Finished => return Ok(taken),
+                StepOutcome::Stalled(e) => return Err(e),
+            };
+            taken += 1;
+            if observer(&point).is_break() {
+                return Ok(taken);
+            }
+        }
+    }
+}
+
+impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<P, S> {
+    type Item = Point;
+
+    /// Converged and failed points alike; ends when the values run out or the run stalls.
+    fn next(&mut self) -> Option<Point> {
+        match self.step() {
+            StepOutcome::Converged(p) | StepOutcome::Failed(p) => Some(p),
+            StepOutcome::Finished | StepOutcome::Stalled(_) => None,
+        }
+    }
+}

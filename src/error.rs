@@ -1,0 +1,268 @@
+//! Typed errors. Every variant carries the numbers that explain it.
+
+use crate::bar::EndRef;
+use thiserror::Error;
+
+/// Errors raised while describing a bar system (bars, boundary conditions, assembly).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ModelError {
+    /// A physical parameter is not strictly positive and finite.
+    #[error("{what} must be positive and finite, got {value}")]
+    NotPositive {
+        /// Which parameter (e.g. "bar length", "Signorini gap").
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A parameter is not finite (NaN or infinite).
+    #[error("{what} must be finite, got {value}")]
+    NotFinite {
+        /// Which parameter.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// The assembly holds no bar.
+    #[error("the assembly has no bar")]
+    NoBars,
+    /// A condition names a bar that the builder did not mint.
+    #[error("condition `{condition}` refers to bar {bar}, but the assembly has {bars} bar(s)")]
+    UnknownBar {
+        /// Name of the condition.
+        condition: String,
+        /// Index of the missing bar.
+        bar: usize,
+        /// Number of bars in the assembly.
+        bars: usize,
+    },
+    /// An end has no boundary condition.
+    #[error("end {end} has no boundary condition")]
+    UnconstrainedEnd {
+        /// The free-floating end.
+        end: EndRef,
+    },
+    /// An end has two boundary conditions.
+    #[error("end {end} has two boundary conditions: `{first}` and `{second}`")]
+    OverconstrainedEnd {
+        /// The doubly constrained end.
+        end: EndRef,
+        /// The first condition.
+        first: String,
+        /// The second condition.
+        second: String,
+    },
+    /// A condition lists the same end twice.
+    #[error("condition `{condition}` lists end {end} twice")]
+    RepeatedEnd {
+        /// Name of the condition.
+        condition: String,
+        /// The repeated end.
+        end: EndRef,
+    },
+    /// A condition's equation count does not match its end count: each end needs one equation
+    /// (a linear row or a unilateral law).
+    #[error(
+        "condition `{condition}` acts on {ends} end(s) but gives {rows} linear row(s) and {laws} unilateral law(s)"
+    )]
+    EquationCount {
+        /// Name of the condition.
+        condition: String,
+        /// Number of ends it constrains.
+        ends: usize,
+        /// Number of linear rows it gives per harmonic.
+        rows: usize,
+        /// Number of unilateral laws (0 or 1).
+        laws: usize,
+    },
+}
+
+/// Errors in harmonic-balance settings or evaluation points.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SettingsError {
+    /// The number of harmonics is zero.
+    #[error("the number of harmonics must be at least 1, got 0")]
+    ZeroHarmonics,
+    /// Too few time samples per harmonic to resolve the highest harmonic.
+    #[error("samples per harmonic must be at least {min}, got {got}")]
+    TooFewSamples {
+        /// Requested samples per harmonic.
+        got: usize,
+        /// Smallest admissible value.
+        min: usize,
+    },
+    /// A real-valued setting is not positive and finite.
+    #[error("{what} must be positive and finite, got {value}")]
+    NotPositive {
+        /// Which setting.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A vector has the wrong length.
+    #[error("{what} has length {got}, expected {expected}")]
+    Length {
+        /// Which vector.
+        what: &'static str,
+        /// Its length.
+        got: usize,
+        /// The expected length.
+        expected: usize,
+    },
+    /// A requested linear mode or subharmonic index is out of range.
+    #[error("{what} must be at least 1, got {value}")]
+    ZeroIndex {
+        /// Which index.
+        what: &'static str,
+        /// The rejected value.
+        value: usize,
+    },
+    /// The system has no unilateral condition, so it has no nonsmooth mode to compute.
+    #[error("the system has no unilateral contact condition")]
+    NoContact,
+    /// The linear mode used for a seed or a normalisation moves no contact gap.
+    #[error("the linear mode at omega = {omega} moves no contact gap, so it never grazes")]
+    NoGrazing {
+        /// Its natural frequency.
+        omega: f64,
+    },
+    /// The seed's harmonic exceeds the basis.
+    #[error("subharmonic {subharmonic} needs harmonic {subharmonic} but the basis stops at {harmonics}")]
+    HarmonicOutOfRange {
+        /// Requested subharmonic order.
+        subharmonic: usize,
+        /// Harmonics of the basis.
+        harmonics: usize,
+    },
+    /// No natural frequency of the open-contact system was found in the searched range.
+    #[error("no natural frequency number {mode} found below omega = {omega_max}")]
+    ModeNotFound {
+        /// Requested mode number.
+        mode: usize,
+        /// Upper end of the searched range.
+        omega_max: f64,
+    },
+}
+
+/// Errors of a nonlinear solve.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SolveError {
+    /// The iteration budget ran out before the tolerance was met.
+    #[error("no convergence after {iterations} iterations: residual norm {residual_norm:e} > tolerance {tolerance:e}")]
+    MaxIterations {
+        /// Iterations performed.
+        iterations: usize,
+        /// Residual norm reached.
+        residual_norm: f64,
+        /// Requested tolerance.
+        tolerance: f64,
+    },
+    /// The (generalised) Jacobian is singular to working precision.
+    #[error("singular Jacobian at iteration {iteration}: pivot {pivot} has |u_ii| / max |u_jj| = {ratio:e}")]
+    SingularJacobian {
+        /// Iteration at which the factorisation failed.
+        iteration: usize,
+        /// Index of the smallest pivot.
+        pivot: usize,
+        /// Ratio of that pivot to the largest.
+        ratio: f64,
+    },
+    /// The backtracking line search found no decrease of the merit function.
+    #[error("line search failed at iteration {iteration}: residual norm {residual_norm:e}, step length {step:e}")]
+    LineSearch {
+        /// Iteration at which it failed.
+        iteration: usize,
+        /// Residual norm at the start of the search.
+        residual_norm: f64,
+        /// Last step length tried.
+        step: f64,
+    },
+    /// The trust region shrank below its minimum radius.
+    #[error("trust region collapsed at iteration {iteration}: radius {radius:e}, residual norm {residual_norm:e}")]
+    TrustRegion {
+        /// Iteration at which it collapsed.
+        iteration: usize,
+        /// Radius reached.
+        radius: f64,
+        /// Residual norm at that point.
+        residual_norm: f64,
+    },
+    /// The residual or the Jacobian contains NaN or infinity.
+    #[error("non-finite {what} at iteration {iteration}")]
+    NonFinite {
+        /// "residual", "Jacobian" or "initial guess".
+        what: &'static str,
+        /// Iteration at which it appeared.
+        iteration: usize,
+    },
+    /// The unknown vector does not match the problem dimension.
+    #[error("unknown vector has length {got}, the problem has dimension {expected}")]
+    Dimension {
+        /// Length given.
+        got: usize,
+        /// Problem dimension.
+        expected: usize,
+    },
+    /// A solver option is invalid.
+    #[error("solver option {what} must be positive and finite, got {value}")]
+    InvalidOption {
+        /// Which option.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+}
+
+/// Errors of a continuation run.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ContinuationError {
+    /// An option is invalid (non-finite, empty range, zero steps...).
+    #[error("invalid continuation option {what}: {value}")]
+    InvalidOption {
+        /// Which option.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// Too many consecutive steps failed: the branch is lost.
+    #[error("continuation stalled: {failures} consecutive failed steps, last at parameter {parameter}")]
+    Stalled {
+        /// Consecutive failures.
+        failures: usize,
+        /// Parameter value of the last failure.
+        parameter: f64,
+    },
+    /// The starting vector does not match the problem dimension.
+    #[error("starting vector has length {got}, the problem has dimension {expected}")]
+    Dimension {
+        /// Length given.
+        got: usize,
+        /// Problem dimension.
+        expected: usize,
+    },
+}
+
+/// Any error of the crate.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum Error {
+    /// See [`ModelError`].
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// See [`SettingsError`].
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// See [`SolveError`].
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// See [`ContinuationError`].
+    #[error(transparent)]
+    Continuation(#[from] ContinuationError),
+}
+
+/// Checks that `value` is strictly positive and finite.
+pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64, ModelError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(ModelError::NotPositive { what, value })
+    }
+}

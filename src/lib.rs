@@ -1,0 +1,70 @@
+//! # nonsmooth-modes
+//!
+//! Nonsmooth modal analysis of elastic bar assemblies with unilateral contact: families of
+//! periodic motions (nonsmooth modes, backbone curves) computed by the Frequency-Domain
+//! Boundary Element Method, the Harmonic Balance Method and numerical continuation, after
+//! T. Lu and M. Legrand, *Nonsmooth Modal Analysis via the Boundary Element Method for
+//! one-dimensional bar systems*, Nonlinear Dynamics (2021).
+//!
+//! ## The model
+//!
+//! Each bar `b` (length `l`, wave speed `c`, axial stiffness `EA`) obeys `u_tt = c^2 u_xx`.
+//! A `T`-periodic motion is expanded in a harmonic basis of fundamental frequency
+//! `Omega = 2 pi / T`; each harmonic `n` of each bar solves a Helmholtz equation with wave
+//! number `k = n Omega / c`, whose solutions `A cos(kx) + B sin(kx)/k` are the unknowns.
+//! Linear boundary conditions (clamped, free, ground spring, contact force balance) are rows
+//! per harmonic; unilateral contact (`g >= 0`, `lambda >= 0`, `g lambda = 0`) is written as
+//! `r = -min(lambda, a_c g) = 0` in time and projected on the basis (weighted residuals).
+//! The square nonsmooth system `F(x; Omega) = 0` is solved by semismooth Newton (or Powell's
+//! dogleg) with an analytic generalised Jacobian, and followed in `Omega` or `T` by
+//! continuation. No equation divides by `sin`, `cos` or `tan` of a frequency: nothing has a
+//! pole at a natural frequency. `docs/theory.md` has the whole derivation.
+//!
+//! ## Main types
+//!
+//! | type | role |
+//! |---|---|
+//! | [`bar::Bar`], [`bar::EndRef`] | a bar; one of its ends |
+//! | [`bc::BoundaryCondition`] | trait of all conditions: [`bc::Dirichlet`], [`bc::Neumann`], [`bc::Robin`], [`bc::Signorini`], [`bc::Contact`] |
+//! | [`system::AssemblyBuilder`] → [`system::BarSystem`] | compose and validate |
+//! | [`system::NonsmoothSystem`] | `F(x; Omega)`, Jacobian, `dF/dOmega` for a [`fourier::Basis`] |
+//! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`] |
+//! | [`continuation::ContinuationProblem`], [`continuation::Sequential`] | continuation |
+//! | [`modal::backbone`] | one call: a backbone with `E / E_g` |
+//! | [`reference`] | the paper's systems and exact solutions |
+//!
+//! ## Quick start
+//!
+//! ```
+//! use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
+//! use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
+//! use nonsmooth_modes::solve::SemismoothNewton;
+//! use nonsmooth_modes::system::HarmonicBalance;
+//!
+//! let system = clamped_bar_with_obstacle(1e-3)?;
+//! let settings = HarmonicBalance { harmonics: 10, ..Default::default() };
+//! let options = BackboneOptions {
+//!     grid: PeriodGrid { start: 3.9, end: 3.7, steps: 5 },
+//!     ..Default::default()
+//! };
+//! let points = backbone(&system, settings, &options, SemismoothNewton::default())?;
+//! let last = points.last().unwrap();
+//! let exact = ClampedFirstMode::new(1e-3, last.period).energy_normalized();
+//! assert!(last.converged);
+//! assert!((last.energy_normalized / exact - 1.0).abs() < 0.1);
+//! # Ok::<(), nonsmooth_modes::Error>(())
+//! ```
+
+pub mod bar;
+pub mod bc;
+pub mod bem;
+pub mod continuation;
+pub mod error;
+pub mod fourier;
+pub mod linalg;
+pub mod modal;
+pub mod reference;
+pub mod solve;
+pub mod system;
+
+pub use error::{ContinuationError, Error, ModelError, SettingsError, SolveError};

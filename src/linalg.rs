@@ -1,0 +1,205 @@
+//! A small dense matrix type for public signatures, and the factorisations the crate needs,
+//! done by `faer` inside (faer's types never appear in the public API).
+
+use faer::linalg::solvers::Solve;
+use faer::Mat;
+use std::ops::{Index, IndexMut};
+
+/// A dense, column-major `f64` matrix.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DenseMatrix {
+    nrows: usize,
+    ncols: usize,
+    data: Vec<f64>,
+}
+
+impl DenseMatrix {
+    /// A matrix of zeros.
+    pub fn zeros(nrows: usize, ncols: usize) -> Self {
+        Self {
+            nrows,
+            ncols,
+            data: vec![0.0; nrows * ncols],
+        }
+    }
+
+    /// Number of rows.
+    pub fn nrows(&self) -> usize {
+        self.nrows
+    }
+
+    /// Number of columns.
+    pub fn ncols(&self) -> usize {
+        self.ncols
+    }
+
+    /// Sets every entry to zero.
+    pub fn fill_zero(&mut self) {
+        self.data.fill(0.0);
+    }
+
+    /// Resizes to `nrows x ncols`, all zero.
+    pub fn reset(&mut self, nrows: usize, ncols: usize) {
+        self.nrows = nrows;
+        self.ncols = ncols;
+        self.data.clear();
+        self.data.resize(nrows * ncols, 0.0);
+    }
+
+    /// Column `j` as a slice.
+    pub fn column(&self, j: usize) -> &[f64] {
+        &self.data[j * self.nrows..(j + 1) * self.nrows]
+    }
+
+    /// `y = A x`.
+    ///
+    /// # Panics
+    /// If `x.len() != ncols` or `y.len() != nrows`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        assert_eq!(x.len(), self.ncols);
+        assert_eq!(y.len(), self.nrows);
+        y.fill(0.0);
+        for (j, &xj) in x.iter().enumerate() {
+            if xj != 0.0 {
+                for (yi, a) in y.iter_mut().zip(self.column(j)) {
+                    *yi += a * xj;
+                }
+            }
+        }
+    }
+
+    /// `y = A^T x`.
+    ///
+    /// # Panics
+    /// If `x.len() != nrows` or `y.len() != ncols`.
+    pub fn mul_transpose_vec(&self, x: &[f64], y: &mut [f64]) {
+        assert_eq!(x.len(), self.nrows);
+        assert_eq!(y.len(), self.ncols);
+        for (j, yj) in y.iter_mut().enumerate() {
+            *yj = self.column(j).iter().zip(x).map(|(a, b)| a * b).sum();
+        }
+    }
+
+    /// Whether every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.data.iter().all(|v| v.is_finite())
+    }
+
+    fn to_faer(&self) -> Mat<f64> {
+        Mat::from_fn(self.nrows, self.ncols, |i, j| self[(i, j)])
+    }
+}
+
+impl Index<(usize, usize)> for DenseMatrix {
+    type Output = f64;
+    fn index(&self, (i, j): (usize, usize)) -> &f64 {
+        debug_assert!(i < self.nrows && j < self.ncols);
+        &self.data[j * self.nrows + i]
+    }
+}
+
+impl IndexMut<(usize, usize)> for DenseMatrix {
+    fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
+        debug_assert!(i < self.nrows && j < self.ncols);
+        &mut self.data[j * self.nrows + i]
+    }
+}
+
+/// Where an LU factorisation found a pivot too small to trust.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SmallPivot {
+    pub pivot: usize,
+    pub ratio: f64,
+}
+
+/// LU factorisation with partial pivoting of a square matrix, with a pivot check
+/// (faer's LU does not report singularity).
+pub(crate) struct Lu {
+    lu: faer::linalg::solvers::PartialPivLu<f64>,
+}
+
+impl Lu {
+    /// Factorises `a`; fails when `min |u_ii| <= tol * max |u_jj|`.
+    pub fn factor(a: &DenseMatrix, tol: f64) -> Result<Self, SmallPivot> {
+        let lu = a.to_faer().partial_piv_lu();
+        let u = lu.U();
+        let n = u.nrows();
+        let mut max = 0.0_f64;
+        let mut min = f64::INFINITY;
+        let mut at = 0;
+        for i in 0..n {
+            let d = u[(i, i)].abs();
+            max = max.max(d);
+            if d < min {
+                min = d;
+                at = i;
+            }
+        }
+        if n > 0 && (!(min > tol * max) || !max.is_finite()) {
+            return Err(SmallPivot {
+                pivot: at,
+                ratio: if max > 0.0 { min / max } else { 0.0 },
+            });
+        }
+        Ok(Self { lu })
+    }
+
+    /// Solves `A x = b` in place.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        let mut rhs = Mat::from_fn(b.len(), 1, |i, _| b[i]);
+        self.lu.solve_in_place(rhs.as_mut());
+        for (i, bi) in b.iter_mut().enumerate() {
+            *bi = rhs[(i, 0)];
+        }
+    }
+}
+
+/// Singular values (descending) and right singular vectors (columns of `v`, `ncols x ncols`)
+/// of a small matrix given row-major as `nrows x ncols`.
+pub(crate) fn svd_small(rows: &[f64], nrows: usize, ncols: usize) -> (Vec<f64>, DenseMatrix) {
+    let m = Mat::from_fn(nrows, ncols, |i, j| rows[i * ncols + j]);
+    let mut v = DenseMatrix::zeros(ncols, ncols);
+    match m.svd() {
+        Ok(svd) => {
+            let s = svd.S().column_vector();
+            let sv: Vec<f64> = (0..nrows.min(ncols)).map(|i| s[i]).collect();
+            let vv = svd.V();
+            for i in 0..ncols {
+                for j in 0..ncols {
+                    v[(i, j)] = vv[(i, j)];
+                }
+            }
+            (sv, v)
+        }
+        Err(_) => (vec![f64::NAN; nrows.min(ncols)], v),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lu_solves_and_detects_singularity() {
+        let mut a = DenseMatrix::zeros(2, 2);
+        a[(0, 0)] = 2.0;
+        a[(0, 1)] = 1.0;
+        a[(1, 0)] = 1.0;
+        a[(1, 1)] = 3.0;
+        let lu = Lu::factor(&a, 1e-14).unwrap();
+        let mut b = [3.0, 4.0];
+        lu.solve_in_place(&mut b);
+        assert!((b[0] - 1.0).abs() < 1e-14 && (b[1] - 1.0).abs() < 1e-14);
+        a[(1, 1)] = 0.5;
+        assert!(Lu::factor(&a, 1e-14).is_err());
+    }
+
+    #[test]
+    fn svd_reports_null_direction() {
+        // rows (1, 1, 0) and (0, 0, 1): null direction (1, -1, 0)/sqrt 2
+        let (s, v) = svd_small(&[1.0, 1.0, 0.0, 0.0, 0.0, 1.0], 2, 3);
+        assert_eq!(s.len(), 2);
+        let n = [v[(0, 2)], v[(1, 2)], v[(2, 2)]];
+        assert!((n[0] + n[1]).abs() < 1e-14 && n[2].abs() < 1e-14);
+    }
+}

@@ -1,0 +1,302 @@
+//! Linear modes of the system with every contact open or closed, the first grazing energy
+//! `E_g`, and branch seeds.
+//!
+//! With every unilateral law replaced by a linear row (open: zero contact force; closed: zero
+//! gap motion), one harmonic of angular frequency `omega` has a square matrix `D(omega)` in
+//! the Helmholtz unknowns. Natural frequencies are the `omega` where it is singular; they are
+//! located as minima of `sigma_min(D) / sigma_max(D)` on a fine scan (which also finds double
+//! roots, where `det D` does not change sign) and refined by golden-section search.
+
+use crate::error::{Error, SettingsError};
+use crate::fourier::{Basis, CosineBasis};
+use crate::linalg::{svd_small, DenseMatrix, Lu};
+use crate::modal::energy::energy;
+use crate::system::rows::{dot, HarmonicRows};
+use crate::system::{BarSystem, NonsmoothSystem};
+
+/// Which linear state the unilateral conditions take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactState {
+    /// Every contact open: zero contact force.
+    Open,
+    /// Every contact closed: the gap does not move.
+    Closed,
+}
+
+/// A natural frequency with its mode shapes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearMode {
+    /// Angular frequency `omega`.
+    pub omega: f64,
+    /// Orthonormal basis of the mode shapes, each in Helmholtz unknowns `(A_b, B_b)` per bar
+    /// (more than one where the frequency is repeated, e.g. two identical bars).
+    pub shapes: Vec<Vec<f64>>,
+}
+
+/// Row-major square matrix of the linear system in `state` at `omega`.
+fn state_matrix(system: &BarSystem, omega: f64, state: ContactState) -> (Vec<f64>, usize) {
+    let rows = HarmonicRows::new(system, omega);
+    let n = rows.unknowns();
+    let mut m = Vec::with_capacity(n * n);
+    for r in 0..rows.linear_count() {
+        m.extend_from_slice(rows.linear_row(r));
+    }
+    for l in 0..system.contact_count() {
+        m.extend_from_slice(match state {
+            ContactState::Open => rows.force_row(l),
+            ContactState::Closed => rows.gap_row(l),
+        });
+    }
+    // Scale each row to unit norm so that the singular-value ratio measures degeneracy,
+    // not the growth of `k sin(kl)` entries with frequency.
+    for row in m.chunks_mut(n) {
+        let s = dot(row, row).sqrt();
+        if s > 0.0 {
+            row.iter_mut().for_each(|v| *v /= s);
+        }
+    }
+    (m, n)
+}
+
+fn singularity(system: &BarSystem, omega: f64, state: ContactState) -> f64 {
+    let (m, n) = state_matrix(system, omega, state);
+    let (s, _) = svd_small(&m, n, n);
+    s[n - 1] / s[0]
+}
+
+/// Natural frequencies in `(0, omega_max]` of the linear system in `state`, ascending, each
+/// refined to about `1e-13` relative, with its mode shapes.
+///
+/// # Errors
+/// [`SettingsError::NotPositive`] if `omega_max` is not positive and finite.
+pub fn natural_frequencies(
+    system: &BarSystem,
+    state: ContactState,
+    omega_max: f64,
+) -> Result<Vec<LinearMode>, SettingsError> {
+    if !(omega_max.is_finite() && omega_max > 0.0) {
+        return Err(SettingsError::NotPositive {
+            what: "upper frequency",
+            value: omega_max,
+        });
+    }
+    // Scan step: 1/400 of the smallest spacing pi c / l of one bar's spectrum.
+    let spacing = system
+        .bars()
+        .iter()
+        .map(|b| std::f64::consts::PI * b.wave_speed() / b.length())
+        .fold(f64::INFINITY, f64::min);
+    let h = spacing / 400.0;
+    let steps = (omega_max / h).ceil() as usize + 1;
+    let values: Vec<f64> = (0..=steps)
+        .map(|i| singularity(system, (i as f64 + 0.5) * h, state))
+        .collect();
+    let mut modes = Vec::new();
+    for i in 1..values.len() - 1 {
+        if values[i] <= values[i - 1] && values[i] < values[i + 1] {
+            let (lo, hi) = ((i as f64 - 0.5) * h, (i as f64 + 1.5) * h);
+            let omega = golden_minimum(|w| singularity(system, w, state), lo, hi);
+            if omega > omega_max || singularity(system, omega, state) > 1e-8 {
+                continue;
+            }
+            modes.push(LinearMode {
+                omega,
+                shapes: null_vectors(system, omega, state),
+            });
+        }
+    }
+    Ok(modes)
+}
+
+fn golden_minimum(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    while (b - a) > 1e-15 * b.abs().max(1.0) {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+        if c >= d {
+            break;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Orthonormal null vectors of `D(omega)` (singular values below `1e-6` of the largest).
+fn null_vectors(system: &BarSystem, omega: f64, state: ContactState) -> Vec<Vec<f64>> {
+    let (m, n) = state_matrix(system, omega, state);
+    let (s, v) = svd_small(&m, n, n);
+    (0..n)
+        .filter(|&j| s[j] <= 1e-6 * s[0])
+        .map(|j| (0..n).map(|i| v[(i, j)]).collect())
+        .collect()
+}
+
+/// The `mode`-th natural frequency of the open-contact system (1-based), searching up to
+/// growing bounds.
+fn open_mode(system: &BarSystem, mode: usize) -> Result<LinearMode, SettingsError> {
+    if mode == 0 {
+        return Err(SettingsError::ZeroIndex {
+            what: "mode number",
+            value: 0,
+        });
+    }
+    let base = system
+        .bars()
+        .iter()
+        .map(|b| std::f64::consts::PI * b.wave_speed() / b.length())
+        .fold(f64::INFINITY, f64::min);
+    let mut omega_max = base * (mode as f64 + 1.0);
+    for _ in 0..6 {
+        let modes = natural_frequencies(system, ContactState::Open, omega_max)?;
+        if let Some(m) = modes.into_iter().nth(mode - 1) {
+            return Ok(m);
+        }
+        omega_max *= 2.0;
+    }
+    Err(SettingsError::ModeNotFound { mode, omega_max })
+}
+
+/// Potential energy at maximum displacement of the motion `shape cos(omega t)`.
+fn shape_energy(system: &BarSystem, omega: f64, shape: &[f64]) -> f64 {
+    let basis = CosineBasis::new(1, 3).expect("valid basis");
+    let mut x = vec![0.0; shape.len()];
+    x.extend_from_slice(shape);
+    energy(system, &basis, &x, omega)
+}
+
+/// The first linear grazing energy `E_g` and the first open-contact mode: the least energy of
+/// a motion in the first mode's eigenspace whose amplitude just closes a contact gap
+/// (formulation §7). For a simple mode this is the mode scaled so that its first contact
+/// grazes; `E_g = min_l g0_l^2 / (c_l^T Q^-1 c_l)` with `Q` the energy form and `c_l` the gap
+/// motion of law `l` on the eigenspace.
+///
+/// Clamped bar: `pi^2 g0^2 / 16`; Robin bar `k_s = 0.5`: `0.185515 g0^2`.
+///
+/// # Errors
+/// [`SettingsError::NoContact`], [`SettingsError::NoGrazing`] or a failed mode search.
+pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsError> {
+    if system.contact_count() == 0 {
+        return Err(SettingsError::NoContact);
+    }
+    let mode = open_mode(system, 1)?;
+    let d = mode.shapes.len();
+    let e: Vec<f64> = mode
+        .shapes
+        .iter()
+        .map(|s| shape_energy(system, mode.omega, s))
+        .collect();
+    let mut q = DenseMatrix::zeros(d, d);
+    for i in 0..d {
+        q[(i, i)] = e[i];
+        for j in 0..i {
+            let sum: Vec<f64> = mode.shapes[i]
+                .iter()
+                .zip(&mode.shapes[j])
+                .map(|(a, b)| a + b)
+                .collect();
+            let qij = 0.5 * (shape_energy(system, mode.omega, &sum) - e[i] - e[j]);
+            q[(i, j)] = qij;
+            q[(j, i)] = qij;
+        }
+    }
+    let lu = Lu::factor(&q, 1e-12).map_err(|_| SettingsError::NoGrazing { omega: mode.omega })?;
+    let rows = HarmonicRows::new(system, mode.omega);
+    let mut best = f64::INFINITY;
+    for (l, law) in system.laws().enumerate() {
+        let g0 = law.gap().offset;
+        let c: Vec<f64> = mode.shapes.iter().map(|s| dot(rows.gap_row(l), s)).collect();
+        let mut y = c.clone();
+        lu.solve_in_place(&mut y);
+        let ctqc = dot(&c, &y);
+        if ctqc > 1e-300 {
+            best = best.min(g0 * g0 / ctqc);
+        }
+    }
+    if best.is_finite() {
+        Ok((best, mode))
+    } else {
+        Err(SettingsError::NoGrazing { omega: mode.omega })
+    }
+}
+
+/// A starting guess for the branch "NSM `mode` sub `subharmonic`" at fundamental frequency
+/// `omega`: the open-contact linear mode `mode`, placed on harmonic `subharmonic` (its period
+/// is `subharmonic` periods of the mode) and scaled so that its first contact just closes at
+/// `t = 0`.
+///
+/// # Errors
+/// [`SettingsError::ZeroIndex`] for `mode = 0` or `subharmonic = 0`,
+/// [`SettingsError::HarmonicOutOfRange`] if the basis has fewer harmonics, or a failed mode
+/// search.
+pub fn branch_seed<B: Basis>(
+    problem: &mut NonsmoothSystem<B>,
+    mode: usize,
+    subharmonic: usize,
+    omega: f64,
+) -> Result<Vec<f64>, Error> {
+    if subharmonic == 0 {
+        return Err(SettingsError::ZeroIndex {
+            what: "subharmonic order",
+            value: 0,
+        }
+        .into());
+    }
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(SettingsError::NotPositive {
+            what: "fundamental frequency",
+            value: omega,
+        }
+        .into());
+    }
+    let harmonics = problem.basis().harmonics();
+    if subharmonic > harmonics {
+        return Err(SettingsError::HarmonicOutOfRange {
+            subharmonic,
+            harmonics,
+        }
+        .into());
+    }
+    let linear = open_mode(problem.system(), mode)?;
+    let shape = &linear.shapes[0];
+    let laws: Vec<f64> = problem.system().laws().map(|l| l.gap().offset).collect();
+    let rows = &problem.rows_at(omega)[subharmonic];
+    let mut scale = f64::INFINITY;
+    for (l, g0) in laws.iter().enumerate() {
+        let delta = dot(rows.gap_row(l), shape);
+        if delta.abs() > 1e-300 {
+            let s = -g0 / delta;
+            if s.abs() < scale.abs() {
+                scale = s;
+            }
+        }
+    }
+    if !scale.is_finite() {
+        return Err(SettingsError::NoGrazing {
+            omega: linear.omega,
+        }
+        .into());
+    }
+    let basis = problem.basis().clone();
+    let mut phi = vec![0.0; basis.len()];
+    basis.functions_at(0.0, &mut phi);
+    let i = (0..basis.len())
+        .find(|&i| basis.harmonic(i) == subharmonic && phi[i] != 0.0)
+        .expect("a basis has a function of each harmonic that is nonzero at t = 0");
+    let mut x = vec![0.0; problem.dimension()];
+    for (c, s) in shape.iter().enumerate() {
+        x[problem.index(i, 0, 0) + c] = scale * s / phi[i];
+    }
+    Ok(x)
+}

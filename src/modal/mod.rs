@@ -1,0 +1,10 @@
+//! Modal post-processing: energy and its normalisation, linear modes of the open-contact
+//! system, branch seeds, and backbones.
+
+pub mod backbone;
+pub mod energy;
+pub mod linear;
+
+pub use backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+pub use energy::{energy, helmholtz_coefficients};
+pub use linear::{branch_seed, grazing_energy, natural_frequencies, ContactState, LinearMode};

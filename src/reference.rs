@@ -1,0 +1,161 @@
+//! The paper's three systems and the exact results to test against (formulation §8–§9).
+
+use crate::bar::Bar;
+use crate::error::ModelError;
+use crate::system::{AssemblyBuilder, BarSystem};
+use std::f64::consts::PI;
+
+/// Unit bar clamped at `x = 0` facing a rigid obstacle at gap `g0` at `x = 1` (the paper's
+/// Dirichlet–Signorini system, its Fig. 1a).
+///
+/// # Errors
+/// If `gap` is not positive and finite.
+pub fn clamped_bar_with_obstacle(gap: f64) -> Result<BarSystem, ModelError> {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.dirichlet(bar.left()).signorini(bar.right(), gap)?;
+    b.build()
+}
+
+/// Unit bar on a ground spring `k_s` at `x = 0` facing a rigid obstacle at gap `g0` at
+/// `x = 1` (the paper's Robin–Signorini system, its Fig. 1b; the paper uses `k_s = 0.5`).
+///
+/// # Errors
+/// If `spring_stiffness` or `gap` is not positive and finite.
+pub fn robin_bar_with_obstacle(spring_stiffness: f64, gap: f64) -> Result<BarSystem, ModelError> {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.robin(bar.left(), spring_stiffness)?
+        .signorini(bar.right(), gap)?;
+    b.build()
+}
+
+/// Two bars clamped at their left ends whose right ends face each other across a gap `g0`
+/// (the paper's two-bar system, its Fig. 1c): bar 1 is the unit bar, bar 2 is `second`.
+///
+/// The paper's triplets `(l, c, alpha)` map to `second = Bar::new(l, c, alpha)`: we read
+/// `alpha` as `EA_2 / EA_1`, the reading under which the paper's balance
+/// `u_x(1) = alpha w_y(l)` is the force balance (its definition `alpha = E1A1/(E2A2)` is the
+/// inverse; formulation §3).
+///
+/// # Errors
+/// If `gap` is not positive and finite.
+pub fn two_bars_in_contact(second: Bar, gap: f64) -> Result<BarSystem, ModelError> {
+    let mut b = AssemblyBuilder::new();
+    let one = b.add_bar(Bar::unit());
+    let two = b.add_bar(second);
+    b.dirichlet(one.left())
+        .dirichlet(two.left())
+        .contact(one.right(), two.right(), gap)?;
+    b.build()
+}
+
+/// Natural frequency `i >= 1` of a clamped-free bar: `(2i - 1) pi c / (2 l)`.
+pub fn clamped_free_frequency(i: usize, length: f64, wave_speed: f64) -> f64 {
+    (2.0 * i as f64 - 1.0) * PI * wave_speed / (2.0 * length)
+}
+
+/// Natural frequency `i >= 1` of a clamped-clamped bar: `i pi c / l`.
+pub fn clamped_clamped_frequency(i: usize, length: f64, wave_speed: f64) -> f64 {
+    i as f64 * PI * wave_speed / length
+}
+
+/// First four roots of `omega tan(omega) = 0.5` (Robin–free unit bar, `k_s = 0.5`).
+pub const ROBIN_FREE_FREQUENCIES: [f64; 4] = [0.653271, 3.292310, 6.361620, 9.477486];
+
+/// First four roots of `omega cos(omega) + 0.5 sin(omega) = 0` (Robin–clamped unit bar).
+pub const ROBIN_CLAMPED_FREQUENCIES: [f64; 4] = [1.836597, 4.815842, 7.917053, 11.040830];
+
+/// First grazing energy of the clamped bar: `pi^2 g0^2 / 16`.
+pub fn clamped_grazing_energy(gap: f64) -> f64 {
+    PI * PI * gap * gap / 16.0
+}
+
+/// First grazing energy of the Robin bar with `k_s = 0.5`, per unit `g0^2`
+/// (spring energy included).
+pub const ROBIN_GRAZING_ENERGY_PER_GAP2: f64 = 0.185515;
+
+/// The exact first nonsmooth mode of the clamped bar against an obstacle at gap `g0 > 0`,
+/// for a period `T in (3, 4)` (formulation §9). Time is measured from the middle of the
+/// contact phase, so the motion is even in time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClampedFirstMode {
+    /// Gap at rest `g0`.
+    pub gap: f64,
+    /// Period `T`.
+    pub period: f64,
+}
+
+impl ClampedFirstMode {
+    /// The mode at period `T` (meaningful for `3 < T < 4`).
+    pub fn new(gap: f64, period: f64) -> Self {
+        Self { gap, period }
+    }
+
+    fn slope(&self) -> f64 {
+        self.gap / (2.0 * (self.period - 3.0))
+    }
+
+    /// Contact duration per period `t_c = 4 - T`.
+    pub fn contact_duration(&self) -> f64 {
+        4.0 - self.period
+    }
+
+    /// Energy `g0^2 / (2 (T - 3)^2)`.
+    pub fn energy(&self) -> f64 {
+        self.gap * self.gap / (2.0 * (self.period - 3.0).powi(2))
+    }
+
+    /// `E / E_g = 8 / (pi^2 (T - 3)^2)`.
+    pub fn energy_normalized(&self) -> f64 {
+        8.0 / (PI * PI * (self.period - 3.0).powi(2))
+    }
+
+    /// Contact-end displacement `u(1, t)`.
+    pub fn end_displacement(&self, t: f64) -> f64 {
+        let tau = wrap(t, self.period).abs();
+        self.gap - 2.0 * self.slope() * (tau - 0.5 * self.contact_duration()).max(0.0)
+    }
+
+    /// Contact force `lambda(t) = -u_x(1, t)`: `g0 / (T - 3)` in contact, 0 in flight.
+    pub fn contact_force(&self, t: f64) -> f64 {
+        if wrap(t, self.period).abs() < 0.5 * self.contact_duration() {
+            self.gap / (self.period - 3.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Mean of `u(1, t)`: `g0 - a (2T - 4)^2 / (2T)`.
+    pub fn displacement_mean(&self) -> f64 {
+        let t = self.period;
+        self.gap - self.slope() * (2.0 * t - 4.0).powi(2) / (2.0 * t)
+    }
+
+    /// Cosine coefficient `j >= 1` of `u(1, t)`:
+    /// `(2 a T / (pi^2 j^2)) (cos(pi j t_c / T) - (-1)^j)`.
+    pub fn displacement_harmonic(&self, j: usize) -> f64 {
+        let (t, jf) = (self.period, j as f64);
+        let sign = if j % 2 == 0 { 1.0 } else { -1.0 };
+        2.0 * self.slope() * t / (PI * PI * jf * jf)
+            * ((PI * jf * self.contact_duration() / t).cos() - sign)
+    }
+
+    /// Cosine coefficient `j >= 1` of the outward strain `p(1, t) = u_x(1, t)` (a rectangular
+    /// pulse of height `-g0/(T - 3)`): `-(g0/(T-3)) (2/(pi j)) sin(pi j t_c / T)`.
+    pub fn strain_harmonic(&self, j: usize) -> f64 {
+        let jf = j as f64;
+        -self.gap / (self.period - 3.0) * 2.0 / (PI * jf)
+            * (PI * jf * self.contact_duration() / self.period).sin()
+    }
+
+    /// Mean of `p(1, t)`: `-(g0/(T-3)) t_c / T`.
+    pub fn strain_mean(&self) -> f64 {
+        -self.gap / (self.period - 3.0) * self.contact_duration() / self.period
+    }
+}
+
+/// `t` brought into `[-T/2, T/2)`.
+fn wrap(t: f64, period: f64) -> f64 {
+    (t + 0.5 * period).rem_euclid(period) - 0.5 * period
+}

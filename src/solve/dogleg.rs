@@ -1,0 +1,184 @@
+//! Powell's hybrid trust-region dogleg method.
+
+use super::{check_positive, norm, Iteration, NonlinearSolver, Problem, SolveInfo};
+use crate::error::SolveError;
+
+/// Options of [`Dogleg`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DoglegOptions {
+    /// Converged when `|F|_2 <= tolerance * problem.residual_scale()` (default `1e-9`).
+    pub tolerance: f64,
+    /// Iteration budget (default 100).
+    pub max_iterations: usize,
+    /// Initial radius as a multiple of `max(|x|_2, residual_scale)` (default 1, as MINPACK's
+    /// `factor = 100` on a scaled norm is for unscaled problems too aggressive).
+    pub initial_radius: f64,
+    /// Smallest radius, relative to `max(|x|_2, residual_scale)`, before giving up
+    /// (default `1e-13`).
+    pub min_radius: f64,
+}
+
+impl Default for DoglegOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-9,
+            max_iterations: 100,
+            initial_radius: 1.0,
+            min_radius: 1e-13,
+        }
+    }
+}
+
+/// Powell's hybrid method: inside a trust region of radius `Delta`, take the Newton step if
+/// it fits, else the dogleg path from the Cauchy point towards it; grow or shrink `Delta` by
+/// the ratio of actual to predicted decrease of `|F|^2`. The paper's solver (Matlab's
+/// `fsolve`), here with the analytic generalised Jacobian instead of finite differences.
+///
+/// Reference: M. J. D. Powell, "A hybrid method for nonlinear equations", in Numerical
+/// Methods for Nonlinear Algebraic Equations, Gordon and Breach, 1970, pp. 87–114.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Dogleg {
+    /// Options.
+    pub options: DoglegOptions,
+}
+
+impl Dogleg {
+    /// A solver with the given options.
+    ///
+    /// # Errors
+    /// [`SolveError::InvalidOption`] for non-positive or non-finite values.
+    pub fn new(options: DoglegOptions) -> Result<Self, SolveError> {
+        check_positive("tolerance", options.tolerance)?;
+        check_positive("initial_radius", options.initial_radius)?;
+        check_positive("min_radius", options.min_radius)?;
+        Ok(Self { options })
+    }
+}
+
+impl NonlinearSolver for Dogleg {
+    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+        self.options.tolerance * problem.residual_scale()
+    }
+
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+        let o = &self.options;
+        let tol = self.tolerance(problem);
+        let scale = problem.residual_scale();
+        let mut it = Iteration::new(problem, x)?;
+        let n = x.len();
+        let reference = norm(x).max(scale);
+        let mut radius = o.initial_radius * reference;
+        let (mut newton, mut grad, mut jg, mut step) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let (mut trial, mut f_trial, mut jp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut r = it.residual(x, 0)?;
+        for iteration in 0..o.max_iterations {
+            if r <= tol {
+                return Ok(it.info(iteration, r));
+            }
+            let lu = it.factor_jacobian(x, iteration);
+            // Steepest-descent direction of |F|^2/2: g = J^T F.
+            it.jac.mul_transpose_vec(&it.f, &mut grad);
+            it.jac.mul_vec(&grad, &mut jg);
+            let g2 = grad.iter().map(|v| v * v).sum::<f64>();
+            let jg2 = jg.iter().map(|v| v * v).sum::<f64>();
+            let cauchy_length = if jg2 > 0.0 { g2 / jg2 } else { 0.0 };
+            let have_newton = match &lu {
+                Ok(lu) => {
+                    for (d, f) in newton.iter_mut().zip(&it.f) {
+                        *d = -f;
+                    }
+                    lu.solve_in_place(&mut newton);
+                    newton.iter().all(|v| v.is_finite())
+                }
+                Err(_) => false,
+            };
+            loop {
+                dogleg_step(&newton, have_newton, &grad, cauchy_length, radius, &mut step);
+                for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(&step) {
+                    *xt = xi + d;
+                }
+                let rt = it.residual_into(&trial, &mut f_trial, iteration)?;
+                it.jac.mul_vec(&step, &mut jp);
+                let predicted_r2 = it
+                    .f
+                    .iter()
+                    .zip(&jp)
+                    .map(|(f, d)| (f + d) * (f + d))
+                    .sum::<f64>();
+                let predicted = r * r - predicted_r2;
+                let actual = r * r - rt * rt;
+                let ratio = if predicted > 0.0 { actual / predicted } else { -1.0 };
+                let length = norm(&step);
+                if ratio < 0.25 {
+                    radius = 0.5 * length.min(radius);
+                } else if ratio > 0.75 {
+                    radius = radius.max(2.0 * length);
+                }
+                if actual > 0.0 && (ratio > 1e-4 || rt <= tol) {
+                    x.copy_from_slice(&trial);
+                    std::mem::swap(&mut it.f, &mut f_trial);
+                    r = rt;
+                    break;
+                }
+                if radius < o.min_radius * reference {
+                    if let Err(e) = lu {
+                        return Err(e);
+                    }
+                    return Err(SolveError::TrustRegion {
+                        iteration,
+                        radius,
+                        residual_norm: r,
+                    });
+                }
+            }
+        }
+        if r <= tol {
+            return Ok(it.info(o.max_iterations, r));
+        }
+        Err(SolveError::MaxIterations {
+            iterations: o.max_iterations,
+            residual_norm: r,
+            tolerance: tol,
+        })
+    }
+}
+
+/// The dogleg step of length at most `radius`.
+fn dogleg_step(
+    newton: &[f64],
+    have_newton: bool,
+    grad: &[f64],
+    cauchy_length: f64,
+    radius: f64,
+    step: &mut [f64],
+) {
+    let gnorm = norm(grad);
+    if have_newton && norm(newton) <= radius {
+        step.copy_from_slice(newton);
+        return;
+    }
+    let cauchy_norm = cauchy_length * gnorm;
+    if !have_newton || cauchy_norm >= radius || gnorm == 0.0 {
+        let s = if gnorm > 0.0 { radius / gnorm } else { 0.0 };
+        let s = if have_newton || cauchy_norm >= radius { s } else { cauchy_length };
+        for (d, g) in step.iter_mut().zip(grad) {
+            *d = -s * g;
+        }
+        return;
+    }
+    // Point on the segment from the Cauchy point c to the Newton point with |p| = radius.
+    let c: Vec<f64> = grad.iter().map(|g| -cauchy_length * g).collect();
+    let diff: Vec<f64> = newton.iter().zip(&c).map(|(n, c)| n - c).collect();
+    let a = diff.iter().map(|v| v * v).sum::<f64>();
+    let b = 2.0 * c.iter().zip(&diff).map(|(c, d)| c * d).sum::<f64>();
+    let cc = c.iter().map(|v| v * v).sum::<f64>() - radius * radius;
+    let tau = if a > 0.0 {
+        (-b + (b * b - 4.0 * a * cc).max(0.0).sqrt()) / (2.0 * a)
+    } else {
+        0.0
+    };
+    for ((s, c), d) in step.iter_mut().zip(&c).zip(&diff) {
+        *s = c + tau * d;
+    }
+}

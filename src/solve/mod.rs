@@ -1,0 +1,163 @@
+//! Nonlinear solvers for square nonsmooth systems `F(x) = 0`.
+//!
+//! Both solvers use the problem's generalised Jacobian (an element of Clarke's generalised
+//! Jacobian where `F` has kinks) and report what happened in a [`SolveInfo`] or a typed
+//! [`SolveError`].
+//!
+//! | solver | step | globalisation |
+//! |---|---|---|
+//! | [`SemismoothNewton`] (default) | `J dx = -F` | backtracking (Armijo) on `|F|^2 / 2` |
+//! | [`Dogleg`] | Powell's dogleg between Newton and Cauchy steps | trust region |
+
+mod dogleg;
+mod newton;
+
+pub use dogleg::{Dogleg, DoglegOptions};
+pub use newton::{NewtonOptions, SemismoothNewton};
+
+use crate::error::SolveError;
+use crate::linalg::{DenseMatrix, Lu};
+
+/// A square system `F(x) = 0` with a generalised Jacobian.
+pub trait Problem {
+    /// Number of unknowns (and equations).
+    fn dimension(&self) -> usize;
+
+    /// Writes `F(x)` into `f`.
+    fn residual(&mut self, x: &[f64], f: &mut [f64]);
+
+    /// Writes a generalised Jacobian `J(x)` into `jac` (resized to `n x n` by the callee).
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix);
+
+    /// Typical magnitude of the residual's entries (tolerances are relative to it); 1 by
+    /// default.
+    fn residual_scale(&self) -> f64 {
+        1.0
+    }
+}
+
+/// What a successful solve did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveInfo {
+    /// Iterations (Jacobian factorisations).
+    pub iterations: usize,
+    /// Final residual norm `|F(x)|_2`.
+    pub residual_norm: f64,
+    /// Residual evaluations.
+    pub residual_evaluations: usize,
+    /// Jacobian evaluations.
+    pub jacobian_evaluations: usize,
+}
+
+/// A solver of square nonsmooth systems. Object safe: continuation drivers take
+/// `&dyn NonlinearSolver` or a generic `S: NonlinearSolver`.
+pub trait NonlinearSolver {
+    /// Solves `F(x) = 0` starting from `x`; on success `x` holds the solution, on failure the
+    /// last iterate.
+    ///
+    /// # Errors
+    /// See [`SolveError`].
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError>;
+
+    /// The absolute tolerance on `|F|_2` this solver uses for `problem` (so that callers can
+    /// judge a point with the same yardstick).
+    fn tolerance(&self, problem: &dyn Problem) -> f64;
+}
+
+/// Relative pivot threshold of the LU factorisations.
+pub(crate) const PIVOT_TOLERANCE: f64 = 1e-13;
+
+pub(crate) fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Shared state of an iteration: the problem, buffers and counters.
+pub(crate) struct Iteration<'p> {
+    pub problem: &'p mut dyn Problem,
+    pub f: Vec<f64>,
+    pub jac: DenseMatrix,
+    pub residuals: usize,
+    pub jacobians: usize,
+}
+
+impl<'p> Iteration<'p> {
+    pub fn new(problem: &'p mut dyn Problem, x: &[f64]) -> Result<Self, SolveError> {
+        let n = problem.dimension();
+        if x.len() != n {
+            return Err(SolveError::Dimension {
+                got: x.len(),
+                expected: n,
+            });
+        }
+        if !x.iter().all(|v| v.is_finite()) {
+            return Err(SolveError::NonFinite {
+                what: "initial guess",
+                iteration: 0,
+            });
+        }
+        Ok(Self {
+            problem,
+            f: vec![0.0; n],
+            jac: DenseMatrix::zeros(n, n),
+            residuals: 0,
+            jacobians: 0,
+        })
+    }
+
+    /// Evaluates `F(x)` into `out` and returns its norm, or an error if non-finite.
+    pub fn residual_into(&mut self, x: &[f64], out: &mut [f64], iteration: usize) -> Result<f64, SolveError> {
+        self.problem.residual(x, out);
+        self.residuals += 1;
+        let r = norm(out);
+        if r.is_finite() {
+            Ok(r)
+        } else {
+            Err(SolveError::NonFinite {
+                what: "residual",
+                iteration,
+            })
+        }
+    }
+
+    /// Evaluates `F(x)` into `self.f` and returns its norm.
+    pub fn residual(&mut self, x: &[f64], iteration: usize) -> Result<f64, SolveError> {
+        let mut f = std::mem::take(&mut self.f);
+        let r = self.residual_into(x, &mut f, iteration);
+        self.f = f;
+        r
+    }
+
+    /// Evaluates and factorises the Jacobian at `x`.
+    pub fn factor_jacobian(&mut self, x: &[f64], iteration: usize) -> Result<Lu, SolveError> {
+        self.problem.jacobian(x, &mut self.jac);
+        self.jacobians += 1;
+        if !self.jac.is_finite() {
+            return Err(SolveError::NonFinite {
+                what: "Jacobian",
+                iteration,
+            });
+        }
+        Lu::factor(&self.jac, PIVOT_TOLERANCE).map_err(|p| SolveError::SingularJacobian {
+            iteration,
+            pivot: p.pivot,
+            ratio: p.ratio,
+        })
+    }
+
+    pub fn info(&self, iterations: usize, residual_norm: f64) -> SolveInfo {
+        SolveInfo {
+            iterations,
+            residual_norm,
+            residual_evaluations: self.residuals,
+            jacobian_evaluations: self.jacobians,
+        }
+    }
+}
+
+pub(crate) fn check_positive(what: &'static str, value: f64) -> Result<(), SolveError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(SolveError::InvalidOption { what, value })
+    }
+}

@@ -1,0 +1,214 @@
+//! Assembly builder and validated bar system.
+
+use crate::bar::{Bar, BarId, EndRef};
+use crate::bc::{BoundaryCondition, Contact, Dirichlet, Neumann, Robin, Signorini, UnilateralLaw};
+use crate::error::ModelError;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Collects bars and boundary conditions; [`AssemblyBuilder::build`] validates them.
+///
+/// ```
+/// use nonsmooth_modes::bar::Bar;
+/// use nonsmooth_modes::system::AssemblyBuilder;
+///
+/// let mut b = AssemblyBuilder::new();
+/// let bar = b.add_bar(Bar::unit());
+/// b.dirichlet(bar.left()).signorini(bar.right(), 1e-3).unwrap();
+/// let system = b.build().unwrap();
+/// assert_eq!(system.contact_count(), 1);
+/// ```
+#[derive(Debug, Default, Clone)]
+pub struct AssemblyBuilder {
+    bars: Vec<Bar>,
+    conditions: Vec<Arc<dyn BoundaryCondition>>,
+}
+
+impl AssemblyBuilder {
+    /// An empty assembly.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a bar and returns its id.
+    pub fn add_bar(&mut self, bar: Bar) -> BarId {
+        self.bars.push(bar);
+        BarId(self.bars.len() - 1)
+    }
+
+    /// Adds any boundary condition, built-in or downstream.
+    pub fn add_condition(&mut self, condition: impl BoundaryCondition + 'static) -> &mut Self {
+        self.conditions.push(Arc::new(condition));
+        self
+    }
+
+    /// Clamps `end` ([`Dirichlet`]).
+    pub fn dirichlet(&mut self, end: EndRef) -> &mut Self {
+        self.add_condition(Dirichlet::new(end))
+    }
+
+    /// Frees `end` ([`Neumann`]).
+    pub fn neumann(&mut self, end: EndRef) -> &mut Self {
+        self.add_condition(Neumann::new(end))
+    }
+
+    /// Ground spring at `end` ([`Robin`]).
+    ///
+    /// # Errors
+    /// If the stiffness is not positive and finite.
+    pub fn robin(&mut self, end: EndRef, stiffness: f64) -> Result<&mut Self, ModelError> {
+        Ok(self.add_condition(Robin::new(end, stiffness)?))
+    }
+
+    /// Rigid obstacle at `gap` from `end` ([`Signorini`]).
+    ///
+    /// # Errors
+    /// If the gap is not positive and finite.
+    pub fn signorini(&mut self, end: EndRef, gap: f64) -> Result<&mut Self, ModelError> {
+        Ok(self.add_condition(Signorini::new(end, gap)?))
+    }
+
+    /// Unilateral contact between two ends ([`Contact`]).
+    ///
+    /// # Errors
+    /// If the gap is not positive and finite.
+    pub fn contact(
+        &mut self,
+        first: EndRef,
+        second: EndRef,
+        gap: f64,
+    ) -> Result<&mut Self, ModelError> {
+        Ok(self.add_condition(Contact::new(first, second, gap)?))
+    }
+
+    /// Validates and builds: every condition's parameters are valid, it refers to existing
+    /// bars, gives one equation per end, and every end has exactly one condition.
+    ///
+    /// # Errors
+    /// The first [`ModelError`] found, naming the offending end or condition.
+    pub fn build(&self) -> Result<BarSystem, ModelError> {
+        if self.bars.is_empty() {
+            return Err(ModelError::NoBars);
+        }
+        let mut owner: BTreeMap<EndRef, usize> = BTreeMap::new();
+        for (index, condition) in self.conditions.iter().enumerate() {
+            condition.validate()?;
+            let ends = condition.ends();
+            for (i, end) in ends.iter().enumerate() {
+                if end.bar.0 >= self.bars.len() {
+                    return Err(ModelError::UnknownBar {
+                        condition: condition.name(),
+                        bar: end.bar.0,
+                        bars: self.bars.len(),
+                    });
+                }
+                if ends[..i].contains(end) {
+                    return Err(ModelError::RepeatedEnd {
+                        condition: condition.name(),
+                        end: *end,
+                    });
+                }
+                if let Some(&first) = owner.get(end) {
+                    return Err(ModelError::OverconstrainedEnd {
+                        end: *end,
+                        first: self.conditions[first].name(),
+                        second: condition.name(),
+                    });
+                }
+                owner.insert(*end, index);
+            }
+            let mut rows = crate::bc::LinearRows::new();
+            condition.linear_rows(1.0, &|e| self.bars[e.bar.0].stiffness(), &mut rows);
+            let laws = usize::from(condition.unilateral().is_some());
+            if rows.len() + laws != ends.len() {
+                return Err(ModelError::EquationCount {
+                    condition: condition.name(),
+                    ends: ends.len(),
+                    rows: rows.len(),
+                    laws,
+                });
+            }
+        }
+        for b in 0..self.bars.len() {
+            let id = BarId(b);
+            for end in [id.left(), id.right()] {
+                if !owner.contains_key(&end) {
+                    return Err(ModelError::UnconstrainedEnd { end });
+                }
+            }
+        }
+        Ok(BarSystem {
+            bars: self.bars.clone(),
+            conditions: self.conditions.clone(),
+        })
+    }
+}
+
+/// A validated assembly of bars and boundary conditions. Cheap to clone (conditions are
+/// shared).
+#[derive(Debug, Clone)]
+pub struct BarSystem {
+    bars: Vec<Bar>,
+    conditions: Vec<Arc<dyn BoundaryCondition>>,
+}
+
+impl BarSystem {
+    /// The bars, in the order they were added.
+    pub fn bars(&self) -> &[Bar] {
+        &self.bars
+    }
+
+    /// The bar with id `id`.
+    ///
+    /// # Panics
+    /// If `id` was minted by another assembly with more bars.
+    pub fn bar(&self, id: BarId) -> &Bar {
+        &self.bars[id.0]
+    }
+
+    /// Every boundary condition.
+    pub fn conditions(&self) -> impl Iterator<Item = &dyn BoundaryCondition> {
+        self.conditions.iter().map(|c| c.as_ref())
+    }
+
+    /// The unilateral laws, in condition order.
+    pub fn laws(&self) -> impl Iterator<Item = &dyn UnilateralLaw> {
+        self.conditions.iter().filter_map(|c| c.unilateral())
+    }
+
+    /// Number of unilateral conditions (contacts and obstacles).
+    pub fn contact_count(&self) -> usize {
+        self.laws().count()
+    }
+
+    /// Axial stiffness of the bar owning `end`.
+    pub fn stiffness_at(&self, end: EndRef) -> f64 {
+        self.bars[end.bar.0].stiffness()
+    }
+
+    /// Number of Helmholtz unknowns per harmonic: `(A, B)` for each bar.
+    pub fn unknowns_per_harmonic(&self) -> usize {
+        2 * self.bars.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_the_offending_end() {
+        let mut b = AssemblyBuilder::new();
+        let bar = b.add_bar(Bar::unit());
+        b.dirichlet(bar.left());
+        assert_eq!(
+            b.build().unwrap_err(),
+            ModelError::UnconstrainedEnd { end: bar.right() }
+        );
+        b.neumann(bar.right()).neumann(bar.right());
+        assert!(matches!(
+            b.build(),
+            Err(ModelError::OverconstrainedEnd { end, .. }) if end == bar.right()
+        ));
+    }
+}

@@ -1,0 +1,13 @@
+//! From bars and conditions to the harmonic-balance equations.
+//!
+//! - [`assembly`]: the builder and the validated [`BarSystem`].
+//! - [`rows`]: per-harmonic linear rows and observables in the Helmholtz unknowns `(A, B)`.
+//! - [`problem`]: the square nonsmooth system `F(x; Omega) = 0`, its generalised Jacobian and
+//!   `dF/dOmega`.
+
+pub mod assembly;
+pub mod problem;
+pub mod rows;
+
+pub use assembly::{AssemblyBuilder, BarSystem};
+pub use problem::{HarmonicBalance, NonsmoothSystem};

@@ -1,0 +1,380 @@
+//! The square nonsmooth system `F(x; Omega) = 0` of harmonic balance.
+//!
+//! Unknowns: for each basis coefficient `i` and bar `b`, the Helmholtz coefficients
+//! `(A, B)` of that harmonic, at index `(i * n_bars + b) * 2 + {0, 1}`.
+//!
+//! Equations, in this order:
+//! 1. for each coefficient `i`, the linear rows of its harmonic (conditions and contact force
+//!    balances): `2 n_bars - n_contacts` rows;
+//! 2. for each unilateral law `l`, the projections `R_j = (2/N) sum_k psi_j(theta_k) r(theta_k)`
+//!    of its pointwise residual `r = law(gap(theta_k), force(theta_k))`: one per coefficient.
+//!
+//! The generalised Jacobian of block 2 is `G(w_gap) * gap_rows + G(w_force) * force_rows`, where
+//! `G(w)` is the basis' weighted Gram matrix of the law's generalised gradient `w` sampled in time
+//! (Toeplitz + Hankel for cosines: formulation §6). `dF/dOmega` at fixed `x` comes only through
+//! the wave numbers `k = n Omega / c` in the rows.
+
+use crate::continuation::ContinuationProblem;
+use crate::error::{Error, SettingsError};
+use crate::fourier::{Basis, CosineBasis};
+use crate::linalg::DenseMatrix;
+use crate::system::rows::{dot, HarmonicRows};
+use crate::system::BarSystem;
+
+/// Harmonic-balance settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HarmonicBalance {
+    /// Number of harmonics `m` (default 20).
+    pub harmonics: usize,
+    /// Time samples per harmonic `n_h`; the period has `N = n_h m` samples (default 30).
+    pub samples_per_harmonic: usize,
+    /// Complementarity parameter `a_c > 0` of `r = -min(lambda, a_c g)` (default 4).
+    pub penalty: f64,
+}
+
+impl Default for HarmonicBalance {
+    fn default() -> Self {
+        Self {
+            harmonics: 20,
+            samples_per_harmonic: 30,
+            penalty: 4.0,
+        }
+    }
+}
+
+impl HarmonicBalance {
+    /// The constant + cosine basis of these settings.
+    ///
+    /// # Errors
+    /// See [`CosineBasis::new`].
+    pub fn cosine_basis(&self) -> Result<CosineBasis, SettingsError> {
+        CosineBasis::new(self.harmonics, self.samples_per_harmonic)
+    }
+}
+
+/// Relative singular-value threshold under which a harmonic's linear rows count as
+/// rank-deficient (see [`HarmonicRows::regularise`]).
+const RANK_TOLERANCE: f64 = 1e-9;
+
+/// Time samples of the laws' observables and generalised gradients.
+#[derive(Debug, Clone, Default)]
+struct Workspace {
+    coefficients: Vec<f64>,
+    gap: Vec<f64>,
+    force: Vec<f64>,
+    values: Vec<f64>,
+    w_gap: Vec<f64>,
+    w_force: Vec<f64>,
+    scratch: Vec<f64>,
+    projection: Vec<f64>,
+    gram_gap: Vec<f64>,
+    gram_force: Vec<f64>,
+}
+
+/// A bar system under harmonic balance at a variable fundamental frequency `Omega`.
+///
+/// It implements [`ContinuationProblem`] with parameter `Omega`: residual, generalised
+/// Jacobian and `dF/dOmega`, all analytic.
+#[derive(Debug, Clone)]
+pub struct NonsmoothSystem<B: Basis = CosineBasis> {
+    system: BarSystem,
+    basis: B,
+    penalty: f64,
+    unknowns: usize,
+    linear_count: usize,
+    laws: usize,
+    offsets: Vec<(f64, f64)>,
+    omega: f64,
+    rows: Vec<HarmonicRows>,
+    ws: Workspace,
+}
+
+impl NonsmoothSystem<CosineBasis> {
+    /// The system with the paper's constant + cosine basis.
+    ///
+    /// # Errors
+    /// Invalid settings ([`SettingsError`]) or a system without unilateral condition
+    /// ([`SettingsError::NoContact`]).
+    pub fn new(system: &BarSystem, settings: HarmonicBalance) -> Result<Self, Error> {
+        Self::with_basis(system, settings.cosine_basis()?, settings.penalty)
+    }
+}
+
+impl<B: Basis> NonsmoothSystem<B> {
+    /// The system with any basis.
+    ///
+    /// # Errors
+    /// [`SettingsError::NotPositive`] for a bad penalty, [`SettingsError::NoContact`] for a
+    /// linear system.
+    pub fn with_basis(system: &BarSystem, basis: B, penalty: f64) -> Result<Self, Error> {
+        if !(penalty.is_finite() && penalty > 0.0) {
+            return Err(SettingsError::NotPositive {
+                what: "complementarity penalty a_c",
+                value: penalty,
+            }
+            .into());
+        }
+        let laws = system.contact_count();
+        if laws == 0 {
+            return Err(SettingsError::NoContact.into());
+        }
+        let unknowns = system.unknowns_per_harmonic();
+        let offsets = system
+            .laws()
+            .map(|l| (l.gap().offset, l.force().offset))
+            .collect();
+        let n = basis.samples();
+        let len = basis.len();
+        let ws = Workspace {
+            coefficients: vec![0.0; len],
+            gap: vec![0.0; laws * n],
+            force: vec![0.0; laws * n],
+            values: vec![0.0; laws * n],
+            w_gap: vec![0.0; laws * n],
+            w_force: vec![0.0; laws * n],
+            scratch: vec![0.0; n],
+            projection: vec![0.0; len],
+            gram_gap: vec![0.0; len * len],
+            gram_force: vec![0.0; len * len],
+        };
+        Ok(Self {
+            system: system.clone(),
+            basis,
+            penalty,
+            unknowns,
+            linear_count: unknowns - laws,
+            laws,
+            offsets,
+            omega: f64::NAN,
+            rows: Vec::new(),
+            ws,
+        })
+    }
+
+    /// The bar system.
+    pub fn system(&self) -> &BarSystem {
+        &self.system
+    }
+
+    /// The harmonic basis.
+    pub fn basis(&self) -> &B {
+        &self.basis
+    }
+
+    /// The complementarity parameter `a_c`.
+    pub fn penalty(&self) -> f64 {
+        self.penalty
+    }
+
+    /// Number of unknowns (and equations).
+    pub fn dimension(&self) -> usize {
+        self.basis.len() * self.unknowns
+    }
+
+    /// Index in `x` of coefficient `i`, bar `bar`, Helmholtz component `which` (0: `A`, 1: `B`).
+    pub fn index(&self, i: usize, bar: usize, which: usize) -> usize {
+        i * self.unknowns + 2 * bar + which
+    }
+
+    /// The per-harmonic rows at fundamental frequency `omega` (cached).
+    pub fn rows_at(&mut self, omega: f64) -> &[HarmonicRows] {
+        self.prepare(omega);
+        &self.rows
+    }
+
+    /// Rebuilds the per-harmonic rows when `omega` changed.
+    fn prepare(&mut self, omega: f64) {
+        if omega == self.omega && !self.rows.is_empty() {
+            return;
+        }
+        self.omega = omega;
+        self.rows = (0..=self.basis.harmonics())
+            .map(|h| {
+                let mut rows = HarmonicRows::new(&self.system, h as f64 * omega);
+                rows.regularise(RANK_TOLERANCE);
+                rows
+            })
+            .collect();
+    }
+
+    /// Coefficients of the gap (`gap == true`) or force of law `l`, one per basis function.
+    fn observable_coefficients(&self, x: &[f64], l: usize, gap: bool, derivative: bool, out: &mut [f64]) {
+        let n = self.unknowns;
+        for (i, o) in out.iter_mut().enumerate() {
+            let h = self.basis.harmonic(i);
+            let rows = &self.rows[h];
+            let row = match (gap, derivative) {
+                (true, false) => rows.gap_row(l),
+                (true, true) => rows.gap_row_derivative(l),
+                (false, false) => rows.force_row(l),
+                (false, true) => rows.force_row_derivative(l),
+            };
+            let scale = if derivative { h as f64 } else { 1.0 };
+            *o = scale * dot(row, &x[i * n..(i + 1) * n]);
+        }
+    }
+
+    /// Samples gap, force, pointwise residual and its generalised gradient of every law
+    /// (law `l` occupies `l * N..(l + 1) * N` of each buffer).
+    fn sample_laws(&mut self, x: &[f64]) {
+        let n = self.basis.samples();
+        let mut ws = std::mem::take(&mut self.ws);
+        for (l, law) in self.system.laws().enumerate() {
+            let range = l * n..(l + 1) * n;
+            let (g0, f0) = self.offsets[l];
+            self.observable_coefficients(x, l, true, false, &mut ws.coefficients);
+            self.basis.synthesize(&ws.coefficients, &mut ws.gap[range.clone()]);
+            self.observable_coefficients(x, l, false, false, &mut ws.coefficients);
+            self.basis.synthesize(&ws.coefficients, &mut ws.force[range.clone()]);
+            for k in range {
+                ws.gap[k] += g0;
+                ws.force[k] += f0;
+                let v = law.residual(ws.gap[k], ws.force[k], self.penalty);
+                ws.values[k] = v.value;
+                ws.w_gap[k] = v.d_gap;
+                ws.w_force[k] = v.d_force;
+            }
+        }
+        self.ws = ws;
+    }
+
+    /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid).
+    pub fn gap_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
+        self.history(x, omega, l, true)
+    }
+
+    /// Contact-force samples of law `l` over one period at `omega`.
+    pub fn force_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
+        self.history(x, omega, l, false)
+    }
+
+    /// Pointwise law residual `r(theta_k)` of law `l` over one period at `omega`.
+    pub fn law_residual_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
+        let g = self.gap_history(x, omega, l);
+        let f = self.force_history(x, omega, l);
+        let law = self.system.laws().nth(l).expect("law index in range");
+        g.iter()
+            .zip(&f)
+            .map(|(&g, &f)| law.residual(g, f, self.penalty).value)
+            .collect()
+    }
+
+    fn history(&mut self, x: &[f64], omega: f64, l: usize, gap: bool) -> Vec<f64> {
+        self.prepare(omega);
+        let mut c = vec![0.0; self.basis.len()];
+        self.observable_coefficients(x, l, gap, false, &mut c);
+        let mut s = vec![0.0; self.basis.samples()];
+        self.basis.synthesize(&c, &mut s);
+        let offset = if gap { self.offsets[l].0 } else { self.offsets[l].1 };
+        s.iter_mut().for_each(|v| *v += offset);
+        s
+    }
+
+    fn linear_block(&self, x: &[f64], derivative: bool, f: &mut [f64]) {
+        let (n, rpc) = (self.unknowns, self.linear_count);
+        for i in 0..self.basis.len() {
+            let h = self.basis.harmonic(i);
+            let rows = &self.rows[h];
+            let xi = &x[i * n..(i + 1) * n];
+            for r in 0..rpc {
+                f[i * rpc + r] = if derivative {
+                    h as f64 * dot(rows.linear_row_derivative(r), xi)
+                } else {
+                    dot(rows.linear_row(r), xi)
+                };
+            }
+        }
+    }
+}
+
+impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
+    fn dimension(&self) -> usize {
+        self.dimension()
+    }
+
+    fn residual(&mut self, x: &[f64], omega: f64, f: &mut [f64]) {
+        self.prepare(omega);
+        self.linear_block(x, false, f);
+        let (len, n) = (self.basis.len(), self.basis.samples());
+        let base = len * self.linear_count;
+        self.sample_laws(x);
+        for l in 0..self.laws {
+            self.basis.project(
+                &self.ws.values[l * n..(l + 1) * n],
+                &mut f[base + l * len..base + (l + 1) * len],
+            );
+        }
+    }
+
+    fn jacobian(&mut self, x: &[f64], omega: f64, jac: &mut DenseMatrix) {
+        self.prepare(omega);
+        let (len, n, un, rpc) = (
+            self.basis.len(),
+            self.basis.samples(),
+            self.unknowns,
+            self.linear_count,
+        );
+        jac.reset(self.dimension(), self.dimension());
+        for i in 0..len {
+            let rows = &self.rows[self.basis.harmonic(i)];
+            for r in 0..rpc {
+                for (c, &v) in rows.linear_row(r).iter().enumerate() {
+                    jac[(i * rpc + r, i * un + c)] = v;
+                }
+            }
+        }
+        self.sample_laws(x);
+        let base = len * rpc;
+        let mut ws = std::mem::take(&mut self.ws);
+        for l in 0..self.laws {
+            let range = l * n..(l + 1) * n;
+            self.basis.weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
+            self.basis.weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+            for i in 0..len {
+                let rows = &self.rows[self.basis.harmonic(i)];
+                let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
+                for j in 0..len {
+                    let (gg, gf) = (ws.gram_gap[j * len + i], ws.gram_force[j * len + i]);
+                    if gg == 0.0 && gf == 0.0 {
+                        continue;
+                    }
+                    for c in 0..un {
+                        jac[(base + l * len + j, i * un + c)] = gg * grow[c] + gf * frow[c];
+                    }
+                }
+            }
+        }
+        self.ws = ws;
+    }
+
+    fn parameter_derivative(&mut self, x: &[f64], omega: f64, df: &mut [f64]) {
+        self.prepare(omega);
+        self.linear_block(x, true, df);
+        self.sample_laws(x);
+        let (len, n) = (self.basis.len(), self.basis.samples());
+        let base = len * self.linear_count;
+        let mut ws = std::mem::take(&mut self.ws);
+        for l in 0..self.laws {
+            let dg = &mut ws.gap[..n];
+            self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
+            self.basis.synthesize(&ws.coefficients, dg);
+            self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
+            self.basis.synthesize(&ws.coefficients, &mut ws.scratch);
+            for k in 0..n {
+                ws.scratch[k] =
+                    ws.w_gap[l * n + k] * ws.gap[k] + ws.w_force[l * n + k] * ws.scratch[k];
+            }
+            self.basis.project(&ws.scratch, &mut ws.projection);
+            df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
+        }
+        self.ws = ws;
+    }
+
+    fn residual_scale(&self) -> f64 {
+        self.offsets
+            .iter()
+            .map(|o| o.0.abs())
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE)
+    }
+}

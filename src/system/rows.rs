@@ -1,0 +1,214 @@
+//! Per-harmonic linear rows and observables, written in the Helmholtz unknowns.
+//!
+//! For one harmonic of angular frequency `omega`, each bar `b` has two unknowns `(A_b, B_b)`
+//! (see [`crate::bem`]). Every condition row and every law observable is a linear form in these
+//! `2 n_bars` unknowns; [`HarmonicRows`] holds them as dense rows, with their derivatives in
+//! `omega`.
+
+use crate::bar::{End, EndRef};
+use crate::bc::{LinearRows, Quantity, Term};
+use crate::bem::HelmholtzMap;
+use crate::linalg::svd_small;
+use crate::system::BarSystem;
+
+/// Weights `(w_u, w_p)` such that `quantity = w_u u + w_p p` at an end with outward normal `n`
+/// on a bar of axial stiffness `EA` (`u` displacement, `p = n u_x` outward strain).
+pub fn quantity_weights(quantity: Quantity, end: End, stiffness: f64) -> (f64, f64) {
+    let n = end.normal();
+    match quantity {
+        Quantity::Displacement => (1.0, 0.0),
+        Quantity::OutwardDisplacement => (n, 0.0),
+        Quantity::Strain => (0.0, n),
+        Quantity::OutwardStrain => (0.0, 1.0),
+        Quantity::ContactForce => (0.0, -stiffness * n),
+    }
+}
+
+/// Adds `term` to a dense row over the `2 n_bars` Helmholtz unknowns, and its derivative in
+/// `omega` to `d_row`.
+fn add_term(term: &Term, maps: &[HelmholtzMap], stiffness: f64, row: &mut [f64], d_row: &mut [f64]) {
+    let b = term.end.bar.index();
+    let (wu, wp) = quantity_weights(term.quantity, term.end.end, stiffness);
+    let (iu, ip) = match term.end.end {
+        End::Left => (0, 1),
+        End::Right => (2, 3),
+    };
+    let map = &maps[b];
+    for j in 0..2 {
+        let value = wu * map.rows[iu][j] + wp * map.rows[ip][j];
+        let d_value = wu * map.d_omega[iu][j] + wp * map.d_omega[ip][j];
+        row[2 * b + j] += term.coefficient * value;
+        d_row[2 * b + j] += term.d_coefficient * value + term.coefficient * d_value;
+    }
+}
+
+/// Linear rows and law observables of one harmonic.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HarmonicRows {
+    unknowns: usize,
+    linear_count: usize,
+    linear: Vec<f64>,
+    d_linear: Vec<f64>,
+    gap: Vec<f64>,
+    d_gap: Vec<f64>,
+    force: Vec<f64>,
+    d_force: Vec<f64>,
+    regularised: bool,
+}
+
+impl HarmonicRows {
+    /// Rows of `system` for the harmonic of angular frequency `omega` (0 for the constant).
+    pub fn new(system: &BarSystem, omega: f64) -> Self {
+        let maps: Vec<HelmholtzMap> = system
+            .bars()
+            .iter()
+            .map(|bar| HelmholtzMap::new(bar, omega))
+            .collect();
+        let unknowns = system.unknowns_per_harmonic();
+        let stiffness = |e: EndRef| system.stiffness_at(e);
+        let mut rows = LinearRows::new();
+        for condition in system.conditions() {
+            condition.linear_rows(omega, &stiffness, &mut rows);
+        }
+        let dense = |terms_of: &mut dyn Iterator<Item = &[Term]>, count: usize| {
+            let mut v = vec![0.0; count * unknowns];
+            let mut d = vec![0.0; count * unknowns];
+            for (r, terms) in terms_of.enumerate() {
+                let (row, d_row) = (
+                    &mut v[r * unknowns..(r + 1) * unknowns],
+                    &mut d[r * unknowns..(r + 1) * unknowns],
+                );
+                for t in terms {
+                    add_term(t, &maps, stiffness(t.end), row, d_row);
+                }
+            }
+            (v, d)
+        };
+        let (linear, d_linear) = dense(&mut (0..rows.len()).map(|i| rows.row(i)), rows.len());
+        let gaps: Vec<_> = system.laws().map(|l| l.gap().terms).collect();
+        let forces: Vec<_> = system.laws().map(|l| l.force().terms).collect();
+        let (gap, d_gap) = dense(&mut gaps.iter().map(|t| t.as_slice()), gaps.len());
+        let (force, d_force) = dense(&mut forces.iter().map(|t| t.as_slice()), forces.len());
+        Self {
+            unknowns,
+            linear_count: rows.len(),
+            linear,
+            d_linear,
+            gap,
+            d_gap,
+            force,
+            d_force,
+            regularised: false,
+        }
+    }
+
+    /// Number of unknowns `2 n_bars`.
+    pub fn unknowns(&self) -> usize {
+        self.unknowns
+    }
+
+    /// Number of linear rows (`2 n_bars - n_contacts` for a validated system).
+    pub fn linear_count(&self) -> usize {
+        self.linear_count
+    }
+
+    /// Linear row `r` (length `unknowns()`).
+    pub fn linear_row(&self, r: usize) -> &[f64] {
+        &self.linear[r * self.unknowns..(r + 1) * self.unknowns]
+    }
+
+    /// Derivative of linear row `r` in `omega`.
+    pub fn linear_row_derivative(&self, r: usize) -> &[f64] {
+        &self.d_linear[r * self.unknowns..(r + 1) * self.unknowns]
+    }
+
+    /// Linear part of the gap of law `l` (the offset is applied in time).
+    pub fn gap_row(&self, l: usize) -> &[f64] {
+        &self.gap[l * self.unknowns..(l + 1) * self.unknowns]
+    }
+
+    /// Derivative of [`HarmonicRows::gap_row`] in `omega`.
+    pub fn gap_row_derivative(&self, l: usize) -> &[f64] {
+        &self.d_gap[l * self.unknowns..(l + 1) * self.unknowns]
+    }
+
+    /// Contact force of law `l` as a row.
+    pub fn force_row(&self, l: usize) -> &[f64] {
+        &self.force[l * self.unknowns..(l + 1) * self.unknowns]
+    }
+
+    /// Derivative of [`HarmonicRows::force_row`] in `omega`.
+    pub fn force_row_derivative(&self, l: usize) -> &[f64] {
+        &self.d_force[l * self.unknowns..(l + 1) * self.unknowns]
+    }
+
+    /// Whether [`HarmonicRows::regularise`] replaced the linear rows.
+    pub fn is_regularised(&self) -> bool {
+        self.regularised
+    }
+
+    /// Residuals of the linear rows for the unknowns `x` (length `unknowns()`).
+    pub fn linear_residuals(&self, x: &[f64], out: &mut [f64]) {
+        for (r, o) in out.iter_mut().enumerate().take(self.linear_count) {
+            *o = dot(self.linear_row(r), x);
+        }
+    }
+
+    /// Handles a harmonic that sits on a natural frequency of two parts at once
+    /// (formulation §5): the linear rows lose rank and a motion appears that no contact sees
+    /// (zero gap and zero force). When the smallest singular value of the rows falls below
+    /// `tolerance` times the largest, the rows are replaced by their numerically independent
+    /// part plus one row per invisible direction pinning it to zero, so that the unknown count
+    /// stays fixed and the Jacobian stays regular. Derivatives of replaced rows are set to
+    /// zero. Returns whether it acted.
+    pub fn regularise(&mut self, tolerance: f64) -> bool {
+        let (n, r) = (self.unknowns, self.linear_count);
+        if r == 0 {
+            return false;
+        }
+        let (s, v) = svd_small(&self.linear, r, n);
+        let smax = s.iter().cloned().fold(0.0, f64::max);
+        let rank = s.iter().filter(|&&x| x > tolerance * smax).count();
+        if rank == r || !s.iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        // Null space of the rows: columns rank..n of v.
+        let null: Vec<Vec<f64>> = (rank..n).map(|j| (0..n).map(|i| v[(i, j)]).collect()).collect();
+        let laws = self.gap.len() / n;
+        let mut seen = vec![0.0; 2 * laws * null.len()];
+        for l in 0..laws {
+            for (c, z) in null.iter().enumerate() {
+                seen[(2 * l) * null.len() + c] = dot(self.gap_row(l), z);
+                seen[(2 * l + 1) * null.len() + c] = dot(self.force_row(l), z);
+            }
+        }
+        let (t, w) = svd_small(&seen, 2 * laws, null.len());
+        let tmax = t.iter().cloned().fold(0.0, f64::max).max(f64::MIN_POSITIVE);
+        let seen_rank = t.iter().filter(|&&x| x > tolerance * tmax).count();
+        let invisible: Vec<Vec<f64>> = (seen_rank..null.len())
+            .map(|j| {
+                (0..n)
+                    .map(|i| (0..null.len()).map(|c| null[c][i] * w[(c, j)]).sum())
+                    .collect()
+            })
+            .collect();
+        if rank + invisible.len() != r {
+            return false;
+        }
+        let mut rows = Vec::with_capacity(r * n);
+        for (i, sigma) in s.iter().enumerate().take(rank) {
+            rows.extend((0..n).map(|k| sigma * v[(k, i)]));
+        }
+        for z in &invisible {
+            rows.extend(z.iter().map(|zi| smax * zi));
+        }
+        self.linear = rows;
+        self.d_linear.fill(0.0);
+        self.regularised = true;
+        true
+    }
+}
+
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
