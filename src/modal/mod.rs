@@ -3,8 +3,10 @@
 
 pub mod backbone;
 pub mod energy;
+pub mod field;
 pub mod linear;
 
 pub use backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
-pub use energy::{energy, helmholtz_coefficients};
+pub use energy::energy;
+pub use field::{FieldEvaluator, FieldValue};
 pub use linear::{branch_seed, grazing_energy, natural_frequencies, ContactState, LinearMode};
