@@ -231,6 +231,15 @@ pub enum ContinuationError {
         /// Parameter value of the last failure.
         parameter: f64,
     },
+    /// The solver failed at the starting point.
+    #[error("the solver failed at the starting point: {0}")]
+    Start(SolveError),
+    /// The bordered Jacobian that gives the tangent is singular.
+    #[error("singular bordered Jacobian: no tangent at parameter {lambda}")]
+    SingularTangent {
+        /// Parameter value.
+        lambda: f64,
+    },
     /// The starting vector does not match the problem dimension.
     #[error("starting vector has length {got}, the problem has dimension {expected}")]
     Dimension {

@@ -9,8 +9,13 @@
 //! loop), `Iterator<Item = Point>`, and [`Sequential::run`] with an observer closure that can
 //! stop the run.
 
+mod arclength;
 mod sequential;
 
+pub use arclength::{
+    Arclength, ArclengthOptions, ArclengthOutcome, ArclengthScale, Branch, EndReason,
+    RejectReason, Rejection, StallEscape, TangentPredictor,
+};
 pub use sequential::{Predictor, Sequential, SequentialOptions, StepOutcome};
 
 use crate::error::SolveError;
@@ -35,6 +40,14 @@ pub trait ContinuationProblem {
     fn residual_scale(&self) -> f64 {
         1.0
     }
+
+    /// For nonsmooth problems: the size of the active set of each unilateral law at
+    /// `(x, lambda)` (for harmonic balance, the number of time samples in contact). Drivers
+    /// report a grazing event when one of these appears or vanishes. `None` by default.
+    fn active_set(&mut self, x: &[f64], lambda: f64) -> Option<Vec<usize>> {
+        let _ = (x, lambda);
+        None
+    }
 }
 
 impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
@@ -52,6 +65,9 @@ impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
     }
     fn residual_scale(&self) -> f64 {
         (**self).residual_scale()
+    }
+    fn active_set(&mut self, x: &[f64], lambda: f64) -> Option<Vec<usize>> {
+        (**self).active_set(x, lambda)
     }
 }
 
@@ -106,6 +122,9 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
     fn residual_scale(&self) -> f64 {
         self.0.residual_scale()
     }
+    fn active_set(&mut self, x: &[f64], period: f64) -> Option<Vec<usize>> {
+        self.0.active_set(x, omega_of(period))
+    }
 }
 
 /// One point of a branch.
@@ -126,4 +145,43 @@ pub struct Point {
     /// Why the solver failed, if it did (`None` with `converged == false`: the solver
     /// converged but the driver's acceptance test rejected the solution).
     pub error: Option<SolveError>,
+    /// Step used to reach the point: the parameter increment for sequential runs, the
+    /// arclength `ds` for pseudo-arclength runs (0 for a starting point).
+    pub step_size: f64,
+    /// Events detected on the way to this point.
+    pub events: Vec<Event>,
+}
+
+/// Something that happened along a branch, reported on the point where it was detected.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// Turning point: the parameter component of the tangent changed sign.
+    Fold {
+        /// Parameter at the point after the fold.
+        lambda: f64,
+    },
+    /// The corrected point is far from its prediction even at the smallest step.
+    Jump {
+        /// Distance to the prediction over the step size.
+        ratio: f64,
+    },
+    /// The active set of a unilateral law appeared (`contact == true`) or vanished.
+    Grazing {
+        /// Law index.
+        law: usize,
+        /// Whether the contact is active after the event.
+        contact: bool,
+    },
+}
+
+impl Event {
+    /// A short label for tables: `fold`, `jump`, `grazing+`, `grazing-`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Event::Fold { .. } => "fold",
+            Event::Jump { .. } => "jump",
+            Event::Grazing { contact: true, .. } => "grazing+",
+            Event::Grazing { contact: false, .. } => "grazing-",
+        }
+    }
 }

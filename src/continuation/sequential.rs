@@ -168,6 +168,11 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         }
     }
 
+    /// Parameter of the grid value before `step` (the step itself for the first one).
+    fn last_lambda_before(&self, step: usize) -> f64 {
+        self.values[step.saturating_sub(1)]
+    }
+
     /// Solves at the next parameter value.
     pub fn step(&mut self) -> StepOutcome {
         if self.stalled {
@@ -201,6 +206,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                     iterations: info.iterations,
                     converged: true,
                     error: None,
+                    step_size: lambda - self.last_lambda_before(step),
+                    events: Vec::new(),
                 })
             }
             other => {
@@ -233,6 +240,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                     iterations,
                     converged: false,
                     error,
+                    step_size: lambda - self.last_lambda,
+                    events: Vec::new(),
                 };
                 if self.failures >= self.options.max_consecutive_failures {
                     self.stalled = true;

@@ -1,0 +1,879 @@
+//! Pseudo-arclength continuation with step-size control and event detection.
+//!
+//! The branch is followed in `y = (x, lambda)` with the scaled inner product
+//! `<a, b>_W = sum_i a_i b_i / s_x^2 + a_lambda b_lambda / s_lambda^2`, so that a step `ds`
+//! measures the relative change of the whole state (end values are of the order of the gap
+//! `g0` while `Omega` is of order 1). From an accepted point `y_k` with unit tangent `t_k`:
+//!
+//! 1. **predict** `y_p = y_k + ds t_k` (tangent from the bordered Jacobian, or secant);
+//! 2. **correct** with any [`NonlinearSolver`] on the bordered system
+//!    `F(x, lambda) = 0`, `<t_k, y - y_p>_W = 0`;
+//! 3. **control** the step: a converged corrector that needed at most `fast_iterations`
+//!    grows `ds` (up to `ds_max`); a failed one, a jump (`|y - y_p|_W > jump_ratio ds`) or a
+//!    turn of the tangent sharper than `max_turn` halves it and retries from `y_k`, which is
+//!    never modified; below `ds_min` the run ends.
+//!
+//! **Stalls.** Near internal resonances a truncated harmonic-balance branch can turn into an
+//! (almost) vertical branch whose energy grows without bound at fixed parameter; the paper
+//! abandoned arclength continuation for this reason. With [`StallEscape`] set, a run whose
+//! parameter has not progressed by `min_progress` in the requested direction over `window`
+//! accepted points jumps: from the recent point of smallest state norm (resonant branches
+//! carry more energy than the backbone they leave) it solves at fixed parameter a little
+//! beyond the most advanced parameter reached, doubling the distance while the solve fails or
+//! lands on a state more than `max_norm_ratio` times larger; it then restarts the tangent
+//! there and reports [`Event::Jump`] on that point. Without it, the run follows the
+//! branch wherever it goes.
+//!
+//! Events are reported on accepted points: folds (the parameter component of the tangent
+//! changes sign), jumps that could not be refined away, and grazing (the problem's active
+//! set, see [`ContinuationProblem::active_set`], appears or disappears).
+//!
+//! Reference: E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*,
+//! SIAM Classics in Applied Mathematics 45 (2003), chapter 2.
+
+use super::{ContinuationProblem, Event, Point};
+use crate::error::{ContinuationError, SolveError};
+use crate::linalg::{DenseMatrix, Lu};
+use crate::solve::{norm, NonlinearSolver, Problem, SolveInfo, PIVOT_TOLERANCE};
+use std::ops::ControlFlow;
+
+/// How the predictor direction is formed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TangentPredictor {
+    /// Tangent of the branch from the bordered Jacobian `[J, F_lambda; t_k^T W]` (default).
+    #[default]
+    Tangent,
+    /// Normalised secant through the last two accepted points (tangent for the first step).
+    Secant,
+}
+
+/// Scales `(s_x, s_lambda)` of the arclength norm.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum ArclengthScale {
+    /// `s_x = |x_0|_2` (relative change of the state) and `s_lambda = |lambda_0|` (or 1 when
+    /// `lambda_0 = 0`), from the starting point (default).
+    #[default]
+    Automatic,
+    /// Fixed scales `(s_x, s_lambda)`.
+    Fixed(f64, f64),
+}
+
+/// Automatic escape from stalls (see the module documentation). Distances are relative to the
+/// parameter scale `s_lambda`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StallEscape {
+    /// Accepted points over which progress is measured (default 20).
+    pub window: usize,
+    /// Least progress of the parameter over the window, relative (default `2e-3`).
+    pub min_progress: f64,
+    /// First jump beyond the stalled parameter, relative (default `2e-3`); doubled on each
+    /// failed attempt.
+    pub jump: f64,
+    /// Attempts before the run ends with [`EndReason::Stalled`] (default 6).
+    pub max_attempts: usize,
+    /// A jump is accepted only if the new state's norm is at most this multiple of the norm
+    /// of the point it started from (default 2).
+    pub max_norm_ratio: f64,
+}
+
+impl Default for StallEscape {
+    fn default() -> Self {
+        Self {
+            window: 20,
+            min_progress: 2e-3,
+            jump: 2e-3,
+            max_attempts: 6,
+            max_norm_ratio: 2.0,
+        }
+    }
+}
+
+/// Options of [`Arclength`]. Every field documents its default.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArclengthOptions {
+    /// Initial step `ds` (default `0.02`).
+    pub ds: f64,
+    /// Smallest step before the run ends with [`EndReason::StepBelowMinimum`] (default `1e-5`).
+    pub ds_min: f64,
+    /// Largest step (default `0.2`).
+    pub ds_max: f64,
+    /// Accepted points before [`EndReason::MaxSteps`] (default 2000).
+    pub max_steps: usize,
+    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves
+    /// `[lo, hi]` (default unbounded).
+    pub parameter_range: (f64, f64),
+    /// Initial direction of `lambda`: `+1` or `-1` (default `+1`).
+    pub direction: f64,
+    /// Predictor (default tangent).
+    pub predictor: TangentPredictor,
+    /// Norm scales (default automatic).
+    pub scale: ArclengthScale,
+    /// Corrector iterations at or below which `ds` grows (default 3).
+    pub fast_iterations: usize,
+    /// Growth factor of `ds` after a fast corrector (default 1.5).
+    pub growth: f64,
+    /// Shrink factor of `ds` after a rejection (default 0.5).
+    pub shrink: f64,
+    /// A corrected point farther than `jump_ratio * ds` from its prediction is a jump
+    /// (default 2).
+    pub jump_ratio: f64,
+    /// Largest angle in radians between successive tangents (default `pi/4`).
+    pub max_turn: f64,
+    /// Automatic escape from stalls (default `None`: follow the branch wherever it goes).
+    pub escape: Option<StallEscape>,
+}
+
+impl Default for ArclengthOptions {
+    fn default() -> Self {
+        Self {
+            ds: 0.02,
+            ds_min: 1e-5,
+            ds_max: 0.2,
+            max_steps: 2000,
+            parameter_range: (f64::NEG_INFINITY, f64::INFINITY),
+            direction: 1.0,
+            predictor: TangentPredictor::Tangent,
+            scale: ArclengthScale::Automatic,
+            fast_iterations: 3,
+            growth: 1.5,
+            shrink: 0.5,
+            jump_ratio: 2.0,
+            max_turn: std::f64::consts::FRAC_PI_4,
+            escape: None,
+        }
+    }
+}
+
+impl ArclengthOptions {
+    /// Checks the options.
+    ///
+    /// # Errors
+    /// [`ContinuationError::InvalidOption`] for non-finite or non-positive steps,
+    /// `ds_min > ds_max`, `ds` outside `[ds_min, ds_max]`, an empty or NaN range, a zero
+    /// direction, factors out of range or non-positive fixed scales.
+    pub fn validate(&self) -> Result<(), ContinuationError> {
+        let bad = |what, value| Err(ContinuationError::InvalidOption { what, value });
+        for (what, v) in [
+            ("ds", self.ds),
+            ("ds_min", self.ds_min),
+            ("ds_max", self.ds_max),
+            ("jump_ratio", self.jump_ratio),
+            ("max_turn", self.max_turn),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(what, v);
+            }
+        }
+        if self.ds_min > self.ds_max {
+            return bad("ds_min (greater than ds_max)", self.ds_min);
+        }
+        if self.ds < self.ds_min || self.ds > self.ds_max {
+            return bad("ds (outside [ds_min, ds_max])", self.ds);
+        }
+        let (lo, hi) = self.parameter_range;
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
+            return bad("parameter_range (empty)", hi - lo);
+        }
+        if !(self.direction == 1.0 || self.direction == -1.0) {
+            return bad("direction (must be +1 or -1)", self.direction);
+        }
+        if !(self.growth.is_finite() && self.growth >= 1.0) {
+            return bad("growth (at least 1)", self.growth);
+        }
+        if !(self.shrink > 0.0 && self.shrink < 1.0) {
+            return bad("shrink (in (0, 1))", self.shrink);
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", 0.0);
+        }
+        if let Some(e) = self.escape {
+            if e.window < 2 || e.max_attempts == 0 {
+                return bad("escape window/attempts", e.window.min(e.max_attempts) as f64);
+            }
+            for (what, v) in [
+                ("escape min_progress", e.min_progress),
+                ("escape jump", e.jump),
+                ("escape max_norm_ratio", e.max_norm_ratio),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return bad(what, v);
+                }
+            }
+        }
+        if let ArclengthScale::Fixed(a, b) = self.scale {
+            for v in [a, b] {
+                if !(v.is_finite() && v > 0.0) {
+                    return bad("scale", v);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EndReason {
+    /// `max_steps` points were accepted.
+    MaxSteps,
+    /// The corrected parameter left the allowed range (the point is not kept).
+    ParameterOutOfRange {
+        /// The parameter value reached.
+        lambda: f64,
+    },
+    /// The step fell below `ds_min`.
+    StepBelowMinimum {
+        /// The last rejection.
+        last: Box<Rejection>,
+    },
+    /// An observer returned `ControlFlow::Break`.
+    StoppedByObserver,
+    /// The parameter stopped progressing and every escape attempt failed.
+    Stalled {
+        /// Parameter where the run stalled.
+        lambda: f64,
+    },
+}
+
+/// Why a step was rejected.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RejectReason {
+    /// The corrector failed.
+    Solver(SolveError),
+    /// The corrected point is far from the prediction.
+    Jump {
+        /// `|y - y_p|_W / ds`.
+        ratio: f64,
+    },
+    /// The tangent turned too sharply.
+    Turn {
+        /// Angle between successive tangents, radians.
+        angle: f64,
+    },
+    /// The bordered Jacobian for the tangent is singular.
+    SingularTangent,
+    /// The acceptance test of [`Arclength::with_acceptance`] failed.
+    NotAccepted,
+}
+
+/// A rejected step: the branch stays at its last accepted point and `ds` shrinks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rejection {
+    /// Step size tried.
+    pub ds: f64,
+    /// Predicted parameter.
+    pub lambda: f64,
+    /// Why.
+    pub reason: RejectReason,
+}
+
+/// What one call of [`Arclength::step`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ArclengthOutcome {
+    /// A point was accepted.
+    Accepted(Point),
+    /// A step was rejected; call again to retry with a smaller `ds`.
+    Rejected(Rejection),
+    /// The run is over.
+    Finished(EndReason),
+}
+
+/// The points of a branch with their diagnostics.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Branch {
+    /// Accepted points in order.
+    pub points: Vec<Point>,
+    /// Number of rejected steps.
+    pub rejections: usize,
+    /// Why the run ended (None while it runs).
+    pub end: Option<EndReason>,
+}
+
+impl Branch {
+    /// Points carrying an event of the given kind (by predicate).
+    pub fn with_event(&self, mut which: impl FnMut(&Event) -> bool) -> impl Iterator<Item = &Point> {
+        self.points.iter().filter(move |p| p.events.iter().any(&mut which))
+    }
+}
+
+/// The bordered corrector system `[F(x, lambda); scale <t, y - y_p>_W]` as a [`Problem`].
+struct Bordered<'a, P: ?Sized> {
+    problem: &'a mut P,
+    tangent: &'a [f64],
+    predicted: &'a [f64],
+    weights: (f64, f64),
+    df: Vec<f64>,
+}
+
+impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
+    fn dimension(&self) -> usize {
+        self.problem.dimension() + 1
+    }
+    fn residual(&mut self, y: &[f64], f: &mut [f64]) {
+        let n = self.problem.dimension();
+        self.problem.residual(&y[..n], y[n], &mut f[..n]);
+        f[n] = self.problem.residual_scale() * weighted_dot(self.tangent, y, self.predicted, self.weights);
+    }
+    fn jacobian(&mut self, y: &[f64], jac: &mut DenseMatrix) {
+        let n = self.problem.dimension();
+        let mut inner = DenseMatrix::zeros(n, n);
+        self.problem.jacobian(&y[..n], y[n], &mut inner);
+        self.problem.parameter_derivative(&y[..n], y[n], &mut self.df);
+        jac.reset(n + 1, n + 1);
+        for j in 0..n {
+            for i in 0..n {
+                jac[(i, j)] = inner[(i, j)];
+            }
+        }
+        let s = self.problem.residual_scale();
+        for i in 0..n {
+            jac[(i, n)] = self.df[i];
+            jac[(n, i)] = s * self.tangent[i] * self.weights.0;
+        }
+        jac[(n, n)] = s * self.tangent[n] * self.weights.1;
+    }
+    fn residual_scale(&self) -> f64 {
+        self.problem.residual_scale()
+    }
+}
+
+/// `<t, a - b>_W`.
+fn weighted_dot(t: &[f64], a: &[f64], b: &[f64], w: (f64, f64)) -> f64 {
+    let n = t.len() - 1;
+    let mut s = 0.0;
+    for i in 0..n {
+        s += t[i] * (a[i] - b[i]) * w.0;
+    }
+    s + t[n] * (a[n] - b[n]) * w.1
+}
+
+fn weighted_norm(v: &[f64], w: (f64, f64)) -> f64 {
+    let n = v.len() - 1;
+    (v[..n].iter().map(|a| a * a).sum::<f64>() * w.0 + v[n] * v[n] * w.1).sqrt()
+}
+
+/// Pseudo-arclength continuation driver, generic over the problem and the corrector.
+pub struct Arclength<P, S> {
+    problem: P,
+    solver: S,
+    options: ArclengthOptions,
+    weights: (f64, f64),
+    y: Vec<f64>,
+    tangent: Vec<f64>,
+    previous: Option<Vec<f64>>,
+    active: Option<Vec<usize>>,
+    ds: f64,
+    accepted: usize,
+    finished: Option<EndReason>,
+    history: std::collections::VecDeque<(f64, Vec<f64>)>,
+    accept: Option<Acceptance>,
+}
+
+/// A test that a converged solution `(x, lambda)` belongs to the branch.
+type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
+
+impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
+    /// Starts from a solution `x0` at `lambda0` (it is corrected at fixed `lambda0` first).
+    ///
+    /// # Errors
+    /// Invalid options, a wrong-sized `x0`, a start where the solver fails
+    /// ([`ContinuationError::Start`]) or a singular bordered Jacobian there.
+    pub fn new(
+        mut problem: P,
+        solver: S,
+        x0: Vec<f64>,
+        lambda0: f64,
+        options: ArclengthOptions,
+    ) -> Result<(Self, Point), ContinuationError> {
+        options.validate()?;
+        let n = problem.dimension();
+        if x0.len() != n {
+            return Err(ContinuationError::Dimension {
+                got: x0.len(),
+                expected: n,
+            });
+        }
+        if !lambda0.is_finite() {
+            return Err(ContinuationError::InvalidOption {
+                what: "starting parameter",
+                value: lambda0,
+            });
+        }
+        let mut x = x0;
+        let info = solver
+            .solve(
+                &mut super::AtParameter {
+                    problem: &mut problem,
+                    lambda: lambda0,
+                },
+                &mut x,
+            )
+            .map_err(ContinuationError::Start)?;
+        let weights = match options.scale {
+            ArclengthScale::Automatic => {
+                let sx = norm(&x).max(f64::MIN_POSITIVE.sqrt());
+                let sl = if lambda0 != 0.0 { lambda0.abs() } else { 1.0 };
+                (1.0 / (sx * sx), 1.0 / (sl * sl))
+            }
+            ArclengthScale::Fixed(a, b) => (1.0 / (a * a), 1.0 / (b * b)),
+        };
+        let mut y = x;
+        y.push(lambda0);
+        let mut seed = vec![0.0; n + 1];
+        seed[n] = options.direction;
+        let mut driver = Self {
+            problem,
+            solver,
+            ds: options.ds,
+            options,
+            weights,
+            tangent: Vec::new(),
+            y,
+            previous: None,
+            active: None,
+            accepted: 0,
+            finished: None,
+            history: Default::default(),
+            accept: None,
+        };
+        driver.tangent = driver
+            .tangent_at(&driver.y.clone(), &seed)
+            .ok_or(ContinuationError::SingularTangent { lambda: lambda0 })?;
+        driver.active = driver.problem.active_set(&driver.y[..n], lambda0);
+        let point = driver.point(0, &info, Vec::new());
+        Ok((driver, point))
+    }
+
+    /// Adds a test every accepted point must pass (for instance "not the state of rest"); a
+    /// failing corrected point is rejected like a solver failure.
+    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'static) -> Self {
+        self.accept = Some(Box::new(accept));
+        self
+    }
+
+    /// Restarts from a stored point of a branch (e.g. after changing options or direction).
+    ///
+    /// # Errors
+    /// As [`Arclength::new`].
+    pub fn restart(
+        problem: P,
+        solver: S,
+        point: &Point,
+        options: ArclengthOptions,
+    ) -> Result<(Self, Point), ContinuationError> {
+        Self::new(problem, solver, point.x.clone(), point.lambda, options)
+    }
+
+    /// The problem.
+    pub fn problem_mut(&mut self) -> &mut P {
+        &mut self.problem
+    }
+
+    /// Current step size.
+    pub fn step_size(&self) -> f64 {
+        self.ds
+    }
+
+    /// Current unit tangent `(dx, dlambda)` in the scaled norm.
+    pub fn tangent(&self) -> &[f64] {
+        &self.tangent
+    }
+
+    /// Unit tangent at `y` oriented along `reference` (`<t, reference>_W > 0`).
+    fn tangent_at(&mut self, y: &[f64], reference: &[f64]) -> Option<Vec<f64>> {
+        let n = self.problem.dimension();
+        let mut jac = DenseMatrix::zeros(n, n);
+        let mut df = vec![0.0; n];
+        self.problem.jacobian(&y[..n], y[n], &mut jac);
+        self.problem.parameter_derivative(&y[..n], y[n], &mut df);
+        let mut b = DenseMatrix::zeros(n + 1, n + 1);
+        for j in 0..n {
+            for i in 0..n {
+                b[(i, j)] = jac[(i, j)];
+            }
+        }
+        for i in 0..n {
+            b[(i, n)] = df[i];
+            b[(n, i)] = reference[i] * self.weights.0;
+        }
+        b[(n, n)] = reference[n] * self.weights.1;
+        let lu = Lu::factor(&b, PIVOT_TOLERANCE).ok()?;
+        let mut t = vec![0.0; n + 1];
+        t[n] = 1.0;
+        lu.solve_in_place(&mut t);
+        let len = weighted_norm(&t, self.weights);
+        if !(len.is_finite() && len > 0.0) {
+            return None;
+        }
+        t.iter_mut().for_each(|v| *v /= len);
+        Some(t)
+    }
+
+    fn point(&mut self, step: usize, info: &SolveInfo, events: Vec<Event>) -> Point {
+        let n = self.problem.dimension();
+        Point {
+            step,
+            lambda: self.y[n],
+            x: self.y[..n].to_vec(),
+            residual_norm: info.residual_norm,
+            iterations: info.iterations,
+            converged: true,
+            error: None,
+            step_size: self.ds,
+            events,
+        }
+    }
+
+    fn reject(&mut self, lambda: f64, reason: RejectReason) -> ArclengthOutcome {
+        let rejection = Rejection {
+            ds: self.ds,
+            lambda,
+            reason,
+        };
+        self.ds *= self.options.shrink;
+        if self.ds < self.options.ds_min {
+            if let Some(escape) = self.options.escape {
+                if self.history.len() > 1 {
+                    return self.escape(&escape, self.y[self.y.len() - 1]);
+                }
+            }
+            let end = EndReason::StepBelowMinimum {
+                last: Box::new(rejection),
+            };
+            self.finished = Some(end.clone());
+            return ArclengthOutcome::Finished(end);
+        }
+        ArclengthOutcome::Rejected(rejection)
+    }
+
+    /// One predictor–corrector attempt.
+    pub fn step(&mut self) -> ArclengthOutcome {
+        if let Some(end) = &self.finished {
+            return ArclengthOutcome::Finished(end.clone());
+        }
+        if self.accepted >= self.options.max_steps {
+            self.finished = Some(EndReason::MaxSteps);
+            return ArclengthOutcome::Finished(EndReason::MaxSteps);
+        }
+        let n = self.problem.dimension();
+        let direction = match (self.options.predictor, &self.previous) {
+            (TangentPredictor::Secant, Some(prev)) => {
+                let mut d: Vec<f64> = self.y.iter().zip(prev).map(|(a, b)| a - b).collect();
+                let len = weighted_norm(&d, self.weights);
+                d.iter_mut().for_each(|v| *v /= len);
+                d
+            }
+            _ => self.tangent.clone(),
+        };
+        let predicted: Vec<f64> = self
+            .y
+            .iter()
+            .zip(&direction)
+            .map(|(y, t)| y + self.ds * t)
+            .collect();
+        let mut y = predicted.clone();
+        let result = {
+            let mut bordered = Bordered {
+                problem: &mut self.problem,
+                tangent: &direction,
+                predicted: &predicted,
+                weights: self.weights,
+                df: vec![0.0; n],
+            };
+            self.solver.solve(&mut bordered, &mut y)
+        };
+        let info = match result {
+            Ok(info) => info,
+            Err(e) => return self.reject(predicted[n], RejectReason::Solver(e)),
+        };
+        if let Some(accept) = self.accept.as_mut() {
+            if !accept(&y[..n], y[n]) {
+                return self.reject(y[n], RejectReason::NotAccepted);
+            }
+        }
+        let distance: Vec<f64> = y.iter().zip(&predicted).map(|(a, b)| a - b).collect();
+        let ratio = weighted_norm(&distance, self.weights) / self.ds;
+        let at_floor = self.ds * self.options.shrink < self.options.ds_min;
+        let mut events = Vec::new();
+        if ratio > self.options.jump_ratio {
+            if !at_floor {
+                return self.reject(y[n], RejectReason::Jump { ratio });
+            }
+            events.push(Event::Jump { ratio });
+        }
+        let Some(tangent) = self.tangent_at(&y, &direction) else {
+            return self.reject(y[n], RejectReason::SingularTangent);
+        };
+        let cos = (0..=n)
+            .map(|i| tangent[i] * self.tangent[i] * if i < n { self.weights.0 } else { self.weights.1 })
+            .sum::<f64>()
+            .clamp(-1.0, 1.0);
+        let angle = cos.acos();
+        if angle > self.options.max_turn && !at_floor {
+            return self.reject(y[n], RejectReason::Turn { angle });
+        }
+        let (lo, hi) = self.options.parameter_range;
+        if y[n] < lo || y[n] > hi {
+            let end = EndReason::ParameterOutOfRange { lambda: y[n] };
+            self.finished = Some(end.clone());
+            return ArclengthOutcome::Finished(end);
+        }
+        if tangent[n] * self.tangent[n] < 0.0 {
+            events.push(Event::Fold {
+                lambda: y[n],
+            });
+        }
+        let active = self.problem.active_set(&y[..n], y[n]);
+        if let (Some(old), Some(new)) = (&self.active, &active) {
+            for (law, (a, b)) in old.iter().zip(new).enumerate() {
+                if (*a == 0) != (*b == 0) {
+                    events.push(Event::Grazing {
+                        law,
+                        contact: *b > 0,
+                    });
+                }
+            }
+        }
+        self.active = active;
+        self.previous = Some(std::mem::replace(&mut self.y, y));
+        self.tangent = tangent;
+        self.accepted += 1;
+        let step_used = self.ds;
+        if info.iterations <= self.options.fast_iterations {
+            self.ds = (self.ds * self.options.growth).min(self.options.ds_max);
+        }
+        let mut point = self.point(self.accepted, &info, events);
+        point.step_size = step_used;
+        if let Some(escape) = self.options.escape {
+            self.history.push_back((self.y[n], self.y[..n].to_vec()));
+            if self.history.len() > 2 * escape.window {
+                self.history.pop_front();
+            }
+            if self.is_stalled(&escape) {
+                return self.escape(&escape, point.lambda);
+            }
+        }
+        ArclengthOutcome::Accepted(point)
+    }
+
+    /// Parameter scale `s_lambda`.
+    fn lambda_scale(&self) -> f64 {
+        1.0 / self.weights.1.sqrt()
+    }
+
+    /// Whether the last `window` accepted points made less than `min_progress` progress.
+    fn is_stalled(&self, escape: &StallEscape) -> bool {
+        let h = &self.history;
+        if h.len() <= escape.window {
+            return false;
+        }
+        let now = h[h.len() - 1].0;
+        let then = h[h.len() - 1 - escape.window].0;
+        self.options.direction * (now - then) < escape.min_progress * self.lambda_scale()
+    }
+
+    /// Jumps past a stall: see [`StallEscape`].
+    fn escape(&mut self, escape: &StallEscape, now: f64) -> ArclengthOutcome {
+        let n = self.problem.dimension();
+        let dir = self.options.direction;
+        let scale = self.lambda_scale();
+        // The recent point of least state norm: the backbone below the resonant branch.
+        let from = self
+            .history
+            .iter()
+            .min_by(|a, b| norm(&a.1).total_cmp(&norm(&b.1)))
+            .expect("history holds more than `window` points")
+            .clone();
+        let from_norm = norm(&from.1);
+        let ahead = self.history.iter().map(|(l, _)| dir * l).fold(f64::NEG_INFINITY, f64::max);
+        let mut distance = escape.jump * scale;
+        for _ in 0..escape.max_attempts {
+            // `ahead` and `distance` are in progress coordinates `dir * lambda`.
+            let target = dir * (ahead + distance);
+            let (lo, hi) = self.options.parameter_range;
+            if target < lo || target > hi {
+                let end = EndReason::ParameterOutOfRange { lambda: target };
+                self.finished = Some(end.clone());
+                return ArclengthOutcome::Finished(end);
+            }
+            let mut x = from.1.clone();
+            let solved = self.solver.solve(
+                &mut super::AtParameter {
+                    problem: &mut self.problem,
+                    lambda: target,
+                },
+                &mut x,
+            );
+            let accepted = solved.is_ok()
+                && norm(&x) <= escape.max_norm_ratio * from_norm
+                && self.accept.as_mut().is_none_or(|accept| accept(&x, target));
+            if let (Ok(info), true) = (solved, accepted) {
+                let mut y = x;
+                y.push(target);
+                let mut seed = vec![0.0; n + 1];
+                seed[n] = dir;
+                if let Some(t) = self.tangent_at(&y, &seed) {
+                    let jump: Vec<f64> = y.iter().zip(&self.y).map(|(a, b)| a - b).collect();
+                    let ratio = weighted_norm(&jump, self.weights) / self.ds;
+                    self.previous = None;
+                    self.y = y;
+                    self.tangent = t;
+                    self.history.clear();
+                    self.history.push_back((target, self.y[..n].to_vec()));
+                    self.active = self.problem.active_set(&self.y[..n], target);
+                    self.accepted += 1;
+                    self.ds = self.options.ds;
+                    let mut point = self.point(self.accepted, &info, vec![Event::Jump { ratio }]);
+                    point.step_size = target - now;
+                    return ArclengthOutcome::Accepted(point);
+                }
+            }
+            distance *= 2.0;
+        }
+        let end = EndReason::Stalled { lambda: now };
+        self.finished = Some(end.clone());
+        ArclengthOutcome::Finished(end)
+    }
+
+    /// Runs until the end, handing every outcome (accepted and rejected) to `observer`,
+    /// which may stop the run. Returns the branch (the start point is not included; pass it
+    /// in `start` to have it first).
+    pub fn run(
+        &mut self,
+        start: Option<Point>,
+        mut observer: impl FnMut(&ArclengthOutcome) -> ControlFlow<()>,
+    ) -> Branch {
+        let mut branch = Branch {
+            points: start.into_iter().collect(),
+            ..Default::default()
+        };
+        loop {
+            let outcome = self.step();
+            let stop = observer(&outcome).is_break();
+            match outcome {
+                ArclengthOutcome::Accepted(p) => branch.points.push(p),
+                ArclengthOutcome::Rejected(_) => branch.rejections += 1,
+                ArclengthOutcome::Finished(end) => {
+                    branch.end = Some(end);
+                    return branch;
+                }
+            }
+            if stop {
+                branch.end = Some(EndReason::StoppedByObserver);
+                self.finished = Some(EndReason::StoppedByObserver);
+                return branch;
+            }
+        }
+    }
+}
+
+impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<P, S> {
+    type Item = Point;
+
+    /// Accepted points only (rejections are retried internally); ends with the run.
+    fn next(&mut self) -> Option<Point> {
+        loop {
+            match self.step() {
+                ArclengthOutcome::Accepted(p) => return Some(p),
+                ArclengthOutcome::Rejected(_) => continue,
+                ArclengthOutcome::Finished(_) => return None,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::SemismoothNewton;
+
+    /// `F(x, lambda) = x^2 + lambda^2 - 1`: a circle with folds at `lambda = +-1`.
+    struct Circle;
+
+    impl ContinuationProblem for Circle {
+        fn dimension(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
+            f[0] = x[0] * x[0] + lambda * lambda - 1.0;
+        }
+        fn jacobian(&mut self, x: &[f64], _: f64, jac: &mut DenseMatrix) {
+            jac.reset(1, 1);
+            jac[(0, 0)] = 2.0 * x[0];
+        }
+        fn parameter_derivative(&mut self, _: &[f64], lambda: f64, df: &mut [f64]) {
+            df[0] = 2.0 * lambda;
+        }
+    }
+
+    #[test]
+    fn passes_the_fold_of_a_circle_and_comes_back() {
+        let options = ArclengthOptions {
+            ds: 0.05,
+            ds_max: 0.1,
+            max_steps: 400,
+            parameter_range: (-0.5, 2.0),
+            scale: ArclengthScale::Fixed(1.0, 1.0),
+            ..Default::default()
+        };
+        let (mut driver, start) =
+            Arclength::new(Circle, SemismoothNewton::default(), vec![0.9], 0.0, options).unwrap();
+        let branch = driver.run(Some(start), |_| ControlFlow::Continue(()));
+        // Leaves through lambda < -0.5 on the lower half after turning at lambda = 1.
+        assert!(matches!(branch.end, Some(EndReason::ParameterOutOfRange { lambda }) if lambda < -0.5));
+        let folds: Vec<_> = branch.with_event(|e| matches!(e, Event::Fold { .. })).collect();
+        assert_eq!(folds.len(), 1);
+        assert!(folds[0].lambda > 0.95);
+        assert!(branch.points.iter().any(|p| p.x[0] < -0.5), "came back on the other side");
+        for p in &branch.points {
+            assert!((p.x[0].powi(2) + p.lambda.powi(2) - 1.0).abs() < 1e-9);
+        }
+        // Arclength steps match the geometry: consecutive points are ds apart (chord ~ arc).
+        for w in branch.points.windows(2) {
+            let chord = ((w[1].x[0] - w[0].x[0]).powi(2) + (w[1].lambda - w[0].lambda).powi(2)).sqrt();
+            assert!((chord - w[1].step_size).abs() < 0.01 * w[1].step_size + 1e-3);
+        }
+    }
+
+    #[test]
+    fn observer_stops_and_secant_works() {
+        let options = ArclengthOptions {
+            predictor: TangentPredictor::Secant,
+            scale: ArclengthScale::Fixed(1.0, 1.0),
+            ..Default::default()
+        };
+        let (mut driver, _) =
+            Arclength::new(Circle, SemismoothNewton::default(), vec![1.0], 0.0, options).unwrap();
+        let mut seen = 0;
+        let branch = driver.run(None, |o| {
+            seen += usize::from(matches!(o, ArclengthOutcome::Accepted(_)));
+            if seen == 5 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        assert_eq!(branch.points.len(), 5);
+        assert_eq!(branch.end, Some(EndReason::StoppedByObserver));
+        assert!(matches!(driver.step(), ArclengthOutcome::Finished(EndReason::StoppedByObserver)));
+    }
+
+    #[test]
+    fn rejects_bad_options() {
+        let bad = [
+            ArclengthOptions { ds_min: 1.0, ds_max: 0.1, ds: 0.5, ..Default::default() },
+            ArclengthOptions { ds: f64::NAN, ..Default::default() },
+            ArclengthOptions { parameter_range: (1.0, 1.0), ..Default::default() },
+            ArclengthOptions { parameter_range: (f64::NAN, 1.0), ..Default::default() },
+            ArclengthOptions { direction: 0.0, ..Default::default() },
+            ArclengthOptions { max_steps: 0, ..Default::default() },
+            ArclengthOptions { scale: ArclengthScale::Fixed(0.0, 1.0), ..Default::default() },
+        ];
+        for o in bad {
+            assert!(matches!(
+                Arclength::new(Circle, SemismoothNewton::default(), vec![1.0], 0.0, o),
+                Err(ContinuationError::InvalidOption { .. })
+            ));
+        }
+    }
+}
