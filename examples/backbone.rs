@@ -5,20 +5,41 @@
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
+//!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
+//!     [--parameter-range LO:HI] [--progress]
 //! ```
 //!
 //! Columns: `step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,
-//! residual_norm,iterations` (`exact_energy_normalized` is the exact first mode of the clamped
-//! bar, formulation §9, for `--system ds --mode 1` and empty otherwise).
+//! residual_norm,iterations,step_size,event,parameter` (`exact_energy_normalized` is the exact
+//! first mode of the clamped bar, formulation §9, for `--system ds --mode 1` and empty
+//! otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the
+//! continued parameter's value).
+//!
+//! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
+//! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
+//! escape from internal-resonance stalls. `--parameter gap|robin-stiffness|stiffness-ratio`
+//! continues in that parameter at the fixed period `--period-start` inside
+//! `--parameter-range` (default: a decade either side), starting from the branch point at that
+//! period (reached by a short sequential run from the system's default start).
 
 use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::continuation::{
+    linspace, Arclength, ArclengthOptions, ArclengthOutcome, Event, Point, Sequential,
+    SequentialOptions, StallEscape,
+};
 use nonsmooth_modes::modal::backbone::backbone_with;
-use nonsmooth_modes::modal::{BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::modal::{
+    arclength_backbone, backbone, energy, grazing_energy, ArclengthBackboneOptions,
+    BackboneOptions, BackbonePoint, PeriodGrid,
+};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, SemismoothNewton};
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance};
+use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
+use nonsmooth_modes::{ModelError, SolveError};
+use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::process::ExitCode;
@@ -26,7 +47,12 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
   [--penalty AC] [--mode I] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--out FILE]";
+  [--solver newton|dogleg] [--out FILE] [--method sequential|arclength]
+  [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
+  [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
+  [--progress]";
+
+const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,residual_norm,iterations,step_size,event,parameter";
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum SystemKind {
@@ -35,7 +61,15 @@ enum SystemKind {
     TwoBar,
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Parameter {
+    Omega,
+    Gap,
+    RobinStiffness,
+    StiffnessRatio,
+}
+
+#[derive(Debug, Clone)]
 struct Args {
     system: SystemKind,
     gap: f64,
@@ -50,6 +84,12 @@ struct Args {
     steps: usize,
     dogleg: bool,
     out: Option<String>,
+    arclength: bool,
+    driver: ArclengthOptions,
+    omega_range: Option<(f64, f64)>,
+    parameter: Parameter,
+    parameter_range: Option<(f64, f64)>,
+    progress: bool,
 }
 
 /// Default period range per system: just below the linear period of the chosen mode
@@ -62,6 +102,17 @@ fn default_periods(system: SystemKind) -> (f64, f64) {
         // bar 1 clamped-free: T_1 = 4
         SystemKind::TwoBar => (3.95, 3.05),
     }
+}
+
+fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
+    let (a, b) = text
+        .split_once(':')
+        .ok_or_else(|| format!("expected LO:HI, got `{text}`"))?;
+    let parse = |v: &str| {
+        v.parse::<f64>()
+            .map_err(|e| lexopt::Error::from(format!("`{v}`: {e}")))
+    };
+    Ok((parse(a)?, parse(b)?))
 }
 
 fn parse() -> Result<Args, lexopt::Error> {
@@ -80,6 +131,15 @@ fn parse() -> Result<Args, lexopt::Error> {
         steps: 181,
         dogleg: false,
         out: None,
+        arclength: false,
+        driver: ArclengthOptions {
+            escape: Some(StallEscape::default()),
+            ..Default::default()
+        },
+        omega_range: None,
+        parameter: Parameter::Omega,
+        parameter_range: None,
+        progress: false,
     };
     let mut parser = lexopt::Parser::from_env();
     while let Some(arg) = parser.next()? {
@@ -114,6 +174,29 @@ fn parse() -> Result<Args, lexopt::Error> {
                 }
             }
             Long("out") => a.out = Some(parser.value()?.string()?),
+            Long("method") => {
+                a.arclength = match parser.value()?.string()?.as_str() {
+                    "sequential" => false,
+                    "arclength" => true,
+                    other => return Err(format!("unknown method `{other}`").into()),
+                }
+            }
+            Long("ds") => a.driver.ds = parser.value()?.parse()?,
+            Long("ds-min") => a.driver.ds_min = parser.value()?.parse()?,
+            Long("ds-max") => a.driver.ds_max = parser.value()?.parse()?,
+            Long("max-steps") => a.driver.max_steps = parser.value()?.parse()?,
+            Long("omega-range") => a.omega_range = Some(range(&parser.value()?.string()?)?),
+            Long("parameter") => {
+                a.parameter = match parser.value()?.string()?.as_str() {
+                    "omega" => Parameter::Omega,
+                    "gap" => Parameter::Gap,
+                    "robin-stiffness" => Parameter::RobinStiffness,
+                    "stiffness-ratio" => Parameter::StiffnessRatio,
+                    other => return Err(format!("unknown parameter `{other}`").into()),
+                }
+            }
+            Long("parameter-range") => a.parameter_range = Some(range(&parser.value()?.string()?)?),
+            Long("progress") => a.progress = true,
             Short('h') | Long("help") => return Err("help requested".into()),
             _ => return Err(arg.unexpected()),
         }
@@ -121,87 +204,256 @@ fn parse() -> Result<Args, lexopt::Error> {
     Ok(a)
 }
 
-fn build_system(a: &Args) -> Result<BarSystem, nonsmooth_modes::Error> {
-    Ok(match a.system {
-        SystemKind::Clamped => clamped_bar_with_obstacle(a.gap)?,
-        SystemKind::Robin => robin_bar_with_obstacle(a.robin_stiffness, a.gap)?,
+/// The system of the command line with `parameter` set to `value` (the other flags fixed).
+fn build_system(a: &Args, parameter: Parameter, value: f64) -> Result<BarSystem, ModelError> {
+    let mut a = a.clone();
+    match parameter {
+        Parameter::Omega => {}
+        Parameter::Gap => a.gap = value,
+        Parameter::RobinStiffness => a.robin_stiffness = value,
+        Parameter::StiffnessRatio => a.stiffness_ratio = value,
+    }
+    match a.system {
+        SystemKind::Clamped => clamped_bar_with_obstacle(a.gap),
+        SystemKind::Robin => robin_bar_with_obstacle(a.robin_stiffness, a.gap),
         SystemKind::TwoBar => {
-            let second = Bar::new(a.length2, a.speed2, a.stiffness_ratio)?;
-            two_bars_in_contact(second, a.gap)?
+            two_bars_in_contact(Bar::new(a.length2, a.speed2, a.stiffness_ratio)?, a.gap)
         }
-    })
+    }
 }
 
-fn csv_row(p: &BackbonePoint, exact: Option<f64>) -> String {
-    format!(
-        "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{:.3e},{}",
-        p.step,
-        p.period,
-        p.omega,
-        p.energy,
-        p.energy_normalized,
-        exact.map(|e| format!("{e:.10e}")).unwrap_or_default(),
-        p.converged,
-        p.residual_norm,
-        p.iterations
-    )
+fn parameter_value(a: &Args, parameter: Parameter) -> f64 {
+    match parameter {
+        Parameter::Omega => f64::NAN,
+        Parameter::Gap => a.gap,
+        Parameter::RobinStiffness => a.robin_stiffness,
+        Parameter::StiffnessRatio => a.stiffness_ratio,
+    }
+}
+
+fn events(events: &[Event]) -> String {
+    events
+        .iter()
+        .map(Event::label)
+        .collect::<Vec<_>>()
+        .join(";")
+}
+
+/// Writes rows and counts them; remembers the first I/O error and stops the run on it.
+struct Sink<'a> {
+    out: &'a mut dyn Write,
+    exact: Option<f64>,
+    total: usize,
+    converged: usize,
+    error: Option<std::io::Error>,
+    progress: bool,
+}
+
+impl Sink<'_> {
+    fn row(&mut self, p: &BackbonePoint, parameter: f64) -> ControlFlow<()> {
+        self.total += 1;
+        self.converged += usize::from(p.converged);
+        let exact = self
+            .exact
+            .map(|gap| ClampedFirstMode::new(gap, p.period).energy_normalized());
+        if self.progress && self.total % 25 == 0 {
+            eprintln!(
+                "step {:5}  T {:.5}  E/Eg {:.5e}  ds {:.3e}",
+                p.step, p.period, p.energy_normalized, p.step_size
+            );
+        }
+        let line = format!(
+            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{:.3e},{},{:.6e},{},{}",
+            p.step,
+            p.period,
+            p.omega,
+            p.energy,
+            p.energy_normalized,
+            exact.map(|e| format!("{e:.10e}")).unwrap_or_default(),
+            p.converged,
+            p.residual_norm,
+            p.iterations,
+            p.step_size,
+            events(&p.events),
+            if parameter.is_nan() {
+                String::new()
+            } else {
+                format!("{parameter:.10e}")
+            },
+        );
+        match writeln!(self.out, "{line}") {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                self.error = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    }
 }
 
 fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::error::Error>> {
-    let system = build_system(a)?;
+    let system = build_system(a, Parameter::Omega, f64::NAN)?;
     let (t0, t1) = default_periods(a.system);
+    let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
+    writeln!(out, "{HEADER}")?;
+    let mut sink = Sink {
+        out,
+        exact: (a.system == SystemKind::Clamped && a.mode == 1 && a.parameter != Parameter::Gap)
+            .then_some(a.gap),
+        total: 0,
+        converged: 0,
+        error: None,
+        progress: a.progress,
+    };
+    let solver = DynSolver(if a.dogleg {
+        Box::new(Dogleg::default())
+    } else {
+        Box::new(SemismoothNewton::default())
+    });
+    if a.parameter != Parameter::Omega {
+        run_parameter(a, t0, solver, &mut sink)?;
+    } else if a.arclength {
+        let (lo, hi) = (2.0 * PI / t0, 2.0 * PI / t1);
+        let options = ArclengthBackboneOptions {
+            start_period: t0,
+            omega_range: a.omega_range.unwrap_or((lo.min(hi) * 0.999, lo.max(hi))),
+            mode: a.mode,
+            arclength: ArclengthOptions {
+                direction: if t1 < t0 { 1.0 } else { -1.0 },
+                ..a.driver
+            },
+            ..Default::default()
+        };
+        let (_, branch) = arclength_backbone(&system, a.settings, &options, solver, |p| {
+            sink.row(p, f64::NAN)
+        })?;
+        eprintln!(
+            "backbone: arclength ended: {:?}; {} rejected steps",
+            branch.end, branch.rejections
+        );
+    } else {
+        let options = BackboneOptions {
+            grid: PeriodGrid {
+                start: t0,
+                end: t1,
+                steps: a.steps,
+            },
+            mode: a.mode,
+            ..Default::default()
+        };
+        backbone_with(&system, a.settings, &options, solver, |p| {
+            sink.row(p, f64::NAN)
+        })?;
+    }
+    if let Some(e) = sink.error {
+        return Err(e.into());
+    }
+    Ok((sink.total, sink.converged))
+}
+
+/// Continuation in a system parameter at the fixed period `period`.
+fn run_parameter(
+    a: &Args,
+    period: f64,
+    solver: DynSolver,
+    sink: &mut Sink<'_>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let parameter = a.parameter;
+    let value = parameter_value(a, parameter);
+    let system = build_system(a, parameter, value)?;
+    // Reach the branch at `period` from the system's default start.
+    let start_period = default_periods(a.system).0;
     let options = BackboneOptions {
         grid: PeriodGrid {
-            start: a.period_start.unwrap_or(t0),
-            end: a.period_end.unwrap_or(t1),
-            steps: a.steps,
+            start: start_period,
+            end: period,
+            steps: ((start_period - period).abs() / 0.005).ceil().max(1.0) as usize + 1,
         },
         mode: a.mode,
         ..Default::default()
     };
-    let exact = a.system == SystemKind::Clamped && a.mode == 1;
-    writeln!(
-        out,
-        "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,residual_norm,iterations"
-    )?;
-    let (mut total, mut converged) = (0, 0);
-    let mut io_error = None;
-    let mut observer = |p: &BackbonePoint| {
-        total += 1;
-        converged += usize::from(p.converged);
-        let e = exact.then(|| ClampedFirstMode::new(a.gap, p.period).energy_normalized());
-        match writeln!(out, "{}", csv_row(p, e)) {
-            Ok(()) => ControlFlow::Continue(()),
-            Err(err) => {
-                io_error = Some(err);
-                ControlFlow::Break(())
-            }
+    let reached = backbone(&system, a.settings, &options, SemismoothNewton::default())?;
+    let start = reached
+        .iter()
+        .rev()
+        .find(|p| p.converged)
+        .ok_or("no converged point on the way to the starting period")?
+        .clone();
+    let omega = 2.0 * PI / start.period;
+    let family = move |v: f64| build_system(a, parameter, v);
+    let problem = ParameterFamily::at(family, a.settings, omega, value)?;
+    let (lo, hi) = a.parameter_range.unwrap_or((value / 10.0, value * 10.0));
+    let mut report = |p: &Point| {
+        let system = match build_system(a, parameter, p.lambda) {
+            Ok(s) => s,
+            Err(_) => return ControlFlow::Continue(()),
+        };
+        let basis = match a.settings.cosine_basis() {
+            Ok(b) => b,
+            Err(_) => return ControlFlow::Break(()),
+        };
+        let e = energy(&system, &basis, &p.x, omega);
+        let e_g = grazing_energy(&system).map(|g| g.0).unwrap_or(f64::NAN);
+        let point = BackbonePoint {
+            step: p.step,
+            period: start.period,
+            omega,
+            energy: e,
+            energy_normalized: e / e_g,
+            converged: p.converged,
+            residual_norm: p.residual_norm,
+            iterations: p.iterations,
+            x: Vec::new(),
+            step_size: p.step_size,
+            events: p.events.clone(),
+        };
+        sink.row(&point, p.lambda)
+    };
+    if a.arclength {
+        let options = ArclengthOptions {
+            parameter_range: (lo, hi),
+            escape: None,
+            ..a.driver
+        };
+        let (mut driver, first) = Arclength::new(problem, solver, start.x, value, options)?;
+        if report(&first).is_continue() {
+            let branch = driver.run(None, |o| match o {
+                ArclengthOutcome::Accepted(p) => report(p),
+                _ => ControlFlow::Continue(()),
+            });
+            eprintln!(
+                "backbone: arclength ended: {:?}; {} rejected steps",
+                branch.end, branch.rejections
+            );
         }
-    };
-    let solver: Box<dyn NonlinearSolver> = if a.dogleg {
-        Box::new(Dogleg::default())
     } else {
-        Box::new(SemismoothNewton::default())
-    };
-    backbone_with(&system, a.settings, &options, DynSolver(solver), &mut observer)?;
-    if let Some(e) = io_error {
-        return Err(e.into());
+        // Sequential parameter runs go from the current value to the far end of the range.
+        let far = if (hi - value).abs() >= (value - lo).abs() {
+            hi
+        } else {
+            lo
+        };
+        let values = linspace(value, far, a.steps)?;
+        let mut driver = Sequential::new(
+            problem,
+            solver,
+            start.x,
+            values,
+            SequentialOptions::default(),
+        )?;
+        driver.run(|p| report(p))?;
     }
-    Ok((total, converged))
+    Ok(())
 }
 
 /// Lets a boxed solver stand where a generic one is expected.
 struct DynSolver(Box<dyn NonlinearSolver>);
 
 impl NonlinearSolver for DynSolver {
-    fn solve(
-        &self,
-        problem: &mut dyn nonsmooth_modes::solve::Problem,
-        x: &mut [f64],
-    ) -> Result<nonsmooth_modes::solve::SolveInfo, nonsmooth_modes::SolveError> {
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
         self.0.solve(problem, x)
     }
-    fn tolerance(&self, problem: &dyn nonsmooth_modes::solve::Problem) -> f64 {
+    fn tolerance(&self, problem: &dyn Problem) -> f64 {
         self.0.tolerance(problem)
     }
 }

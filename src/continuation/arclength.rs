@@ -34,7 +34,7 @@
 use super::{ContinuationProblem, Event, Point};
 use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::solve::{norm, NonlinearSolver, Problem, SolveInfo, PIVOT_TOLERANCE};
+use crate::solve::{NonlinearSolver, Problem, SolveInfo, PIVOT_TOLERANCE};
 use std::ops::ControlFlow;
 
 /// How the predictor direction is formed.
@@ -50,11 +50,13 @@ pub enum TangentPredictor {
 /// Scales `(s_x, s_lambda)` of the arclength norm.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum ArclengthScale {
-    /// `s_x = |x_0|_2` (relative change of the state) and `s_lambda = |lambda_0|` (or 1 when
-    /// `lambda_0 = 0`), from the starting point (default).
+    /// `|x|^2 = sum_i w_i x_i^2 / sum_i w_i x0_i^2` with the problem's
+    /// [`ContinuationProblem::state_weights`] (an energy norm for harmonic balance; all 1 if it
+    /// has none), so that `ds` is the relative change of the state; and
+    /// `s_lambda = |lambda_0|` (or 1 when `lambda_0 = 0`) (default).
     #[default]
     Automatic,
-    /// Fixed scales `(s_x, s_lambda)`.
+    /// Fixed scales `(s_x, s_lambda)`: `|y|^2 = |x|_2^2 / s_x^2 + lambda^2 / s_lambda^2`.
     Fixed(f64, f64),
 }
 
@@ -188,7 +190,10 @@ impl ArclengthOptions {
         }
         if let Some(e) = self.escape {
             if e.window < 2 || e.max_attempts == 0 {
-                return bad("escape window/attempts", e.window.min(e.max_attempts) as f64);
+                return bad(
+                    "escape window/attempts",
+                    e.window.min(e.max_attempts) as f64,
+                );
             }
             for (what, v) in [
                 ("escape min_progress", e.min_progress),
@@ -291,8 +296,13 @@ pub struct Branch {
 
 impl Branch {
     /// Points carrying an event of the given kind (by predicate).
-    pub fn with_event(&self, mut which: impl FnMut(&Event) -> bool) -> impl Iterator<Item = &Point> {
-        self.points.iter().filter(move |p| p.events.iter().any(&mut which))
+    pub fn with_event(
+        &self,
+        mut which: impl FnMut(&Event) -> bool,
+    ) -> impl Iterator<Item = &Point> {
+        self.points
+            .iter()
+            .filter(move |p| p.events.iter().any(&mut which))
     }
 }
 
@@ -301,7 +311,7 @@ struct Bordered<'a, P: ?Sized> {
     problem: &'a mut P,
     tangent: &'a [f64],
     predicted: &'a [f64],
-    weights: (f64, f64),
+    metric: &'a Metric,
     df: Vec<f64>,
 }
 
@@ -312,13 +322,15 @@ impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
     fn residual(&mut self, y: &[f64], f: &mut [f64]) {
         let n = self.problem.dimension();
         self.problem.residual(&y[..n], y[n], &mut f[..n]);
-        f[n] = self.problem.residual_scale() * weighted_dot(self.tangent, y, self.predicted, self.weights);
+        f[n] =
+            self.problem.residual_scale() * self.metric.dot_diff(self.tangent, y, self.predicted);
     }
     fn jacobian(&mut self, y: &[f64], jac: &mut DenseMatrix) {
         let n = self.problem.dimension();
         let mut inner = DenseMatrix::zeros(n, n);
         self.problem.jacobian(&y[..n], y[n], &mut inner);
-        self.problem.parameter_derivative(&y[..n], y[n], &mut self.df);
+        self.problem
+            .parameter_derivative(&y[..n], y[n], &mut self.df);
         jac.reset(n + 1, n + 1);
         for j in 0..n {
             for i in 0..n {
@@ -328,28 +340,43 @@ impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
         let s = self.problem.residual_scale();
         for i in 0..n {
             jac[(i, n)] = self.df[i];
-            jac[(n, i)] = s * self.tangent[i] * self.weights.0;
         }
-        jac[(n, n)] = s * self.tangent[n] * self.weights.1;
+        for i in 0..=n {
+            jac[(n, i)] = s * self.tangent[i] * self.metric.weight(i);
+        }
     }
     fn residual_scale(&self) -> f64 {
         self.problem.residual_scale()
     }
 }
 
-/// `<t, a - b>_W`.
-fn weighted_dot(t: &[f64], a: &[f64], b: &[f64], w: (f64, f64)) -> f64 {
-    let n = t.len() - 1;
-    let mut s = 0.0;
-    for i in 0..n {
-        s += t[i] * (a[i] - b[i]) * w.0;
-    }
-    s + t[n] * (a[n] - b[n]) * w.1
+/// Diagonal metric `W` of the scaled norm on `y = (x, lambda)`: `x[i]` weighs `x_w[i]`,
+/// `lambda` weighs `lambda_w`.
+#[derive(Debug, Clone, PartialEq)]
+struct Metric {
+    x_w: Vec<f64>,
+    lambda_w: f64,
 }
 
-fn weighted_norm(v: &[f64], w: (f64, f64)) -> f64 {
-    let n = v.len() - 1;
-    (v[..n].iter().map(|a| a * a).sum::<f64>() * w.0 + v[n] * v[n] * w.1).sqrt()
+impl Metric {
+    fn weight(&self, i: usize) -> f64 {
+        self.x_w.get(i).copied().unwrap_or(self.lambda_w)
+    }
+
+    /// `<a, b - c>_W`.
+    fn dot_diff(&self, a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+        (0..a.len())
+            .map(|i| a[i] * (b[i] - c[i]) * self.weight(i))
+            .sum()
+    }
+
+    /// `|v|_W` for `v = (x, lambda)` or `v = x` alone.
+    fn norm(&self, v: &[f64]) -> f64 {
+        (0..v.len())
+            .map(|i| v[i] * v[i] * self.weight(i))
+            .sum::<f64>()
+            .sqrt()
+    }
 }
 
 /// Pseudo-arclength continuation driver, generic over the problem and the corrector.
@@ -357,7 +384,7 @@ pub struct Arclength<P, S> {
     problem: P,
     solver: S,
     options: ArclengthOptions,
-    weights: (f64, f64),
+    metric: Metric,
     y: Vec<f64>,
     tangent: Vec<f64>,
     previous: Option<Vec<f64>>,
@@ -366,6 +393,7 @@ pub struct Arclength<P, S> {
     accepted: usize,
     finished: Option<EndReason>,
     history: std::collections::VecDeque<(f64, Vec<f64>)>,
+    frontier: Option<(f64, Vec<f64>)>,
     accept: Option<Acceptance>,
 }
 
@@ -409,13 +437,28 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 &mut x,
             )
             .map_err(ContinuationError::Start)?;
-        let weights = match options.scale {
+        let metric = match options.scale {
             ArclengthScale::Automatic => {
-                let sx = norm(&x).max(f64::MIN_POSITIVE.sqrt());
+                let raw = problem
+                    .state_weights(lambda0)
+                    .filter(|w| w.len() == n && w.iter().all(|v| v.is_finite() && *v > 0.0))
+                    .unwrap_or_else(|| vec![1.0; n]);
+                let sx2 = (0..n).map(|i| raw[i] * x[i] * x[i]).sum::<f64>();
+                let sx2 = if sx2 > 0.0 {
+                    sx2
+                } else {
+                    raw.iter().sum::<f64>()
+                };
                 let sl = if lambda0 != 0.0 { lambda0.abs() } else { 1.0 };
-                (1.0 / (sx * sx), 1.0 / (sl * sl))
+                Metric {
+                    x_w: raw.iter().map(|w| w / sx2).collect(),
+                    lambda_w: 1.0 / (sl * sl),
+                }
             }
-            ArclengthScale::Fixed(a, b) => (1.0 / (a * a), 1.0 / (b * b)),
+            ArclengthScale::Fixed(a, b) => Metric {
+                x_w: vec![1.0 / (a * a); n],
+                lambda_w: 1.0 / (b * b),
+            },
         };
         let mut y = x;
         y.push(lambda0);
@@ -426,7 +469,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             solver,
             ds: options.ds,
             options,
-            weights,
+            metric,
             tangent: Vec::new(),
             y,
             previous: None,
@@ -434,6 +477,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             accepted: 0,
             finished: None,
             history: Default::default(),
+            frontier: None,
             accept: None,
         };
         driver.tangent = driver
@@ -494,14 +538,15 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         }
         for i in 0..n {
             b[(i, n)] = df[i];
-            b[(n, i)] = reference[i] * self.weights.0;
         }
-        b[(n, n)] = reference[n] * self.weights.1;
+        for i in 0..=n {
+            b[(n, i)] = reference[i] * self.metric.weight(i);
+        }
         let lu = Lu::factor(&b, PIVOT_TOLERANCE).ok()?;
         let mut t = vec![0.0; n + 1];
         t[n] = 1.0;
         lu.solve_in_place(&mut t);
-        let len = weighted_norm(&t, self.weights);
+        let len = self.metric.norm(&t);
         if !(len.is_finite() && len > 0.0) {
             return None;
         }
@@ -559,7 +604,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         let direction = match (self.options.predictor, &self.previous) {
             (TangentPredictor::Secant, Some(prev)) => {
                 let mut d: Vec<f64> = self.y.iter().zip(prev).map(|(a, b)| a - b).collect();
-                let len = weighted_norm(&d, self.weights);
+                let len = self.metric.norm(&d);
                 d.iter_mut().for_each(|v| *v /= len);
                 d
             }
@@ -577,7 +622,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 problem: &mut self.problem,
                 tangent: &direction,
                 predicted: &predicted,
-                weights: self.weights,
+                metric: &self.metric,
                 df: vec![0.0; n],
             };
             self.solver.solve(&mut bordered, &mut y)
@@ -592,7 +637,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             }
         }
         let distance: Vec<f64> = y.iter().zip(&predicted).map(|(a, b)| a - b).collect();
-        let ratio = weighted_norm(&distance, self.weights) / self.ds;
+        let ratio = self.metric.norm(&distance) / self.ds;
         let at_floor = self.ds * self.options.shrink < self.options.ds_min;
         let mut events = Vec::new();
         if ratio > self.options.jump_ratio {
@@ -605,7 +650,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             return self.reject(y[n], RejectReason::SingularTangent);
         };
         let cos = (0..=n)
-            .map(|i| tangent[i] * self.tangent[i] * if i < n { self.weights.0 } else { self.weights.1 })
+            .map(|i| tangent[i] * self.tangent[i] * self.metric.weight(i))
             .sum::<f64>()
             .clamp(-1.0, 1.0);
         let angle = cos.acos();
@@ -619,9 +664,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             return ArclengthOutcome::Finished(end);
         }
         if tangent[n] * self.tangent[n] < 0.0 {
-            events.push(Event::Fold {
-                lambda: y[n],
-            });
+            events.push(Event::Fold { lambda: y[n] });
         }
         let active = self.problem.active_set(&y[..n], y[n]);
         if let (Some(old), Some(new)) = (&self.active, &active) {
@@ -645,6 +688,14 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         let mut point = self.point(self.accepted, &info, events);
         point.step_size = step_used;
         if let Some(escape) = self.options.escape {
+            let dir = self.options.direction;
+            if self
+                .frontier
+                .as_ref()
+                .is_none_or(|(l, _)| dir * self.y[n] > dir * l)
+            {
+                self.frontier = Some((self.y[n], self.y[..n].to_vec()));
+            }
             self.history.push_back((self.y[n], self.y[..n].to_vec()));
             if self.history.len() > 2 * escape.window {
                 self.history.pop_front();
@@ -658,7 +709,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
 
     /// Parameter scale `s_lambda`.
     fn lambda_scale(&self) -> f64 {
-        1.0 / self.weights.1.sqrt()
+        1.0 / self.metric.lambda_w.sqrt()
     }
 
     /// Whether the last `window` accepted points made less than `min_progress` progress.
@@ -677,15 +728,21 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         let n = self.problem.dimension();
         let dir = self.options.direction;
         let scale = self.lambda_scale();
-        // The recent point of least state norm: the backbone below the resonant branch.
-        let from = self
+        // Anchors: the recent point of least state norm (the backbone below a resonant
+        // branch) and the most advanced point ever accepted (the frontier).
+        let mut anchors: Vec<(f64, Vec<f64>)> = self
             .history
             .iter()
-            .min_by(|a, b| norm(&a.1).total_cmp(&norm(&b.1)))
-            .expect("history holds more than `window` points")
-            .clone();
-        let from_norm = norm(&from.1);
-        let ahead = self.history.iter().map(|(l, _)| dir * l).fold(f64::NEG_INFINITY, f64::max);
+            .min_by(|a, b| self.metric.norm(&a.1).total_cmp(&self.metric.norm(&b.1)))
+            .into_iter()
+            .cloned()
+            .collect();
+        anchors.extend(self.frontier.clone());
+        let ahead = anchors
+            .iter()
+            .chain(self.history.iter())
+            .map(|(l, _)| dir * l)
+            .fold(f64::NEG_INFINITY, f64::max);
         let mut distance = escape.jump * scale;
         for _ in 0..escape.max_attempts {
             // `ahead` and `distance` are in progress coordinates `dir * lambda`.
@@ -696,36 +753,40 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 self.finished = Some(end.clone());
                 return ArclengthOutcome::Finished(end);
             }
-            let mut x = from.1.clone();
-            let solved = self.solver.solve(
-                &mut super::AtParameter {
-                    problem: &mut self.problem,
-                    lambda: target,
-                },
-                &mut x,
-            );
-            let accepted = solved.is_ok()
-                && norm(&x) <= escape.max_norm_ratio * from_norm
-                && self.accept.as_mut().is_none_or(|accept| accept(&x, target));
-            if let (Ok(info), true) = (solved, accepted) {
-                let mut y = x;
-                y.push(target);
-                let mut seed = vec![0.0; n + 1];
-                seed[n] = dir;
-                if let Some(t) = self.tangent_at(&y, &seed) {
-                    let jump: Vec<f64> = y.iter().zip(&self.y).map(|(a, b)| a - b).collect();
-                    let ratio = weighted_norm(&jump, self.weights) / self.ds;
-                    self.previous = None;
-                    self.y = y;
-                    self.tangent = t;
-                    self.history.clear();
-                    self.history.push_back((target, self.y[..n].to_vec()));
-                    self.active = self.problem.active_set(&self.y[..n], target);
-                    self.accepted += 1;
-                    self.ds = self.options.ds;
-                    let mut point = self.point(self.accepted, &info, vec![Event::Jump { ratio }]);
-                    point.step_size = target - now;
-                    return ArclengthOutcome::Accepted(point);
+            for from in &anchors {
+                let from_norm = self.metric.norm(&from.1);
+                let mut x = from.1.clone();
+                let solved = self.solver.solve(
+                    &mut super::AtParameter {
+                        problem: &mut self.problem,
+                        lambda: target,
+                    },
+                    &mut x,
+                );
+                let accepted = solved.is_ok()
+                    && self.metric.norm(&x) <= escape.max_norm_ratio * from_norm
+                    && self.accept.as_mut().is_none_or(|accept| accept(&x, target));
+                if let (Ok(info), true) = (solved, accepted) {
+                    let mut y = x;
+                    y.push(target);
+                    let mut seed = vec![0.0; n + 1];
+                    seed[n] = dir;
+                    if let Some(t) = self.tangent_at(&y, &seed) {
+                        let jump: Vec<f64> = y.iter().zip(&self.y).map(|(a, b)| a - b).collect();
+                        let ratio = self.metric.norm(&jump) / self.ds;
+                        self.previous = None;
+                        self.y = y;
+                        self.tangent = t;
+                        self.history.clear();
+                        self.history.push_back((target, self.y[..n].to_vec()));
+                        self.active = self.problem.active_set(&self.y[..n], target);
+                        self.accepted += 1;
+                        self.ds = self.options.ds;
+                        let mut point =
+                            self.point(self.accepted, &info, vec![Event::Jump { ratio }]);
+                        point.step_size = target - now;
+                        return ArclengthOutcome::Accepted(point);
+                    }
                 }
             }
             distance *= 2.0;
@@ -820,17 +881,25 @@ mod tests {
             Arclength::new(Circle, SemismoothNewton::default(), vec![0.9], 0.0, options).unwrap();
         let branch = driver.run(Some(start), |_| ControlFlow::Continue(()));
         // Leaves through lambda < -0.5 on the lower half after turning at lambda = 1.
-        assert!(matches!(branch.end, Some(EndReason::ParameterOutOfRange { lambda }) if lambda < -0.5));
-        let folds: Vec<_> = branch.with_event(|e| matches!(e, Event::Fold { .. })).collect();
+        assert!(
+            matches!(branch.end, Some(EndReason::ParameterOutOfRange { lambda }) if lambda < -0.5)
+        );
+        let folds: Vec<_> = branch
+            .with_event(|e| matches!(e, Event::Fold { .. }))
+            .collect();
         assert_eq!(folds.len(), 1);
         assert!(folds[0].lambda > 0.95);
-        assert!(branch.points.iter().any(|p| p.x[0] < -0.5), "came back on the other side");
+        assert!(
+            branch.points.iter().any(|p| p.x[0] < -0.5),
+            "came back on the other side"
+        );
         for p in &branch.points {
             assert!((p.x[0].powi(2) + p.lambda.powi(2) - 1.0).abs() < 1e-9);
         }
         // Arclength steps match the geometry: consecutive points are ds apart (chord ~ arc).
         for w in branch.points.windows(2) {
-            let chord = ((w[1].x[0] - w[0].x[0]).powi(2) + (w[1].lambda - w[0].lambda).powi(2)).sqrt();
+            let chord =
+                ((w[1].x[0] - w[0].x[0]).powi(2) + (w[1].lambda - w[0].lambda).powi(2)).sqrt();
             assert!((chord - w[1].step_size).abs() < 0.01 * w[1].step_size + 1e-3);
         }
     }
@@ -855,19 +924,45 @@ mod tests {
         });
         assert_eq!(branch.points.len(), 5);
         assert_eq!(branch.end, Some(EndReason::StoppedByObserver));
-        assert!(matches!(driver.step(), ArclengthOutcome::Finished(EndReason::StoppedByObserver)));
+        assert!(matches!(
+            driver.step(),
+            ArclengthOutcome::Finished(EndReason::StoppedByObserver)
+        ));
     }
 
     #[test]
     fn rejects_bad_options() {
         let bad = [
-            ArclengthOptions { ds_min: 1.0, ds_max: 0.1, ds: 0.5, ..Default::default() },
-            ArclengthOptions { ds: f64::NAN, ..Default::default() },
-            ArclengthOptions { parameter_range: (1.0, 1.0), ..Default::default() },
-            ArclengthOptions { parameter_range: (f64::NAN, 1.0), ..Default::default() },
-            ArclengthOptions { direction: 0.0, ..Default::default() },
-            ArclengthOptions { max_steps: 0, ..Default::default() },
-            ArclengthOptions { scale: ArclengthScale::Fixed(0.0, 1.0), ..Default::default() },
+            ArclengthOptions {
+                ds_min: 1.0,
+                ds_max: 0.1,
+                ds: 0.5,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                ds: f64::NAN,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                parameter_range: (1.0, 1.0),
+                ..Default::default()
+            },
+            ArclengthOptions {
+                parameter_range: (f64::NAN, 1.0),
+                ..Default::default()
+            },
+            ArclengthOptions {
+                direction: 0.0,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                max_steps: 0,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                scale: ArclengthScale::Fixed(0.0, 1.0),
+                ..Default::default()
+            },
         ];
         for o in bad {
             assert!(matches!(

@@ -10,13 +10,15 @@
 //! stop the run.
 
 mod arclength;
+mod progress;
 mod sequential;
 
 pub use arclength::{
-    Arclength, ArclengthOptions, ArclengthOutcome, ArclengthScale, Branch, EndReason,
-    RejectReason, Rejection, StallEscape, TangentPredictor,
+    Arclength, ArclengthOptions, ArclengthOutcome, ArclengthScale, Branch, EndReason, RejectReason,
+    Rejection, StallEscape, TangentPredictor,
 };
-pub use sequential::{Predictor, Sequential, SequentialOptions, StepOutcome};
+pub use progress::{quiet, Progress};
+pub use sequential::{linspace, Predictor, Sequential, SequentialOptions, StepOutcome};
 
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;
@@ -39,6 +41,14 @@ pub trait ContinuationProblem {
     /// Typical magnitude of residual entries (see [`Problem::residual_scale`]).
     fn residual_scale(&self) -> f64 {
         1.0
+    }
+
+    /// Diagonal weights `w_i` of a natural norm `sum_i w_i x_i^2` of the unknowns at
+    /// parameter `lambda` (for harmonic balance, an energy norm). The arclength drivers use it
+    /// for their scaled norm; `None` (default) means all weights 1.
+    fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
+        let _ = lambda;
+        None
     }
 
     /// For nonsmooth problems: the size of the active set of each unilateral law at
@@ -68,6 +78,9 @@ impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
     }
     fn active_set(&mut self, x: &[f64], lambda: f64) -> Option<Vec<usize>> {
         (**self).active_set(x, lambda)
+    }
+    fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
+        (**self).state_weights(lambda)
     }
 }
 
@@ -124,6 +137,9 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
     }
     fn active_set(&mut self, x: &[f64], period: f64) -> Option<Vec<usize>> {
         self.0.active_set(x, omega_of(period))
+    }
+    fn state_weights(&mut self, period: f64) -> Option<Vec<f64>> {
+        self.0.state_weights(omega_of(period))
     }
 }
 

@@ -121,29 +121,6 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         self
     }
 
-    /// `steps` equispaced values from `start` to `end` inclusive.
-    ///
-    /// # Errors
-    /// [`ContinuationError::InvalidOption`] for non-finite ends or fewer than 2 steps.
-    pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
-        for v in [start, end] {
-            if !v.is_finite() {
-                return Err(ContinuationError::InvalidOption {
-                    what: "range end",
-                    value: v,
-                });
-            }
-        }
-        if steps < 2 {
-            return Err(ContinuationError::InvalidOption {
-                what: "steps (at least 2)",
-                value: steps as f64,
-            });
-        }
-        let h = (end - start) / (steps - 1) as f64;
-        Ok((0..steps).map(|i| start + h * i as f64).collect())
-    }
-
     /// The problem (for post-processing between steps).
     pub fn problem_mut(&mut self) -> &mut P {
         &mut self.problem
@@ -196,7 +173,10 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         match result {
             Ok(info) if accepted => {
                 self.failures = 0;
-                self.previous = Some((std::mem::replace(&mut self.last, x.clone()), self.last_lambda));
+                self.previous = Some((
+                    std::mem::replace(&mut self.last, x.clone()),
+                    self.last_lambda,
+                ));
                 self.last_lambda = lambda;
                 StepOutcome::Converged(Point {
                     step,
@@ -289,4 +269,27 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<P, S> {
             StepOutcome::Finished | StepOutcome::Stalled(_) => None,
         }
     }
+}
+
+/// `steps` equispaced values from `start` to `end` inclusive.
+///
+/// # Errors
+/// [`ContinuationError::InvalidOption`] for non-finite ends or fewer than 2 steps.
+pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
+    for v in [start, end] {
+        if !v.is_finite() {
+            return Err(ContinuationError::InvalidOption {
+                what: "range end",
+                value: v,
+            });
+        }
+    }
+    if steps < 2 {
+        return Err(ContinuationError::InvalidOption {
+            what: "steps (at least 2)",
+            value: steps as f64,
+        });
+    }
+    let h = (end - start) / (steps - 1) as f64;
+    Ok((0..steps).map(|i| start + h * i as f64).collect())
 }

@@ -1,7 +1,10 @@
 //! Backbone curves: a nonsmooth-mode branch computed by sequential continuation in the
 //! period, with energies normalised by the first grazing energy.
 
-use crate::continuation::{PeriodParametrised, Point, Predictor, Sequential, SequentialOptions};
+use crate::continuation::{
+    linspace, Arclength, ArclengthOptions, ArclengthOutcome, Branch, Event, PeriodParametrised,
+    Point, Predictor, Sequential, SequentialOptions, StallEscape,
+};
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
 use crate::modal::linear::{branch_seed, grazing_energy};
@@ -85,6 +88,28 @@ pub struct BackbonePoint {
     pub iterations: usize,
     /// The unknowns (layout of [`NonsmoothSystem`]).
     pub x: Vec<f64>,
+    /// Step used to reach the point (period increment, or arclength `ds`).
+    pub step_size: f64,
+    /// Events detected there (folds, jumps, grazing).
+    pub events: Vec<Event>,
+}
+
+impl BackbonePoint {
+    fn new(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
+        Self {
+            step: p.step,
+            period: 2.0 * PI / omega,
+            omega,
+            energy,
+            energy_normalized: energy / e_g,
+            converged: p.converged,
+            residual_norm: p.residual_norm,
+            iterations: p.iterations,
+            x: p.x.clone(),
+            step_size: p.step_size,
+            events: p.events.clone(),
+        }
+    }
 }
 
 /// Computes a backbone with the constant + cosine basis: seeds the branch from the linear mode
@@ -119,11 +144,14 @@ pub fn backbone_with<S: NonlinearSolver>(
         }
         .into());
     }
-    let values = Sequential::<PeriodParametrised<NonsmoothSystem>, S>::linspace(
-        grid.start, grid.end, grid.steps,
-    )?;
+    let values = linspace(grid.start, grid.end, grid.steps)?;
     let (e_g, _) = grazing_energy(system)?;
-    let start = branch_seed(&mut problem, options.mode, options.subharmonic, 2.0 * PI / grid.start)?;
+    let start = branch_seed(
+        &mut problem,
+        options.mode,
+        options.subharmonic,
+        2.0 * PI / grid.start,
+    )?;
     let basis = problem.basis().clone();
     let seq_options = SequentialOptions {
         predictor: options.predictor,
@@ -132,24 +160,24 @@ pub fn backbone_with<S: NonlinearSolver>(
     let floor = options.trivial_energy * e_g;
     let accept_system = system.clone();
     let accept_basis = basis.clone();
-    let mut driver = Sequential::new(PeriodParametrised(problem), solver, start, values, seq_options)?
-        .with_acceptance(move |x, period| {
-            energy(&accept_system, &accept_basis, x, 2.0 * PI / period) > floor
-        });
+    let mut driver = Sequential::new(
+        PeriodParametrised(problem),
+        solver,
+        start,
+        values,
+        seq_options,
+    )?
+    .with_acceptance(move |x, period| {
+        energy(&accept_system, &accept_basis, x, 2.0 * PI / period) > floor
+    });
     driver.run(|p: &Point| {
         let omega = 2.0 * PI / p.lambda;
-        let e = energy(system, &basis, &p.x, omega);
-        observer(&BackbonePoint {
-            step: p.step,
-            period: p.lambda,
+        observer(&BackbonePoint::new(
+            p,
             omega,
-            energy: e,
-            energy_normalized: e / e_g,
-            converged: p.converged,
-            residual_norm: p.residual_norm,
-            iterations: p.iterations,
-            x: p.x.clone(),
-        })
+            energy(system, &basis, &p.x, omega),
+            e_g,
+        ))
     })?;
     Ok(e_g)
 }
@@ -172,3 +200,96 @@ pub fn backbone<S: NonlinearSolver>(
     Ok(points)
 }
 
+/// Options of [`arclength_backbone`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArclengthBackboneOptions {
+    /// Period at which the branch is seeded (default 3.95, the clamped bar's first mode).
+    pub start_period: f64,
+    /// The run stays inside this range of `Omega` (default `[2 pi / 3.96, 2 pi / 3.05]`).
+    pub omega_range: (f64, f64),
+    /// Linear mode the branch starts from (default 1).
+    pub mode: usize,
+    /// Period multiple of the seed (default 1).
+    pub subharmonic: usize,
+    /// Driver options. The default has `direction = +1` (towards higher `Omega`) and
+    /// `escape = Some(StallEscape::default())`, so that internal-resonance branches do not
+    /// stall the backbone.
+    pub arclength: ArclengthOptions,
+    /// As [`BackboneOptions::trivial_energy`] (default `1e-6`).
+    pub trivial_energy: f64,
+}
+
+impl Default for ArclengthBackboneOptions {
+    fn default() -> Self {
+        Self {
+            start_period: 3.95,
+            omega_range: (2.0 * PI / 3.96, 2.0 * PI / 3.05),
+            mode: 1,
+            subharmonic: 1,
+            arclength: ArclengthOptions {
+                escape: Some(StallEscape::default()),
+                ..Default::default()
+            },
+            trivial_energy: 1e-6,
+        }
+    }
+}
+
+/// Computes a backbone by pseudo-arclength continuation in `Omega` (see
+/// [`Arclength`]): seeds the branch from the linear mode at `start_period`, follows it inside
+/// `omega_range` and hands every accepted point to `observer`, which may stop the run.
+/// Returns `E_g` and the branch summary (points, rejections, end reason).
+///
+/// # Errors
+/// Invalid settings or options, a failed seed or a failed start.
+pub fn arclength_backbone<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalance,
+    options: &ArclengthBackboneOptions,
+    solver: S,
+    mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+) -> Result<(f64, Branch), Error> {
+    let mut problem = NonsmoothSystem::new(system, settings)?;
+    if !(options.start_period.is_finite() && options.start_period > 0.0) {
+        return Err(ContinuationError::InvalidOption {
+            what: "start period",
+            value: options.start_period,
+        }
+        .into());
+    }
+    let omega0 = 2.0 * PI / options.start_period;
+    let (e_g, _) = grazing_energy(system)?;
+    let start = branch_seed(&mut problem, options.mode, options.subharmonic, omega0)?;
+    let basis = problem.basis().clone();
+    let arclength = ArclengthOptions {
+        parameter_range: options.omega_range,
+        ..options.arclength
+    };
+    let floor = options.trivial_energy * e_g;
+    let (accept_system, accept_basis) = (system.clone(), basis.clone());
+    let (driver, first) = Arclength::new(problem, solver, start, omega0, arclength)?;
+    let mut driver = driver
+        .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
+    let mut report = |p: &Point| {
+        observer(&BackbonePoint::new(
+            p,
+            p.lambda,
+            energy(system, &basis, &p.x, p.lambda),
+            e_g,
+        ))
+    };
+    if report(&first).is_break() {
+        return Ok((
+            e_g,
+            Branch {
+                points: vec![first],
+                ..Default::default()
+            },
+        ));
+    }
+    let branch = driver.run(Some(first), |outcome| match outcome {
+        ArclengthOutcome::Accepted(p) => report(p),
+        _ => ControlFlow::Continue(()),
+    });
+    Ok((e_g, branch))
+}

@@ -1,8 +1,8 @@
 //! Mechanical energy of a harmonic-balance solution (formulation §7).
 
 use crate::bar::{Bar, End, EndRef};
-use crate::modal::field::{FieldEvaluator, FieldValue};
 use crate::fourier::Basis;
+use crate::modal::field::{FieldEvaluator, FieldValue};
 use crate::system::BarSystem;
 
 /// Gauss–Legendre nodes and weights on `[-1, 1]`, 8 points.

@@ -57,7 +57,13 @@ impl<'a, B: Basis> FieldEvaluator<'a, B> {
 
     /// Fields at `position` with the basis functions and their derivatives at the wanted
     /// phase already evaluated (for loops over many positions at one instant).
-    pub fn with_functions(&self, bar: usize, position: f64, phi: &[f64], dphi: &[f64]) -> FieldValue {
+    pub fn with_functions(
+        &self,
+        bar: usize,
+        position: f64,
+        phi: &[f64],
+        dphi: &[f64],
+    ) -> FieldValue {
         let b = &self.system.bars()[bar];
         let nb = self.system.bars().len();
         let mut v = FieldValue::default();

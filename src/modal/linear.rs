@@ -216,7 +216,11 @@ pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsE
     let mut best = f64::INFINITY;
     for (l, law) in system.laws().enumerate() {
         let g0 = law.gap().offset;
-        let c: Vec<f64> = mode.shapes.iter().map(|s| dot(rows.gap_row(l), s)).collect();
+        let c: Vec<f64> = mode
+            .shapes
+            .iter()
+            .map(|s| dot(rows.gap_row(l), s))
+            .collect();
         let mut y = c.clone();
         lu.solve_in_place(&mut y);
         let ctqc = dot(&c, &y);

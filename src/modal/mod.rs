@@ -6,7 +6,10 @@ pub mod energy;
 pub mod field;
 pub mod linear;
 
-pub use backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+pub use backbone::{
+    arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
+    PeriodGrid,
+};
 pub use energy::energy;
 pub use field::{FieldEvaluator, FieldValue};
 pub use linear::{branch_seed, grazing_energy, natural_frequencies, ContactState, LinearMode};

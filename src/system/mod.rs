@@ -1,13 +1,16 @@
 //! From bars and conditions to the harmonic-balance equations.
 //!
 //! - [`assembly`]: the builder and the validated [`BarSystem`].
+//! - [`family`]: continuation in any scalar parameter of the system.
 //! - [`rows`]: per-harmonic linear rows and observables in the Helmholtz unknowns `(A, B)`.
 //! - [`problem`]: the square nonsmooth system `F(x; Omega) = 0`, its generalised Jacobian and
 //!   `dF/dOmega`.
 
 pub mod assembly;
+pub mod family;
 pub mod problem;
 pub mod rows;
 
 pub use assembly::{AssemblyBuilder, BarSystem};
+pub use family::{ParameterFamily, SystemFamily};
 pub use problem::{HarmonicBalance, NonsmoothSystem};
