@@ -1,0 +1,211 @@
+//! Continuation drivers on the paper's systems (issue: pseudo-arclength, parameters, loops).
+
+use nonsmooth_modes::continuation::{
+    Arclength, ArclengthOptions, ArclengthOutcome, ContinuationProblem, EndReason, Event,
+    PeriodParametrised, Point, StallEscape,
+};
+use nonsmooth_modes::modal::{
+    arclength_backbone, backbone, branch_seed, energy, ArclengthBackboneOptions, BackboneOptions,
+    BackbonePoint, PeriodGrid,
+};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
+};
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem, ParameterFamily};
+use std::f64::consts::PI;
+use std::ops::ControlFlow;
+
+fn run_backbone(
+    system: &nonsmooth_modes::system::BarSystem,
+    harmonics: usize,
+    options: &ArclengthBackboneOptions,
+) -> (Vec<BackbonePoint>, nonsmooth_modes::continuation::Branch) {
+    let mut points = Vec::new();
+    let settings = HarmonicBalance {
+        harmonics,
+        ..Default::default()
+    };
+    let (_, branch) = arclength_backbone(
+        system,
+        settings,
+        options,
+        SemismoothNewton::default(),
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    (points, branch)
+}
+
+/// Every accepted point satisfies the corrector's tolerance on `|F|` at its own `Omega`.
+fn assert_all_converged(
+    system: &nonsmooth_modes::system::BarSystem,
+    harmonics: usize,
+    points: &[BackbonePoint],
+) {
+    let settings = HarmonicBalance {
+        harmonics,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(system, settings).unwrap();
+    let tolerance = 1e-9 * problem.residual_scale();
+    let mut f = vec![0.0; problem.dimension()];
+    for p in points {
+        assert!(p.converged);
+        problem.residual(&p.x, p.omega, &mut f);
+        let r = f.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!(r <= tolerance, "residual {r:e} at T = {}", p.period);
+    }
+}
+
+#[test]
+fn clamped_bar_arclength_reaches_short_periods_without_manual_restarts() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    for m in [20, 40] {
+        let (points, branch) = run_backbone(&system, m, &ArclengthBackboneOptions::default());
+        let shortest = points
+            .iter()
+            .map(|p| p.period)
+            .fold(f64::INFINITY, f64::min);
+        assert!(shortest <= 3.1, "m = {m}: stopped at T = {shortest}");
+        assert!(
+            matches!(branch.end, Some(EndReason::ParameterOutOfRange { .. })),
+            "m = {m}: {:?}",
+            branch.end
+        );
+        assert_all_converged(&system, m, &points);
+        // A good share of the points lie on the exact backbone (the rest are resonances).
+        let close = points
+            .iter()
+            .filter(|p| {
+                let exact = ClampedFirstMode::new(1e-3, p.period).energy_normalized();
+                (p.energy_normalized / exact - 1.0).abs() < 0.05
+            })
+            .count();
+        assert!(close >= 100, "m = {m}: only {close} points within 5%");
+    }
+}
+
+#[test]
+fn robin_bar_arclength_crosses_the_figure_10_range() {
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let options = ArclengthBackboneOptions {
+        start_period: 9.5,
+        omega_range: (2.0 * PI / 9.55, 2.0 * PI / 6.6),
+        ..Default::default()
+    };
+    let (points, branch) = run_backbone(&system, 20, &options);
+    assert!(matches!(
+        branch.end,
+        Some(EndReason::ParameterOutOfRange { .. })
+    ));
+    assert!(points.iter().any(|p| p.period < 6.7));
+    assert_all_converged(&system, 20, &points);
+}
+
+#[test]
+fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
+    // The truncated problem is positively homogeneous in the gap: x(s g0) = s x(g0), so
+    // E / g0^2 is constant along the branch.
+    let settings = HarmonicBalance::default();
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let grid = BackboneOptions {
+        grid: PeriodGrid {
+            start: 3.95,
+            end: 3.6,
+            steps: 71,
+        },
+        ..Default::default()
+    };
+    let walk = backbone(&system, settings, &grid, SemismoothNewton::default()).unwrap();
+    let gap_to_exact = |p: &&BackbonePoint| {
+        (p.energy_normalized / ClampedFirstMode::new(1e-3, p.period).energy_normalized() - 1.0)
+            .abs()
+    };
+    let start = walk
+        .iter()
+        .filter(|p| p.converged && p.period < 3.7)
+        .min_by(|a, b| gap_to_exact(a).total_cmp(&gap_to_exact(b)))
+        .unwrap();
+    let (omega, period, x) = (start.omega, start.period, start.x.clone());
+    let family = ParameterFamily::at(clamped_bar_with_obstacle, settings, omega, 1e-3).unwrap();
+    let solver = SemismoothNewton::default();
+    let basis = settings.cosine_basis().unwrap();
+    let options = ArclengthOptions {
+        parameter_range: (5e-4, 4e-3),
+        ..Default::default()
+    };
+    let (mut driver, first) = Arclength::new(family, solver, x, 1e-3, options).unwrap();
+    let per_gap2 = |p: &Point| {
+        let s = clamped_bar_with_obstacle(p.lambda).unwrap();
+        energy(&s, &basis, &p.x, omega) / (p.lambda * p.lambda)
+    };
+    let reference = per_gap2(&first);
+    let exact = ClampedFirstMode::new(1.0, period).energy();
+    assert!((reference / exact - 1.0).abs() < 0.05);
+    let branch = driver.run(Some(first), |_| ControlFlow::Continue(()));
+    assert!(branch.points.len() > 5);
+    assert!(branch.points.iter().any(|p| p.lambda > 3.5e-3));
+    for p in &branch.points {
+        assert!(
+            (per_gap2(p) / reference - 1.0).abs() < 1e-8,
+            "gap {}",
+            p.lambda
+        );
+    }
+}
+
+#[test]
+fn iterator_restart_and_reverse_direction() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let settings = HarmonicBalance {
+        harmonics: 10,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+    let x0 = branch_seed(&mut problem, 1, 1, 2.0 * PI / 3.9).unwrap();
+    let options = ArclengthOptions {
+        direction: -1.0,
+        parameter_range: (3.5, 3.95),
+        escape: Some(StallEscape::default()),
+        ..Default::default()
+    };
+    let (driver, _) = Arclength::new(
+        PeriodParametrised(problem.clone()),
+        SemismoothNewton::default(),
+        x0,
+        3.9,
+        options,
+    )
+    .unwrap();
+    let forward: Vec<Point> = driver.take(15).collect();
+    assert_eq!(forward.len(), 15);
+    assert!(forward.last().unwrap().lambda < 3.9);
+    // Restart from a stored point in the other direction: the period grows again.
+    let pivot = &forward[10];
+    let (mut back, _) = Arclength::restart(
+        PeriodParametrised(problem),
+        SemismoothNewton::default(),
+        pivot,
+        ArclengthOptions {
+            direction: 1.0,
+            ..options
+        },
+    )
+    .unwrap();
+    let mut grew = false;
+    for _ in 0..20 {
+        if let ArclengthOutcome::Accepted(p) = back.step() {
+            grew |= p.lambda > pivot.lambda;
+            assert!(p.residual_norm <= 1e-12);
+            assert!(p
+                .events
+                .iter()
+                .all(|e| !matches!(e, Event::Jump { .. }) || p.converged));
+        }
+    }
+    assert!(grew);
+}
