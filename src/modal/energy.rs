@@ -25,11 +25,24 @@ const GAUSS_W: [f64; 4] = [
 /// `t = 0` and `E` is the potential energy there. Integrals use 8-point Gauss–Legendre panels
 /// no longer than a quarter of the shortest wavelength present.
 pub fn energy<B: Basis>(system: &BarSystem, basis: &B, x: &[f64], omega: f64) -> f64 {
+    energy_at(system, basis, x, omega, 0.0)
+}
+
+/// The energy of [`energy`] at phase `theta = Omega t` instead of `t = 0`. The exact periodic
+/// motion keeps it constant; a truncated one drifts by the work of its complementarity
+/// residual, which [`crate::modal::diagnostics`] reports.
+pub fn energy_at<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+    theta: f64,
+) -> f64 {
     let len = basis.len();
     let mut phi = vec![0.0; len];
     let mut dphi = vec![0.0; len];
-    basis.functions_at(0.0, &mut phi);
-    basis.derivatives_at(0.0, &mut dphi);
+    basis.functions_at(theta, &mut phi);
+    basis.derivatives_at(theta, &mut dphi);
     let fields = FieldEvaluator::new(system, basis, x, omega);
     let mut total = 0.0;
     let mut end_u = vec![[0.0; 2]; system.bars().len()];

@@ -2,6 +2,7 @@
 //! system, branch seeds, and backbones.
 
 pub mod backbone;
+pub mod diagnostics;
 pub mod energy;
 pub mod field;
 pub mod linear;
@@ -10,6 +11,9 @@ pub use backbone::{
     arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
     PeriodGrid,
 };
-pub use energy::energy;
+pub use diagnostics::{
+    convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,
+};
+pub use energy::{energy, energy_at};
 pub use field::{FieldEvaluator, FieldValue};
 pub use linear::{branch_seed, grazing_energy, natural_frequencies, ContactState, LinearMode};

@@ -1,0 +1,302 @@
+//! Diagnostics of one computed periodic motion: end histories, fields on a space-time grid,
+//! the Signorini residual and its norm `R^(m)`, penetration, contact force and energy drift.
+//!
+//! Time signals are evaluated on a grid finer than the harmonic-balance grid (by default
+//! `8 N` instants), so that the residual norm measures the motion between the collocation
+//! instants too.
+
+use crate::bar::{End, EndRef};
+use crate::error::{Error, SettingsError};
+use crate::fourier::Basis;
+use crate::modal::backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use crate::modal::energy::energy_at;
+use crate::modal::field::FieldEvaluator;
+use crate::solve::NonlinearSolver;
+use crate::system::rows::quantity_weights;
+use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use std::f64::consts::PI;
+
+/// Time histories of one end over a period.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EndHistory {
+    /// Instants `t_k = k T / samples`.
+    pub time: Vec<f64>,
+    /// Displacement `u`.
+    pub displacement: Vec<f64>,
+    /// Strain `u_x`.
+    pub strain: Vec<f64>,
+    /// Compressive force `-EA u_x`.
+    pub contact_force: Vec<f64>,
+}
+
+/// Histories of the end `end` over one period, on `samples` instants.
+///
+/// # Panics
+/// If `end.bar` is not a bar of the system or `x` has the wrong length.
+pub fn end_history<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+    end: EndRef,
+    samples: usize,
+) -> EndHistory {
+    let fields = FieldEvaluator::new(system, basis, x, omega);
+    let bar = system.bar(end.bar);
+    let position = match end.end {
+        End::Left => 0.0,
+        End::Right => bar.length(),
+    };
+    let period = 2.0 * PI / omega;
+    let mut h = EndHistory::default();
+    for k in 0..samples {
+        let t = period * k as f64 / samples as f64;
+        let v = fields.at(end.bar.index(), position, omega * t);
+        h.time.push(t);
+        h.displacement.push(v.displacement);
+        h.strain.push(v.strain);
+        h.contact_force.push(-bar.stiffness() * v.strain);
+    }
+    h
+}
+
+/// Displacement `u(x, t)` of one bar on a space-time grid.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FieldGrid {
+    /// Positions `x_i` (uniform on `[0, l]`).
+    pub position: Vec<f64>,
+    /// Instants `t_k` (uniform on `[0, T)`).
+    pub time: Vec<f64>,
+    /// `u[k * position.len() + i] = u(x_i, t_k)`.
+    pub displacement: Vec<f64>,
+}
+
+/// `u(x, t)` of bar `bar` on `positions x instants` points over one period.
+///
+/// # Panics
+/// If `bar` is out of range or `x` has the wrong length.
+pub fn displacement_grid<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+    bar: usize,
+    positions: usize,
+    instants: usize,
+) -> FieldGrid {
+    let fields = FieldEvaluator::new(system, basis, x, omega);
+    let l = system.bars()[bar].length();
+    let period = 2.0 * PI / omega;
+    let position: Vec<f64> = (0..positions)
+        .map(|i| l * i as f64 / (positions.max(2) - 1) as f64)
+        .collect();
+    let time: Vec<f64> = (0..instants)
+        .map(|k| period * k as f64 / instants as f64)
+        .collect();
+    let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
+    let mut displacement = Vec::with_capacity(positions * instants);
+    for &t in &time {
+        basis.functions_at(omega * t, &mut phi);
+        basis.derivatives_at(omega * t, &mut dphi);
+        for &p in &position {
+            displacement.push(fields.with_functions(bar, p, &phi, &dphi).displacement);
+        }
+    }
+    FieldGrid {
+        position,
+        time,
+        displacement,
+    }
+}
+
+/// Gap, force and pointwise residual of one unilateral law over a period.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LawHistory {
+    /// Instants.
+    pub time: Vec<f64>,
+    /// Gap `g(t)`.
+    pub gap: Vec<f64>,
+    /// Contact force `lambda(t)`.
+    pub force: Vec<f64>,
+    /// Residual `r(t)` of the law (`-min(lambda, a_c g)` for Signorini).
+    pub residual: Vec<f64>,
+}
+
+/// Histories of law `law` over one period on `samples` instants.
+///
+/// # Errors
+/// [`SettingsError::Length`] if `law` is out of range.
+pub fn law_history<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+    law: usize,
+    samples: usize,
+) -> Result<LawHistory, SettingsError> {
+    let system = problem.system();
+    let laws: Vec<_> = system.laws().collect();
+    let Some(law_ref) = laws.get(law) else {
+        return Err(SettingsError::Length {
+            what: "law index",
+            got: law,
+            expected: laws.len(),
+        });
+    };
+    let (gap, force) = (law_ref.gap(), law_ref.force());
+    let basis = problem.basis();
+    let fields = FieldEvaluator::new(system, basis, x, omega);
+    let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
+    let period = 2.0 * PI / omega;
+    let mut h = LawHistory::default();
+    for k in 0..samples {
+        let t = period * k as f64 / samples as f64;
+        basis.functions_at(omega * t, &mut phi);
+        basis.derivatives_at(omega * t, &mut dphi);
+        let value = |o: &crate::bc::Observable| {
+            o.offset
+                + o.terms
+                    .iter()
+                    .map(|term| {
+                        let bar = system.bar(term.end.bar);
+                        let position = match term.end.end {
+                            End::Left => 0.0,
+                            End::Right => bar.length(),
+                        };
+                        let f = fields.with_functions(term.end.bar.index(), position, &phi, &dphi);
+                        let (wu, wp) =
+                            quantity_weights(term.quantity, term.end.end, bar.stiffness());
+                        let p = term.end.end.normal() * f.strain;
+                        term.coefficient * (wu * f.displacement + wp * p)
+                    })
+                    .sum::<f64>()
+        };
+        let (g, l) = (value(&gap), value(&force));
+        h.time.push(t);
+        h.gap.push(g);
+        h.force.push(l);
+        h.residual
+            .push(law_ref.residual(g, l, problem.penalty()).value);
+    }
+    Ok(h)
+}
+
+/// Summary diagnostics of a periodic motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointDiagnostics {
+    /// `R^(m) = sqrt(int_0^T r(t)^2 dt)` for each law (the paper's eq. 32).
+    pub residual_norm: Vec<f64>,
+    /// Largest penetration `max(0, -min_t g(t))` over all laws.
+    pub max_penetration: f64,
+    /// Smallest contact force `min_t lambda(t)` over all laws (negative: tensile).
+    pub min_contact_force: f64,
+    /// `(max_t E - min_t E) / E(0)` over the period (zero for an exact motion).
+    pub energy_drift: f64,
+}
+
+/// Diagnostics of the motion `x` at `omega`, on `refinement` times the harmonic-balance grid
+/// (at least 1; 8 is a good default) and 16 instants for the energy drift.
+///
+/// # Errors
+/// [`SettingsError::ZeroIndex`] for `refinement = 0`.
+pub fn diagnose<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+    refinement: usize,
+) -> Result<PointDiagnostics, SettingsError> {
+    if refinement == 0 {
+        return Err(SettingsError::ZeroIndex {
+            what: "refinement",
+            value: 0,
+        });
+    }
+    let samples = problem.basis().samples() * refinement;
+    let period = 2.0 * PI / omega;
+    let mut residual_norm = Vec::new();
+    let (mut max_penetration, mut min_contact_force) = (0.0_f64, f64::INFINITY);
+    for law in 0..problem.system().contact_count() {
+        let h = law_history(problem, x, omega, law, samples)?;
+        let dt = period / samples as f64;
+        residual_norm.push((h.residual.iter().map(|r| r * r).sum::<f64>() * dt).sqrt());
+        max_penetration = h.gap.iter().fold(max_penetration, |m, g| m.max(-g));
+        min_contact_force = h.force.iter().cloned().fold(min_contact_force, f64::min);
+    }
+    let energies: Vec<f64> = (0..16)
+        .map(|k| {
+            energy_at(
+                problem.system(),
+                problem.basis(),
+                x,
+                omega,
+                2.0 * PI * k as f64 / 16.0,
+            )
+        })
+        .collect();
+    let (lo, hi) = energies
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &e| {
+            (a.min(e), b.max(e))
+        });
+    Ok(PointDiagnostics {
+        residual_norm,
+        max_penetration,
+        min_contact_force,
+        energy_drift: if energies[0] > 0.0 {
+            (hi - lo) / energies[0]
+        } else {
+            0.0
+        },
+    })
+}
+
+/// One entry of a convergence study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvergenceEntry {
+    /// Number of harmonics.
+    pub harmonics: usize,
+    /// The last converged point of the run at this `m` (None if none converged).
+    pub point: Option<BackbonePoint>,
+    /// Its diagnostics.
+    pub diagnostics: Option<PointDiagnostics>,
+}
+
+/// The same point recomputed for each `m` in `harmonics`: a sequential backbone over `grid`
+/// (whose last period is the point of interest) for each `m`, keeping the last converged point
+/// and its diagnostics (refinement 8).
+///
+/// # Errors
+/// Invalid settings or options (the first `m` that fails to set up).
+pub fn convergence_study<S: NonlinearSolver + Clone>(
+    system: &BarSystem,
+    base: HarmonicBalance,
+    grid: PeriodGrid,
+    harmonics: &[usize],
+    solver: S,
+) -> Result<Vec<ConvergenceEntry>, Error> {
+    let mut out = Vec::new();
+    for &m in harmonics {
+        let settings = HarmonicBalance {
+            harmonics: m,
+            ..base
+        };
+        let options = BackboneOptions {
+            grid,
+            ..Default::default()
+        };
+        let points = backbone(system, settings, &options, solver.clone())?;
+        let point = points.into_iter().rev().find(|p| p.converged);
+        let diagnostics = match &point {
+            Some(p) => {
+                let problem = NonsmoothSystem::new(system, settings)?;
+                Some(diagnose(&problem, &p.x, p.omega, 8)?)
+            }
+            None => None,
+        };
+        out.push(ConvergenceEntry {
+            harmonics: m,
+            point,
+            diagnostics,
+        });
+    }
+    Ok(out)
+}
