@@ -218,6 +218,7 @@ impl ArclengthOptions {
 
 /// Why a run ended.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum EndReason {
     /// `max_steps` points were accepted.
     MaxSteps,
@@ -242,6 +243,7 @@ pub enum EndReason {
 
 /// Why a step was rejected.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum RejectReason {
     /// The corrector failed.
     Solver(SolveError),
@@ -263,6 +265,7 @@ pub enum RejectReason {
 
 /// A rejected step: the branch stays at its last accepted point and `ds` shrinks.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Rejection {
     /// Step size tried.
     pub ds: f64,
@@ -285,6 +288,7 @@ pub enum ArclengthOutcome {
 
 /// The points of a branch with their diagnostics.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Branch {
     /// Accepted points in order.
     pub points: Vec<Point>,

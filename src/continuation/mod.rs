@@ -145,6 +145,7 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
 
 /// One point of a branch.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Point {
     /// Step number (0-based).
     pub step: usize,
@@ -170,6 +171,7 @@ pub struct Point {
 
 /// Something that happened along a branch, reported on the point where it was detected.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Event {
     /// Turning point: the parameter component of the tangent changed sign.
     Fold {

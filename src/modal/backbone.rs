@@ -15,6 +15,7 @@ use std::ops::ControlFlow;
 
 /// `steps` equispaced periods from `start` to `end` (both included).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PeriodGrid {
     /// First period `T0`.
     pub start: f64,
@@ -69,6 +70,7 @@ impl Default for BackboneOptions {
 
 /// One point of a backbone.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct BackbonePoint {
     /// Step number.
     pub step: usize,

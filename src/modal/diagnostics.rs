@@ -18,6 +18,7 @@ use std::f64::consts::PI;
 
 /// Time histories of one end over a period.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct EndHistory {
     /// Instants `t_k = k T / samples`.
     pub time: Vec<f64>,
@@ -62,6 +63,7 @@ pub fn end_history<B: Basis>(
 
 /// Displacement `u(x, t)` of one bar on a space-time grid.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FieldGrid {
     /// Positions `x_i` (uniform on `[0, l]`).
     pub position: Vec<f64>,
@@ -111,6 +113,7 @@ pub fn displacement_grid<B: Basis>(
 
 /// Gap, force and pointwise residual of one unilateral law over a period.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LawHistory {
     /// Instants.
     pub time: Vec<f64>,
@@ -182,6 +185,7 @@ pub fn law_history<B: Basis>(
 
 /// Summary diagnostics of a periodic motion.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PointDiagnostics {
     /// `R^(m) = sqrt(int_0^T r(t)^2 dt)` for each law (the paper's eq. 32).
     pub residual_norm: Vec<f64>,
@@ -251,6 +255,7 @@ pub fn diagnose<B: Basis>(
 
 /// One entry of a convergence study.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ConvergenceEntry {
     /// Number of harmonics.
     pub harmonics: usize,
