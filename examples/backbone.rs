@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release --example backbone -- [--system ds|rs|two-bar] [--gap 1e-3]
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
-//!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1]
+//!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
@@ -46,7 +46,7 @@ use std::process::ExitCode;
 
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
-  [--penalty AC] [--mode I] [--period-start T0] [--period-end T1] [--steps S]
+  [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
   [--solver newton|dogleg] [--out FILE] [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
@@ -79,6 +79,7 @@ struct Args {
     stiffness_ratio: f64,
     settings: HarmonicBalance,
     mode: usize,
+    subharmonic: usize,
     period_start: Option<f64>,
     period_end: Option<f64>,
     steps: usize,
@@ -126,6 +127,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         stiffness_ratio: 1.0,
         settings: HarmonicBalance::default(),
         mode: 1,
+        subharmonic: 1,
         period_start: None,
         period_end: None,
         steps: 181,
@@ -163,6 +165,7 @@ fn parse() -> Result<Args, lexopt::Error> {
             }
             Long("penalty") => a.settings.penalty = parser.value()?.parse()?,
             Long("mode") => a.mode = parser.value()?.parse()?,
+            Long("subharmonic") => a.subharmonic = parser.value()?.parse()?,
             Long("period-start") => a.period_start = Some(parser.value()?.parse()?),
             Long("period-end") => a.period_end = Some(parser.value()?.parse()?),
             Long("steps") => a.steps = parser.value()?.parse()?,
@@ -298,7 +301,10 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
     writeln!(out, "{HEADER}")?;
     let mut sink = Sink {
         out,
-        exact: (a.system == SystemKind::Clamped && a.mode == 1 && a.parameter != Parameter::Gap)
+        exact: (a.system == SystemKind::Clamped
+            && a.mode == 1
+            && a.subharmonic == 1
+            && a.parameter != Parameter::Gap)
             .then_some(a.gap),
         total: 0,
         converged: 0,
@@ -318,6 +324,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             start_period: t0,
             omega_range: a.omega_range.unwrap_or((lo.min(hi) * 0.999, lo.max(hi))),
             mode: a.mode,
+            subharmonic: a.subharmonic,
             arclength: ArclengthOptions {
                 direction: if t1 < t0 { 1.0 } else { -1.0 },
                 ..a.driver
@@ -339,6 +346,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
                 steps: a.steps,
             },
             mode: a.mode,
+            subharmonic: a.subharmonic,
             ..Default::default()
         };
         backbone_with(&system, a.settings, &options, solver, |p| {
@@ -370,6 +378,7 @@ fn run_parameter(
             steps: ((start_period - period).abs() / 0.005).ceil().max(1.0) as usize + 1,
         },
         mode: a.mode,
+        subharmonic: a.subharmonic,
         ..Default::default()
     };
     let reached = backbone(&system, a.settings, &options, SemismoothNewton::default())?;
