@@ -136,7 +136,10 @@ mod tests {
     fn rejects_bad_bars() {
         assert!(matches!(
             Bar::new(0.0, 1.0, 1.0),
-            Err(ModelError::NotPositive { what: "bar length", .. })
+            Err(ModelError::NotPositive {
+                what: "bar length",
+                ..
+            })
         ));
         assert!(Bar::new(1.0, f64::NAN, 1.0).is_err());
         assert!(Bar::new(1.0, 1.0, f64::INFINITY).is_err());

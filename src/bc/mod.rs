@@ -153,12 +153,7 @@ pub trait BoundaryCondition: Debug + Send + Sync {
     /// Pushes the linear rows that hold for every harmonic of angular frequency `omega`
     /// (`omega = 0` for the constant term). `stiffness(end)` gives the axial stiffness of the
     /// bar that owns `end`.
-    fn linear_rows(
-        &self,
-        omega: f64,
-        stiffness: &dyn Fn(EndRef) -> f64,
-        rows: &mut LinearRows,
-    ) {
+    fn linear_rows(&self, omega: f64, stiffness: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
         let _ = (omega, stiffness, rows);
     }
 
@@ -169,6 +164,10 @@ pub trait BoundaryCondition: Debug + Send + Sync {
 
     /// Potential energy stored in the condition itself (a spring) when the ends have the
     /// displacements `displacement(end)`; zero by default.
+    ///
+    /// It should be a quadratic form of the displacements: the grazing energy `E_g`
+    /// ([`crate::modal::grazing_energy`]) evaluates it on unit-sized linear mode shapes and
+    /// scales quadratically.
     fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
         let _ = displacement;
         0.0

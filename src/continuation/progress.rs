@@ -20,9 +20,12 @@ pub fn quiet<T: ?Sized>(_: &T) -> ControlFlow<()> {
 pub struct Progress<W: Write> {
     every: usize,
     writer: W,
-    measure: Option<(&'static str, Box<dyn FnMut(&Point) -> f64>)>,
+    measure: Option<(&'static str, Measure)>,
     accepted: usize,
 }
+
+/// A column computed from each point.
+type Measure = Box<dyn FnMut(&Point) -> f64>;
 
 impl Progress<std::io::Stderr> {
     /// Every `every` accepted points, to standard error.

@@ -26,7 +26,13 @@ pub fn quantity_weights(quantity: Quantity, end: End, stiffness: f64) -> (f64, f
 
 /// Adds `term` to a dense row over the `2 n_bars` Helmholtz unknowns, and its derivative in
 /// `omega` to `d_row`.
-fn add_term(term: &Term, maps: &[HelmholtzMap], stiffness: f64, row: &mut [f64], d_row: &mut [f64]) {
+fn add_term(
+    term: &Term,
+    maps: &[HelmholtzMap],
+    stiffness: f64,
+    row: &mut [f64],
+    d_row: &mut [f64],
+) {
     let b = term.end.bar.index();
     let (wu, wp) = quantity_weights(term.quantity, term.end.end, stiffness);
     let (iu, ip) = match term.end.end {
@@ -173,7 +179,9 @@ impl HarmonicRows {
             return false;
         }
         // Null space of the rows: columns rank..n of v.
-        let null: Vec<Vec<f64>> = (rank..n).map(|j| (0..n).map(|i| v[(i, j)]).collect()).collect();
+        let null: Vec<Vec<f64>> = (rank..n)
+            .map(|j| (0..n).map(|i| v[(i, j)]).collect())
+            .collect();
         let laws = self.gap.len() / n;
         let mut seen = vec![0.0; 2 * laws * null.len()];
         for l in 0..laws {
