@@ -1,1 +1,174 @@
-fn main() {}
+//! Criterion benchmarks of the harmonic-balance hot path on the clamped bar with an obstacle
+//! (gap `1e-3`, `n_h = 30`): residual, generalised Jacobian, one continuation step's solve,
+//! whole 181-step backbones at `m = 20, 40, 80`, and a sweep of backbones (parallel with
+//! `--features parallel`).
+//!
+//! ```text
+//! cargo bench --bench harmonic_balance                       # everything
+//! cargo bench --bench harmonic_balance -- residual           # one group
+//! cargo bench --features parallel --bench harmonic_balance -- sweep
+//! ```
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use nonsmooth_modes::continuation::{AtParameter, ContinuationProblem};
+use nonsmooth_modes::linalg::DenseMatrix;
+use nonsmooth_modes::modal::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use std::hint::black_box;
+use std::time::Duration;
+
+const GAP: f64 = 1e-3;
+
+fn settings(m: usize) -> HarmonicBalance {
+    HarmonicBalance {
+        harmonics: m,
+        ..Default::default()
+    }
+}
+
+/// The backbone example's grid: 181 periods from 3.95 down to 3.05.
+fn full_grid() -> BackboneOptions {
+    BackboneOptions {
+        grid: PeriodGrid {
+            start: 3.95,
+            end: 3.05,
+            steps: 181,
+        },
+        ..Default::default()
+    }
+}
+
+/// The last two points of the backbone from `T = 3.95` to `3.9` at `m` harmonics (a state
+/// near the branch for the residual and Jacobian benches; consecutive converged points for
+/// the solve bench, at the `m` where there are two).
+fn two_points(system: &BarSystem, m: usize) -> (BackbonePoint, BackbonePoint) {
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: 3.95,
+            end: 3.9,
+            steps: 11,
+        },
+        ..Default::default()
+    };
+    let points = backbone(system, settings(m), &options, SemismoothNewton::default())
+        .expect("short backbone");
+    let converged: Vec<_> = points.iter().filter(|p| p.converged).cloned().collect();
+    let pick = if converged.len() >= 2 {
+        &converged
+    } else {
+        &points
+    };
+    let n = pick.len();
+    (pick[n - 2].clone(), pick[n - 1].clone())
+}
+
+fn residual_and_jacobian(c: &mut Criterion) {
+    let system = clamped_bar_with_obstacle(GAP).unwrap();
+    let mut residual = c.benchmark_group("residual");
+    for m in [20, 80, 320] {
+        let (_, p) = two_points(&system, m);
+        let mut problem = NonsmoothSystem::new(&system, settings(m)).unwrap();
+        let mut f = vec![0.0; problem.dimension()];
+        residual.bench_with_input(BenchmarkId::from_parameter(m), &p, |b, p| {
+            b.iter(|| problem.residual(black_box(&p.x), p.omega, &mut f));
+        });
+    }
+    residual.finish();
+    let mut jacobian = c.benchmark_group("jacobian");
+    for m in [20, 80, 320] {
+        let (_, p) = two_points(&system, m);
+        let mut problem = NonsmoothSystem::new(&system, settings(m)).unwrap();
+        let mut jac = DenseMatrix::zeros(0, 0);
+        jacobian.bench_with_input(BenchmarkId::from_parameter(m), &p, |b, p| {
+            b.iter(|| problem.jacobian(black_box(&p.x), p.omega, &mut jac));
+        });
+    }
+    jacobian.finish();
+}
+
+/// One continuation step: solve at the next period from the previous solution.
+fn one_solve(c: &mut Criterion) {
+    let system = clamped_bar_with_obstacle(GAP).unwrap();
+    let mut group = c.benchmark_group("solve");
+    for m in [20, 80, 160] {
+        let (from, to) = two_points(&system, m);
+        let mut problem = NonsmoothSystem::new(&system, settings(m)).unwrap();
+        let solver = SemismoothNewton::default();
+        let mut x = from.x.clone();
+        group.bench_with_input(
+            BenchmarkId::from_parameter(m),
+            &(from, to),
+            |b, (from, to)| {
+                b.iter(|| {
+                    x.copy_from_slice(&from.x);
+                    let mut frozen = AtParameter {
+                        problem: &mut problem,
+                        lambda: to.omega,
+                    };
+                    solver.solve(&mut frozen, black_box(&mut x)).unwrap()
+                });
+            },
+        );
+    }
+    group.finish();
+}
+
+/// The `backbone` example's run (181 steps), without the CSV.
+fn whole_backbone(c: &mut Criterion) {
+    let system = clamped_bar_with_obstacle(GAP).unwrap();
+    let options = full_grid();
+    let mut group = c.benchmark_group("backbone_181");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(5));
+    for m in [20, 40, 80] {
+        group.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, &m| {
+            b.iter(|| {
+                backbone(&system, settings(m), &options, SemismoothNewton::default()).unwrap()
+            });
+        });
+    }
+    group.finish();
+}
+
+/// Four 181-step backbones (m = 20 and 30, Newton and dogleg) as one sweep, against the same
+/// jobs run one after the other.
+fn sweep(c: &mut Criterion) {
+    let system = clamped_bar_with_obstacle(GAP).unwrap();
+    let options = full_grid();
+    let mut jobs = Vec::new();
+    for m in [20, 30] {
+        for solver in [
+            Solver::default(),
+            Solver::Dogleg(nonsmooth_modes::solve::Dogleg::default()),
+        ] {
+            jobs.push(SweepJob {
+                system: system.clone(),
+                settings: settings(m),
+                options,
+                solver,
+            });
+        }
+    }
+    let mut group = c.benchmark_group("sweep_4_backbones");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(5));
+    group.bench_function("backbones", |b| b.iter(|| backbones(black_box(&jobs))));
+    group.bench_function("serial", |b| b.iter(|| backbones_serial(black_box(&jobs))));
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    residual_and_jacobian,
+    one_solve,
+    whole_backbone,
+    sweep
+);
+criterion_main!(benches);

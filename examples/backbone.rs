@@ -7,14 +7,16 @@
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
-//!     [--parameter-range LO:HI] [--progress]
+//!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
 //!
 //! Columns: `step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,
 //! residual_norm,iterations,step_size,event,parameter` (`exact_energy_normalized` is the exact
 //! first mode of the clamped bar, formulation §9, for `--system ds --mode 1` and empty
 //! otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the
-//! continued parameter's value).
+//! continued parameter's value). `--verify` marches every point one period in time with the
+//! exact integrator (`verify::periodicity_check`, `dt = 1/400`) and adds the columns
+//! `periodicity_defect,displacement_defect,max_penetration`.
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
@@ -38,6 +40,7 @@ use nonsmooth_modes::reference::{
 };
 use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
+use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use nonsmooth_modes::{ModelError, SolveError};
 use std::f64::consts::PI;
 use std::io::Write;
@@ -50,7 +53,7 @@ const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin
   [--solver newton|dogleg] [--out FILE] [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
-  [--progress]";
+  [--progress] [--verify]";
 
 const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,residual_norm,iterations,step_size,event,parameter";
 
@@ -91,6 +94,7 @@ struct Args {
     parameter: Parameter,
     parameter_range: Option<(f64, f64)>,
     progress: bool,
+    verify: bool,
 }
 
 /// Default period range per system: just below the linear period of the chosen mode
@@ -142,6 +146,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         parameter: Parameter::Omega,
         parameter_range: None,
         progress: false,
+        verify: false,
     };
     let mut parser = lexopt::Parser::from_env();
     while let Some(arg) = parser.next()? {
@@ -200,6 +205,7 @@ fn parse() -> Result<Args, lexopt::Error> {
             }
             Long("parameter-range") => a.parameter_range = Some(range(&parser.value()?.string()?)?),
             Long("progress") => a.progress = true,
+            Long("verify") => a.verify = true,
             Short('h') | Long("help") => return Err("help requested".into()),
             _ => return Err(arg.unexpected()),
         }
@@ -245,6 +251,7 @@ fn events(events: &[Event]) -> String {
 /// Writes rows and counts them; remembers the first I/O error and stops the run on it.
 struct Sink<'a> {
     out: &'a mut dyn Write,
+    verify: Option<HarmonicBalance>,
     exact: Option<f64>,
     total: usize,
     converged: usize,
@@ -253,7 +260,31 @@ struct Sink<'a> {
 }
 
 impl Sink<'_> {
-    fn row(&mut self, p: &BackbonePoint, parameter: f64) -> ControlFlow<()> {
+    /// `periodicity_defect,displacement_defect,max_penetration` of a point, or empty cells.
+    fn verification(&self, system: &BarSystem, p: &BackbonePoint) -> String {
+        let Some(settings) = self.verify else {
+            return String::new();
+        };
+        let report = settings.cosine_basis().map_err(|e| e.to_string()).and_then(|basis| {
+            let options = PeriodicityOptions {
+                adjust_grid: true,
+                ..Default::default()
+            };
+            periodicity_check(system, &basis, &p.x, p.omega, &options).map_err(|e| e.to_string())
+        });
+        match report {
+            Ok(r) => format!(
+                ",{:.6e},{:.6e},{:.6e}",
+                r.defect, r.displacement_defect, r.max_penetration
+            ),
+            Err(e) => {
+                eprintln!("backbone: verification of step {} failed: {e}", p.step);
+                ",,,".to_string()
+            }
+        }
+    }
+
+    fn row(&mut self, system: &BarSystem, p: &BackbonePoint, parameter: f64) -> ControlFlow<()> {
         self.total += 1;
         self.converged += usize::from(p.converged);
         let exact = self
@@ -265,8 +296,9 @@ impl Sink<'_> {
                 p.step, p.period, p.energy_normalized, p.step_size
             );
         }
+        let verification = self.verification(system, p);
         let line = format!(
-            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{:.3e},{},{:.6e},{},{}",
+            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{:.3e},{},{:.6e},{},{}{}",
             p.step,
             p.period,
             p.omega,
@@ -283,6 +315,7 @@ impl Sink<'_> {
             } else {
                 format!("{parameter:.10e}")
             },
+            verification,
         );
         match writeln!(self.out, "{line}") {
             Ok(()) => ControlFlow::Continue(()),
@@ -298,9 +331,15 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
     let system = build_system(a, Parameter::Omega, f64::NAN)?;
     let (t0, t1) = default_periods(a.system);
     let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
-    writeln!(out, "{HEADER}")?;
+    let extra = if a.verify {
+        ",periodicity_defect,displacement_defect,max_penetration"
+    } else {
+        ""
+    };
+    writeln!(out, "{HEADER}{extra}")?;
     let mut sink = Sink {
         out,
+        verify: a.verify.then_some(a.settings),
         exact: (a.system == SystemKind::Clamped
             && a.mode == 1
             && a.subharmonic == 1
@@ -332,7 +371,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             ..Default::default()
         };
         let (_, branch) = arclength_backbone(&system, a.settings, &options, solver, |p| {
-            sink.row(p, f64::NAN)
+            sink.row(&system, p, f64::NAN)
         })?;
         eprintln!(
             "backbone: arclength ended: {:?}; {} rejected steps",
@@ -350,7 +389,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             ..Default::default()
         };
         backbone_with(&system, a.settings, &options, solver, |p| {
-            sink.row(p, f64::NAN)
+            sink.row(&system, p, f64::NAN)
         })?;
     }
     if let Some(e) = sink.error {
@@ -412,11 +451,11 @@ fn run_parameter(
             converged: p.converged,
             residual_norm: p.residual_norm,
             iterations: p.iterations,
-            x: Vec::new(),
+            x: p.x.clone(),
             step_size: p.step_size,
             events: p.events.clone(),
         };
-        sink.row(&point, p.lambda)
+        sink.row(&system, &point, p.lambda)
     };
     if a.arclength {
         let options = ArclengthOptions {

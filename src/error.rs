@@ -126,7 +126,9 @@ pub enum SettingsError {
         omega: f64,
     },
     /// The seed's harmonic exceeds the basis.
-    #[error("subharmonic {subharmonic} needs harmonic {subharmonic} but the basis stops at {harmonics}")]
+    #[error(
+        "subharmonic {subharmonic} needs harmonic {subharmonic} but the basis stops at {harmonics}"
+    )]
     HarmonicOutOfRange {
         /// Requested subharmonic order.
         subharmonic: usize,
@@ -145,6 +147,7 @@ pub enum SettingsError {
 
 /// Errors of a nonlinear solve.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum SolveError {
     /// The iteration budget ran out before the tolerance was met.
     #[error("no convergence after {iterations} iterations: residual norm {residual_norm:e} > tolerance {tolerance:e}")]
@@ -224,7 +227,9 @@ pub enum ContinuationError {
         value: f64,
     },
     /// Too many consecutive steps failed: the branch is lost.
-    #[error("continuation stalled: {failures} consecutive failed steps, last at parameter {parameter}")]
+    #[error(
+        "continuation stalled: {failures} consecutive failed steps, last at parameter {parameter}"
+    )]
     Stalled {
         /// Consecutive failures.
         failures: usize,
@@ -265,6 +270,9 @@ pub enum Error {
     /// See [`ContinuationError`].
     #[error(transparent)]
     Continuation(#[from] ContinuationError),
+    /// See [`VerifyError`](crate::verify::VerifyError).
+    #[error(transparent)]
+    Verify(#[from] crate::verify::VerifyError),
 }
 
 /// Checks that `value` is strictly positive and finite.

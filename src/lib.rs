@@ -32,6 +32,7 @@
 //! | [`continuation::ContinuationProblem`], [`continuation::Sequential`] | continuation |
 //! | [`modal::backbone`] | one call: a backbone with `E / E_g` |
 //! | [`reference`] | the paper's systems and exact solutions |
+//! | [`sweep::backbones`] | many backbones at once; in parallel with the `parallel` feature (rayon), results identical to the serial run |
 //!
 //! ## Quick start
 //!
@@ -61,10 +62,23 @@ pub mod bem;
 pub mod continuation;
 pub mod error;
 pub mod fourier;
+pub mod io;
 pub mod linalg;
 pub mod modal;
+/// SVG plots of backbones, space-time fields, two-bar snapshots and time histories, from
+/// plain data (feature `plot`, backed by `plotters` without fonts or bitmaps).
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod reference;
 pub mod solve;
+/// Proptest strategies for bars, frequencies, Helmholtz coefficients, the paper's systems and
+/// periods, for property tests of the crate's identities (feature `proptest`).
+#[cfg(feature = "proptest")]
+pub mod strategies;
+pub mod sweep;
 pub mod system;
+/// Exact time-domain integration of bar assemblies (d'Alembert on a grid with `dx = c dt`,
+/// impacts resolved inside the step) and the periodicity check of computed modes.
+pub mod verify;
 
 pub use error::{ContinuationError, Error, ModelError, SettingsError, SolveError};

@@ -1,8 +1,11 @@
 //! A small dense matrix type for public signatures, and the factorisations the crate needs,
 //! done by `faer` inside (faer's types never appear in the public API).
 
-use faer::linalg::solvers::Solve;
-use faer::Mat;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::lu::partial_pivoting::factor;
+use faer::linalg::triangular_solve;
+use faer::{Mat, MatMut, MatRef, Par};
+use std::cell::RefCell;
 use std::ops::{Index, IndexMut};
 
 /// A dense, column-major `f64` matrix.
@@ -84,10 +87,6 @@ impl DenseMatrix {
     pub fn is_finite(&self) -> bool {
         self.data.iter().all(|v| v.is_finite())
     }
-
-    fn to_faer(&self) -> Mat<f64> {
-        Mat::from_fn(self.nrows, self.ncols, |i, j| self[(i, j)])
-    }
 }
 
 impl Index<(usize, usize)> for DenseMatrix {
@@ -114,43 +113,108 @@ pub(crate) struct SmallPivot {
 
 /// LU factorisation with partial pivoting of a square matrix, with a pivot check
 /// (faer's LU does not report singularity).
+///
+/// The factors, the permutation and faer's scratch memory live in the value and are reused:
+/// [`Lu::refactor`] of a matrix of the same (or a smaller) size and [`Lu::solve_in_place`]
+/// allocate nothing. Factorisation and solves are done in place by faer's
+/// `lu_in_place` and triangular solves, sequentially (`Par::Seq`), so results do not depend on
+/// the number of threads.
+#[derive(Default)]
 pub(crate) struct Lu {
-    lu: faer::linalg::solvers::PartialPivLu<f64>,
+    n: usize,
+    /// `L` (strictly lower part, unit diagonal implied) and `U` (upper part), column-major.
+    factors: Vec<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    /// faer's scratch for `lu_in_place`, sized for `scratch_n` unknowns.
+    scratch: Option<MemBuffer>,
+    scratch_n: usize,
+    /// The permuted right-hand side of a solve.
+    rhs: RefCell<Vec<f64>>,
+}
+
+impl std::fmt::Debug for Lu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Lu")
+            .field("n", &self.n)
+            .finish_non_exhaustive()
+    }
 }
 
 impl Lu {
     /// Factorises `a`; fails when `min |u_ii| <= tol * max |u_jj|`.
     pub fn factor(a: &DenseMatrix, tol: f64) -> Result<Self, SmallPivot> {
-        let lu = a.to_faer().partial_piv_lu();
-        let u = lu.U();
-        let n = u.nrows();
+        let mut lu = Self::default();
+        lu.refactor(a, tol)?;
+        Ok(lu)
+    }
+
+    /// Factorises `a` into the storage of `self` (no allocation when `a` is no larger than
+    /// the matrices factorised before); fails when `min |u_ii| <= tol * max |u_jj|`, leaving
+    /// `self` unusable for solves until the next successful factorisation.
+    ///
+    /// # Panics
+    /// If `a` is not square.
+    pub fn refactor(&mut self, a: &DenseMatrix, tol: f64) -> Result<(), SmallPivot> {
+        assert_eq!(a.nrows, a.ncols, "LU of a non-square matrix");
+        let n = a.nrows;
+        self.n = n;
+        self.factors.clear();
+        self.factors.extend_from_slice(&a.data);
+        self.perm.resize(n, 0);
+        self.perm_inv.resize(n, 0);
+        if self.scratch.is_none() || self.scratch_n < n {
+            let req = factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default());
+            self.scratch = Some(MemBuffer::new(req));
+            self.scratch_n = n;
+        }
+        let buffer = self.scratch.as_mut().expect("scratch allocated above");
+        let _ = factor::lu_in_place(
+            MatMut::from_column_major_slice_mut(&mut self.factors, n, n),
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            MemStack::new(buffer),
+            Default::default(),
+        );
         let mut max = 0.0_f64;
         let mut min = f64::INFINITY;
         let mut at = 0;
         for i in 0..n {
-            let d = u[(i, i)].abs();
+            let d = self.factors[i * n + i].abs();
             max = max.max(d);
             if d < min {
                 min = d;
                 at = i;
             }
         }
-        if n > 0 && (!(min > tol * max) || !max.is_finite()) {
+        // NaN pivots fail the comparison, hence count as too small.
+        let trusted = min > tol * max && max.is_finite();
+        if n > 0 && !trusted {
             return Err(SmallPivot {
                 pivot: at,
                 ratio: if max > 0.0 { min / max } else { 0.0 },
             });
         }
-        Ok(Self { lu })
+        Ok(())
     }
 
-    /// Solves `A x = b` in place.
+    /// Solves `A x = b` in place (no allocation once a right-hand side of this size has been
+    /// solved).
+    ///
+    /// # Panics
+    /// If `b.len()` is not the size of the factorised matrix.
     pub fn solve_in_place(&self, b: &mut [f64]) {
-        let mut rhs = Mat::from_fn(b.len(), 1, |i, _| b[i]);
-        self.lu.solve_in_place(rhs.as_mut());
-        for (i, bi) in b.iter_mut().enumerate() {
-            *bi = rhs[(i, 0)];
-        }
+        let n = self.n;
+        assert_eq!(b.len(), n, "right-hand side length");
+        let mut rhs = self.rhs.borrow_mut();
+        rhs.clear();
+        rhs.extend(self.perm.iter().map(|&p| b[p]));
+        b.copy_from_slice(&rhs);
+        let factors = MatRef::from_column_major_slice(&self.factors, n, n);
+        let mut x = MatMut::from_column_major_slice_mut(b, n, 1);
+        triangular_solve::solve_unit_lower_triangular_in_place(factors, x.as_mut(), Par::Seq);
+        triangular_solve::solve_upper_triangular_in_place(factors, x, Par::Seq);
     }
 }
 

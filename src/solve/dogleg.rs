@@ -1,6 +1,8 @@
 //! Powell's hybrid trust-region dogleg method.
 
-use super::{check_positive, norm, Iteration, NonlinearSolver, Problem, SolveInfo};
+use super::{
+    check_positive, norm, with_workspace, Iteration, NonlinearSolver, Problem, SolveInfo, Workspace,
+};
 use crate::error::SolveError;
 
 /// Options of [`Dogleg`].
@@ -65,81 +67,96 @@ impl NonlinearSolver for Dogleg {
         let tol = self.tolerance(problem);
         let scale = problem.residual_scale();
         let mut it = Iteration::new(problem, x)?;
-        let n = x.len();
         let reference = norm(x).max(scale);
         let mut radius = o.initial_radius * reference;
-        let (mut newton, mut grad, mut jg, mut step) =
-            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let (mut trial, mut f_trial, mut jp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let mut r = it.residual(x, 0)?;
-        for iteration in 0..o.max_iterations {
+        with_workspace(x.len(), |ws| {
+            let Workspace {
+                f,
+                f_trial,
+                trial,
+                dx: newton,
+                grad,
+                jg,
+                step,
+                jp,
+                jac,
+                lu,
+            } = ws;
+            let mut r = it.residual_into(x, f, 0)?;
+            for iteration in 0..o.max_iterations {
+                if r <= tol {
+                    return Ok(it.info(iteration, r));
+                }
+                let factored = it.factor_jacobian(x, jac, lu, iteration);
+                // A singular Jacobian still allows Cauchy steps; a non-finite one does not.
+                if let Err(e @ SolveError::NonFinite { .. }) = factored {
+                    return Err(e);
+                }
+                // Steepest-descent direction of |F|^2/2: g = J^T F.
+                jac.mul_transpose_vec(f, grad);
+                jac.mul_vec(grad, jg);
+                let g2 = grad.iter().map(|v| v * v).sum::<f64>();
+                let jg2 = jg.iter().map(|v| v * v).sum::<f64>();
+                let cauchy_length = if jg2 > 0.0 { g2 / jg2 } else { 0.0 };
+                let have_newton = match &factored {
+                    Ok(()) => {
+                        for (d, fi) in newton.iter_mut().zip(f.iter()) {
+                            *d = -fi;
+                        }
+                        lu.solve_in_place(newton);
+                        newton.iter().all(|v| v.is_finite())
+                    }
+                    Err(_) => false,
+                };
+                loop {
+                    dogleg_step(newton, have_newton, grad, cauchy_length, radius, step);
+                    for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(step.iter()) {
+                        *xt = xi + d;
+                    }
+                    let rt = it.residual_into(trial, f_trial, iteration)?;
+                    jac.mul_vec(step, jp);
+                    let predicted_r2 = f
+                        .iter()
+                        .zip(jp.iter())
+                        .map(|(f, d)| (f + d) * (f + d))
+                        .sum::<f64>();
+                    let predicted = r * r - predicted_r2;
+                    let actual = r * r - rt * rt;
+                    let ratio = if predicted > 0.0 {
+                        actual / predicted
+                    } else {
+                        -1.0
+                    };
+                    let length = norm(step);
+                    if ratio < 0.25 {
+                        radius = 0.5 * length.min(radius);
+                    } else if ratio > 0.75 {
+                        radius = radius.max(2.0 * length);
+                    }
+                    if actual > 0.0 && (ratio > 1e-4 || rt <= tol) {
+                        x.copy_from_slice(trial);
+                        std::mem::swap(f, f_trial);
+                        r = rt;
+                        break;
+                    }
+                    if radius < o.min_radius * reference {
+                        factored?;
+                        return Err(SolveError::TrustRegion {
+                            iteration,
+                            radius,
+                            residual_norm: r,
+                        });
+                    }
+                }
+            }
             if r <= tol {
-                return Ok(it.info(iteration, r));
+                return Ok(it.info(o.max_iterations, r));
             }
-            let lu = it.factor_jacobian(x, iteration);
-            // Steepest-descent direction of |F|^2/2: g = J^T F.
-            it.jac.mul_transpose_vec(&it.f, &mut grad);
-            it.jac.mul_vec(&grad, &mut jg);
-            let g2 = grad.iter().map(|v| v * v).sum::<f64>();
-            let jg2 = jg.iter().map(|v| v * v).sum::<f64>();
-            let cauchy_length = if jg2 > 0.0 { g2 / jg2 } else { 0.0 };
-            let have_newton = match &lu {
-                Ok(lu) => {
-                    for (d, f) in newton.iter_mut().zip(&it.f) {
-                        *d = -f;
-                    }
-                    lu.solve_in_place(&mut newton);
-                    newton.iter().all(|v| v.is_finite())
-                }
-                Err(_) => false,
-            };
-            loop {
-                dogleg_step(&newton, have_newton, &grad, cauchy_length, radius, &mut step);
-                for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(&step) {
-                    *xt = xi + d;
-                }
-                let rt = it.residual_into(&trial, &mut f_trial, iteration)?;
-                it.jac.mul_vec(&step, &mut jp);
-                let predicted_r2 = it
-                    .f
-                    .iter()
-                    .zip(&jp)
-                    .map(|(f, d)| (f + d) * (f + d))
-                    .sum::<f64>();
-                let predicted = r * r - predicted_r2;
-                let actual = r * r - rt * rt;
-                let ratio = if predicted > 0.0 { actual / predicted } else { -1.0 };
-                let length = norm(&step);
-                if ratio < 0.25 {
-                    radius = 0.5 * length.min(radius);
-                } else if ratio > 0.75 {
-                    radius = radius.max(2.0 * length);
-                }
-                if actual > 0.0 && (ratio > 1e-4 || rt <= tol) {
-                    x.copy_from_slice(&trial);
-                    std::mem::swap(&mut it.f, &mut f_trial);
-                    r = rt;
-                    break;
-                }
-                if radius < o.min_radius * reference {
-                    if let Err(e) = lu {
-                        return Err(e);
-                    }
-                    return Err(SolveError::TrustRegion {
-                        iteration,
-                        radius,
-                        residual_norm: r,
-                    });
-                }
-            }
-        }
-        if r <= tol {
-            return Ok(it.info(o.max_iterations, r));
-        }
-        Err(SolveError::MaxIterations {
-            iterations: o.max_iterations,
-            residual_norm: r,
-            tolerance: tol,
+            Err(SolveError::MaxIterations {
+                iterations: o.max_iterations,
+                residual_norm: r,
+                tolerance: tol,
+            })
         })
     }
 }
@@ -161,24 +178,36 @@ fn dogleg_step(
     let cauchy_norm = cauchy_length * gnorm;
     if !have_newton || cauchy_norm >= radius || gnorm == 0.0 {
         let s = if gnorm > 0.0 { radius / gnorm } else { 0.0 };
-        let s = if have_newton || cauchy_norm >= radius { s } else { cauchy_length };
+        let s = if have_newton || cauchy_norm >= radius {
+            s
+        } else {
+            cauchy_length
+        };
         for (d, g) in step.iter_mut().zip(grad) {
             *d = -s * g;
         }
         return;
     }
-    // Point on the segment from the Cauchy point c to the Newton point with |p| = radius.
-    let c: Vec<f64> = grad.iter().map(|g| -cauchy_length * g).collect();
-    let diff: Vec<f64> = newton.iter().zip(&c).map(|(n, c)| n - c).collect();
-    let a = diff.iter().map(|v| v * v).sum::<f64>();
-    let b = 2.0 * c.iter().zip(&diff).map(|(c, d)| c * d).sum::<f64>();
-    let cc = c.iter().map(|v| v * v).sum::<f64>() - radius * radius;
+    // Point on the segment from the Cauchy point c = -cauchy_length g towards the Newton
+    // point with |p| = radius (no allocation: c and n - c are formed on the fly).
+    let cauchy = |g: &f64| -cauchy_length * g;
+    let (mut a, mut b, mut cc) = (0.0, 0.0, 0.0);
+    for (n, g) in newton.iter().zip(grad) {
+        let c = cauchy(g);
+        let d = n - c;
+        a += d * d;
+        b += c * d;
+        cc += c * c;
+    }
+    let b = 2.0 * b;
+    let cc = cc - radius * radius;
     let tau = if a > 0.0 {
         (-b + (b * b - 4.0 * a * cc).max(0.0).sqrt()) / (2.0 * a)
     } else {
         0.0
     };
-    for ((s, c), d) in step.iter_mut().zip(&c).zip(&diff) {
-        *s = c + tau * d;
+    for ((s, n), g) in step.iter_mut().zip(newton).zip(grad) {
+        let c = cauchy(g);
+        *s = c + tau * (n - c);
     }
 }

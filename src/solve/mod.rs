@@ -17,6 +17,7 @@ pub use newton::{NewtonOptions, SemismoothNewton};
 
 use crate::error::SolveError;
 use crate::linalg::{DenseMatrix, Lu};
+use std::cell::Cell;
 
 /// A square system `F(x) = 0` with a generalised Jacobian.
 pub trait Problem {
@@ -71,11 +72,75 @@ pub(crate) fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Shared state of an iteration: the problem, buffers and counters.
+/// Buffers of one solve. They live in a thread-local cache between solves, so that a
+/// continuation run allocates them once per thread (and again only when the dimension grows).
+#[derive(Debug)]
+pub(crate) struct Workspace {
+    pub f: Vec<f64>,
+    pub f_trial: Vec<f64>,
+    pub trial: Vec<f64>,
+    pub dx: Vec<f64>,
+    pub grad: Vec<f64>,
+    pub jg: Vec<f64>,
+    pub step: Vec<f64>,
+    pub jp: Vec<f64>,
+    pub jac: DenseMatrix,
+    pub lu: Lu,
+}
+
+impl Workspace {
+    fn new() -> Self {
+        Self {
+            f: Vec::new(),
+            f_trial: Vec::new(),
+            trial: Vec::new(),
+            dx: Vec::new(),
+            grad: Vec::new(),
+            jg: Vec::new(),
+            step: Vec::new(),
+            jp: Vec::new(),
+            jac: DenseMatrix::zeros(0, 0),
+            lu: Lu::default(),
+        }
+    }
+
+    /// Zeroes every vector at length `n` (keeping capacity).
+    fn prepare(&mut self, n: usize) {
+        for v in [
+            &mut self.f,
+            &mut self.f_trial,
+            &mut self.trial,
+            &mut self.dx,
+            &mut self.grad,
+            &mut self.jg,
+            &mut self.step,
+            &mut self.jp,
+        ] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+    }
+}
+
+thread_local! {
+    static WORKSPACE: Cell<Option<Box<Workspace>>> = const { Cell::new(None) };
+}
+
+/// Runs `f` with this thread's solver buffers sized for `n` unknowns. A solve started from
+/// inside another (a problem whose residual solves something) gets fresh buffers.
+pub(crate) fn with_workspace<R>(n: usize, f: impl FnOnce(&mut Workspace) -> R) -> R {
+    let mut ws = WORKSPACE
+        .with(Cell::take)
+        .unwrap_or_else(|| Box::new(Workspace::new()));
+    ws.prepare(n);
+    let result = f(&mut ws);
+    WORKSPACE.with(|cell| cell.set(Some(ws)));
+    result
+}
+
+/// Shared state of an iteration: the problem and counters.
 pub(crate) struct Iteration<'p> {
     pub problem: &'p mut dyn Problem,
-    pub f: Vec<f64>,
-    pub jac: DenseMatrix,
     pub residuals: usize,
     pub jacobians: usize,
 }
@@ -97,15 +162,18 @@ impl<'p> Iteration<'p> {
         }
         Ok(Self {
             problem,
-            f: vec![0.0; n],
-            jac: DenseMatrix::zeros(n, n),
             residuals: 0,
             jacobians: 0,
         })
     }
 
     /// Evaluates `F(x)` into `out` and returns its norm, or an error if non-finite.
-    pub fn residual_into(&mut self, x: &[f64], out: &mut [f64], iteration: usize) -> Result<f64, SolveError> {
+    pub fn residual_into(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+        iteration: usize,
+    ) -> Result<f64, SolveError> {
         self.problem.residual(x, out);
         self.residuals += 1;
         let r = norm(out);
@@ -119,29 +187,29 @@ impl<'p> Iteration<'p> {
         }
     }
 
-    /// Evaluates `F(x)` into `self.f` and returns its norm.
-    pub fn residual(&mut self, x: &[f64], iteration: usize) -> Result<f64, SolveError> {
-        let mut f = std::mem::take(&mut self.f);
-        let r = self.residual_into(x, &mut f, iteration);
-        self.f = f;
-        r
-    }
-
-    /// Evaluates and factorises the Jacobian at `x`.
-    pub fn factor_jacobian(&mut self, x: &[f64], iteration: usize) -> Result<Lu, SolveError> {
-        self.problem.jacobian(x, &mut self.jac);
+    /// Evaluates the Jacobian at `x` into `jac` and factorises it into `lu` (in place, reusing
+    /// the storage of both).
+    pub fn factor_jacobian(
+        &mut self,
+        x: &[f64],
+        jac: &mut DenseMatrix,
+        lu: &mut Lu,
+        iteration: usize,
+    ) -> Result<(), SolveError> {
+        self.problem.jacobian(x, jac);
         self.jacobians += 1;
-        if !self.jac.is_finite() {
+        if !jac.is_finite() {
             return Err(SolveError::NonFinite {
                 what: "Jacobian",
                 iteration,
             });
         }
-        Lu::factor(&self.jac, PIVOT_TOLERANCE).map_err(|p| SolveError::SingularJacobian {
-            iteration,
-            pivot: p.pivot,
-            ratio: p.ratio,
-        })
+        lu.refactor(jac, PIVOT_TOLERANCE)
+            .map_err(|p| SolveError::SingularJacobian {
+                iteration,
+                pivot: p.pivot,
+                ratio: p.ratio,
+            })
     }
 
     pub fn info(&self, iterations: usize, residual_norm: f64) -> SolveInfo {

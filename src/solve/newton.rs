@@ -1,6 +1,8 @@
 //! Semismooth Newton with a backtracking line search.
 
-use super::{check_positive, Iteration, NonlinearSolver, Problem, SolveInfo};
+use super::{
+    check_positive, with_workspace, Iteration, NonlinearSolver, Problem, SolveInfo, Workspace,
+};
 use crate::error::SolveError;
 
 /// Options of [`SemismoothNewton`].
@@ -64,49 +66,56 @@ impl NonlinearSolver for SemismoothNewton {
         let o = &self.options;
         let tol = self.tolerance(problem);
         let mut it = Iteration::new(problem, x)?;
-        let n = x.len();
-        let mut dx = vec![0.0; n];
-        let mut trial = vec![0.0; n];
-        let mut f_trial = vec![0.0; n];
-        let mut r = it.residual(x, 0)?;
-        for iteration in 0..o.max_iterations {
+        with_workspace(x.len(), |ws| {
+            let Workspace {
+                f,
+                f_trial,
+                trial,
+                dx,
+                jac,
+                lu,
+                ..
+            } = ws;
+            let mut r = it.residual_into(x, f, 0)?;
+            for iteration in 0..o.max_iterations {
+                if r <= tol {
+                    return Ok(it.info(iteration, r));
+                }
+                it.factor_jacobian(x, jac, lu, iteration)?;
+                for (d, fi) in dx.iter_mut().zip(f.iter()) {
+                    *d = -fi;
+                }
+                lu.solve_in_place(dx);
+                let mut t = 1.0;
+                loop {
+                    for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(dx.iter()) {
+                        *xt = xi + t * d;
+                    }
+                    let rt = it.residual_into(trial, f_trial, iteration)?;
+                    if rt * rt <= (1.0 - 2.0 * o.armijo * t) * r * r || rt <= tol {
+                        x.copy_from_slice(trial);
+                        std::mem::swap(f, f_trial);
+                        r = rt;
+                        break;
+                    }
+                    t *= 0.5;
+                    if t < o.min_step {
+                        return Err(SolveError::LineSearch {
+                            iteration,
+                            residual_norm: r,
+                            step: t,
+                        });
+                    }
+                }
+            }
             if r <= tol {
-                return Ok(it.info(iteration, r));
+                return Ok(it.info(o.max_iterations, r));
             }
-            let lu = it.factor_jacobian(x, iteration)?;
-            for (d, f) in dx.iter_mut().zip(&it.f) {
-                *d = -f;
-            }
-            lu.solve_in_place(&mut dx);
-            let mut t = 1.0;
-            loop {
-                for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(&dx) {
-                    *xt = xi + t * d;
-                }
-                let rt = it.residual_into(&trial, &mut f_trial, iteration)?;
-                if rt * rt <= (1.0 - 2.0 * o.armijo * t) * r * r || rt <= tol {
-                    x.copy_from_slice(&trial);
-                    std::mem::swap(&mut it.f, &mut f_trial);
-                    r = rt;
-                    break;
-                }
-                t *= 0.5;
-                if t < o.min_step {
-                    return Err(SolveError::LineSearch {
-                        iteration,
-                        residual_norm: r,
-                        step: t,
-                    });
-                }
-            }
-        }
-        if r <= tol {
-            return Ok(it.info(o.max_iterations, r));
-        }
-        Err(SolveError::MaxIterations {
-            iterations: o.max_iterations,
-            residual_norm: r,
-            tolerance: tol,
+            Err(SolveError::MaxIterations {
+                iterations: o.max_iterations,
+                residual_norm: r,
+                tolerance: tol,
+            })
         })
     }
 }

@@ -188,17 +188,25 @@ impl<B: Basis> NonsmoothSystem<B> {
             return;
         }
         self.omega = omega;
-        self.rows = (0..=self.basis.harmonics())
-            .map(|h| {
-                let mut rows = HarmonicRows::new(&self.system, h as f64 * omega);
-                rows.regularise(RANK_TOLERANCE);
-                rows
-            })
-            .collect();
+        // Reuse the outer vector (the rows of each harmonic are rebuilt).
+        let system = &self.system;
+        self.rows.clear();
+        self.rows.extend((0..=self.basis.harmonics()).map(|h| {
+            let mut rows = HarmonicRows::new(system, h as f64 * omega);
+            rows.regularise(RANK_TOLERANCE);
+            rows
+        }));
     }
 
     /// Coefficients of the gap (`gap == true`) or force of law `l`, one per basis function.
-    fn observable_coefficients(&self, x: &[f64], l: usize, gap: bool, derivative: bool, out: &mut [f64]) {
+    fn observable_coefficients(
+        &self,
+        x: &[f64],
+        l: usize,
+        gap: bool,
+        derivative: bool,
+        out: &mut [f64],
+    ) {
         let n = self.unknowns;
         for (i, o) in out.iter_mut().enumerate() {
             let h = self.basis.harmonic(i);
@@ -223,9 +231,11 @@ impl<B: Basis> NonsmoothSystem<B> {
             let range = l * n..(l + 1) * n;
             let (g0, f0) = self.offsets[l];
             self.observable_coefficients(x, l, true, false, &mut ws.coefficients);
-            self.basis.synthesize(&ws.coefficients, &mut ws.gap[range.clone()]);
+            self.basis
+                .synthesize(&ws.coefficients, &mut ws.gap[range.clone()]);
             self.observable_coefficients(x, l, false, false, &mut ws.coefficients);
-            self.basis.synthesize(&ws.coefficients, &mut ws.force[range.clone()]);
+            self.basis
+                .synthesize(&ws.coefficients, &mut ws.force[range.clone()]);
             for k in range {
                 ws.gap[k] += g0;
                 ws.force[k] += f0;
@@ -265,7 +275,11 @@ impl<B: Basis> NonsmoothSystem<B> {
         self.observable_coefficients(x, l, gap, false, &mut c);
         let mut s = vec![0.0; self.basis.samples()];
         self.basis.synthesize(&c, &mut s);
-        let offset = if gap { self.offsets[l].0 } else { self.offsets[l].1 };
+        let offset = if gap {
+            self.offsets[l].0
+        } else {
+            self.offsets[l].1
+        };
         s.iter_mut().for_each(|v| *v += offset);
         s
     }
@@ -328,18 +342,22 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let mut ws = std::mem::take(&mut self.ws);
         for l in 0..self.laws {
             let range = l * n..(l + 1) * n;
-            self.basis.weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
-            self.basis.weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+            self.basis
+                .weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
+            self.basis
+                .weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+            // Column by column (the matrix is column-major): contiguous writes.
             for i in 0..len {
                 let rows = &self.rows[self.basis.harmonic(i)];
                 let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
-                for j in 0..len {
-                    let (gg, gf) = (ws.gram_gap[j * len + i], ws.gram_force[j * len + i]);
-                    if gg == 0.0 && gf == 0.0 {
-                        continue;
-                    }
-                    for c in 0..un {
-                        jac[(base + l * len + j, i * un + c)] = gg * grow[c] + gf * frow[c];
+                for c in 0..un {
+                    let (gc, fc) = (grow[c], frow[c]);
+                    for j in 0..len {
+                        let (gg, gf) = (ws.gram_gap[j * len + i], ws.gram_force[j * len + i]);
+                        if gg == 0.0 && gf == 0.0 {
+                            continue;
+                        }
+                        jac[(base + l * len + j, i * un + c)] = gg * gc + gf * fc;
                     }
                 }
             }
@@ -368,6 +386,40 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
         }
         self.ws = ws;
+    }
+
+    /// Energy weights: a harmonic `A cos(kx) + B sin(kx)/k` of bar `b` stores about
+    /// `EA l (A^2 k^2 + B^2) / 4` of strain energy, so `w_A = EA l (k^2 + 1/l^2)` (the `1/l^2`
+    /// keeps rigid displacements weighted) and `w_B = EA l`.
+    fn state_weights(&mut self, omega: f64) -> Option<Vec<f64>> {
+        let bars = self.system.bars();
+        let mut w = Vec::with_capacity(self.dimension());
+        for i in 0..self.basis.len() {
+            let n = self.basis.harmonic(i) as f64;
+            for bar in bars {
+                let (l, ea) = (bar.length(), bar.stiffness());
+                let k = bar.wavenumber(n * omega);
+                w.push(ea * l * (k * k + 1.0 / (l * l)));
+                w.push(ea * l);
+            }
+        }
+        Some(w)
+    }
+
+    fn active_set(&mut self, x: &[f64], omega: f64) -> Option<Vec<usize>> {
+        self.prepare(omega);
+        self.sample_laws(x);
+        let n = self.basis.samples();
+        Some(
+            (0..self.laws)
+                .map(|l| {
+                    self.ws.w_gap[l * n..(l + 1) * n]
+                        .iter()
+                        .filter(|w| **w != 0.0)
+                        .count()
+                })
+                .collect(),
+        )
     }
 
     fn residual_scale(&self) -> f64 {

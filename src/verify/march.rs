@@ -1,0 +1,492 @@
+//! The march: every step, each condition turns the waves arriving at its ends into outgoing
+//! waves, resolving impacts and releases at their exact instants.
+
+use super::state::State;
+use super::wave::{Piece, TINY};
+use super::{Condition, Snapshot, VerifyError};
+use crate::bar::{End, EndRef};
+
+/// How a ground spring is advanced over a piece of constant incoming wave `a`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpringUpdate {
+    /// Exact solution of `u' = a - beta u` (`beta = k_s / Z`); the outgoing wave is the exact
+    /// mean of `b(t) = a - 2 beta u(t)` over the piece. End displacement exact; the
+    /// projection of `b` on constants loses a relative energy `O((beta dt)^2)` per unit time.
+    /// The default.
+    #[default]
+    Exact,
+    /// Spring law imposed at the midpoint of the piece (implicit midpoint rule): energy is
+    /// conserved to rounding, the end displacement has an `O((beta dt)^2)` relative error.
+    Midpoint,
+}
+
+/// Options of [`march`] and [`Integrator`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MarchOptions {
+    /// Update of ground springs (default [`SpringUpdate::Exact`]).
+    pub spring: SpringUpdate,
+    /// Keep a [`Snapshot`] of the fields every that many steps (0, the default: only none;
+    /// the initial and final states are always available from the [`Trajectory`]).
+    pub snapshot_every: usize,
+}
+
+/// What happened during one step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepSummary {
+    /// Time at the end of the step.
+    pub time: f64,
+    /// Length of the step (`dt`, or less for a partial step).
+    pub duration: f64,
+    /// Mean strain `u_x` over the step at `[x = 0, x = l]` of every bar.
+    pub end_strain: Vec<[f64; 2]>,
+    /// Mean contact force over the step, per condition (0 for linear conditions).
+    pub contact_force: Vec<f64>,
+    /// Smallest contact force during the step over all unilateral conditions (0 while a
+    /// contact is open; `+inf` if there is no unilateral condition).
+    pub min_contact_force: f64,
+    /// Largest penetration `max(0, -g)` seen during the step.
+    pub max_penetration: f64,
+}
+
+/// Steps a [`State`] forward, one (possibly partial) step at a time.
+#[derive(Debug, Clone)]
+pub struct Integrator {
+    state: State,
+    options: MarchOptions,
+    incoming: Vec<Vec<Piece>>,
+    outgoing: Vec<Vec<(f64, f64)>>,
+}
+
+/// One end of a condition during a step.
+#[derive(Debug, Clone, Copy)]
+struct Port {
+    /// Outward normal.
+    n: f64,
+    /// Wave speed.
+    c: f64,
+    /// Impedance `EA / c`.
+    z: f64,
+    /// Displacement.
+    u: f64,
+    /// `int u_x ds` over the step (clock units).
+    strain: f64,
+}
+
+/// Observations of one condition during a step.
+#[derive(Debug, Clone, Copy)]
+struct Watch {
+    force: f64,
+    min_force: f64,
+    penetration: f64,
+}
+
+impl Port {
+    /// Records an outgoing value `b` against the incoming `a` for a duration `h` (clock units).
+    fn emit(&mut self, out: &mut Vec<(f64, f64)>, until: f64, a: f64, b: f64, h: f64) {
+        out.push((until, b));
+        self.strain += h * self.n * (b - a) / (2.0 * self.c);
+    }
+}
+
+/// Rounding tolerance for a closed gap.
+fn gap_tolerance(g0: f64, u: &[f64]) -> f64 {
+    8.0 * f64::EPSILON * (g0.abs() + u.iter().map(|v| v.abs()).sum::<f64>())
+}
+
+/// Clock of impact within `[s, end]` for a gap `g` closing at `rate` per step from clock
+/// `s`, snapped to `s` or `end` when within rounding of them (so that an impact that falls on
+/// a breakpoint in exact arithmetic leaves no sliver of a piece); `None` if the gap does not
+/// close before `end`.
+fn impact(s: f64, end: f64, g: f64, rate: f64) -> Option<f64> {
+    if rate <= 0.0 {
+        return None;
+    }
+    let hit = s + g / rate;
+    let tol = TINY.max(64.0 * f64::EPSILON * end.abs());
+    if hit - s < tol {
+        Some(s)
+    } else if (hit - end).abs() < tol {
+        Some(end)
+    } else if hit < end {
+        Some(hit)
+    } else {
+        None
+    }
+}
+
+impl Integrator {
+    /// An integrator starting from `state`.
+    pub fn new(state: State, options: MarchOptions) -> Self {
+        Self {
+            state,
+            options,
+            incoming: vec![Vec::new(), Vec::new()],
+            outgoing: vec![Vec::new(), Vec::new()],
+        }
+    }
+
+    /// The current state.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// The current state, consuming the integrator.
+    pub fn into_state(self) -> State {
+        self.state
+    }
+
+    /// One full step `dt`.
+    pub fn step(&mut self) -> StepSummary {
+        self.advance_unchecked(1.0)
+    }
+
+    /// A partial step of `fraction * dt`.
+    ///
+    /// # Errors
+    /// [`VerifyError::InvalidParameter`] unless `0 < fraction <= 1`.
+    pub fn advance(&mut self, fraction: f64) -> Result<StepSummary, VerifyError> {
+        if !(fraction > 0.0 && fraction <= 1.0) {
+            return Err(VerifyError::InvalidParameter {
+                what: "step fraction",
+                value: fraction,
+            });
+        }
+        Ok(self.advance_unchecked(fraction))
+    }
+
+    fn advance_unchecked(&mut self, fraction: f64) -> StepSummary {
+        let s0 = self.state.clock;
+        let s1 = s0 + fraction;
+        let dt = self.state.grid.dt();
+        let nb = self.state.bars.len();
+        let mut end_strain = vec![[0.0; 2]; nb];
+        let conditions = self.state.model.conditions().to_vec();
+        let mut contact_force = vec![0.0; conditions.len()];
+        let mut min_force = f64::INFINITY;
+        let mut penetration: f64 = 0.0;
+        for (ci, condition) in conditions.iter().enumerate() {
+            let ends = condition.ends();
+            let mut ports = [None, None];
+            for (k, end) in ends.iter().enumerate() {
+                let b = end.bar.index();
+                let bar = self.state.model.bars()[b];
+                let waves = &mut self.state.bars[b];
+                let side = usize::from(end.end == End::Right);
+                self.incoming[k].clear();
+                self.outgoing[k].clear();
+                let wave = if side == 1 {
+                    &mut waves.right
+                } else {
+                    &mut waves.left
+                };
+                wave.take_until(s1, &mut self.incoming[k]);
+                ports[k] = Some(Port {
+                    n: end.end.normal(),
+                    c: bar.wave_speed(),
+                    z: bar.stiffness() / bar.wave_speed(),
+                    u: waves.ends[side],
+                    strain: 0.0,
+                });
+            }
+            let mut watch = Watch {
+                force: 0.0,
+                min_force: f64::INFINITY,
+                penetration: 0.0,
+            };
+            let (inc, out) = (&self.incoming, &mut self.outgoing);
+            match (*condition, ports) {
+                (Condition::Clamped { .. }, [Some(mut p), _]) => {
+                    for q in &inc[0] {
+                        p.emit(&mut out[0], q.end, q.value, -q.value, q.end - q.start);
+                    }
+                    ports[0] = Some(p);
+                }
+                (Condition::Free { .. }, [Some(mut p), _]) => {
+                    for q in &inc[0] {
+                        p.emit(&mut out[0], q.end, q.value, q.value, q.end - q.start);
+                        p.u += (q.end - q.start) * dt * q.value;
+                    }
+                    ports[0] = Some(p);
+                }
+                (Condition::Spring { stiffness, .. }, [Some(mut p), _]) => {
+                    let beta = stiffness / p.z;
+                    for q in &inc[0] {
+                        let h = (q.end - q.start) * dt;
+                        let a = q.value;
+                        // Mean end velocity over the piece, Delta u / h.
+                        let rate = match self.options.spring {
+                            SpringUpdate::Exact => {
+                                let z = beta * h;
+                                let phi = if z > 0.0 { -(-z).exp_m1() / z } else { 1.0 };
+                                (a - beta * p.u) * phi
+                            }
+                            SpringUpdate::Midpoint => (a - beta * p.u) / (1.0 + 0.5 * beta * h),
+                        };
+                        let b = 2.0 * rate - a;
+                        p.emit(&mut out[0], q.end, a, b, q.end - q.start);
+                        p.u += rate * h;
+                    }
+                    ports[0] = Some(p);
+                }
+                (Condition::Obstacle { gap, .. }, [Some(mut p), _]) => {
+                    let n = p.n;
+                    for q in &inc[0] {
+                        let a = q.value;
+                        let w = n * a;
+                        let mut s = q.start;
+                        while s < q.end {
+                            let g = gap - n * p.u;
+                            if g <= gap_tolerance(gap, &[p.u]) && w > 0.0 {
+                                // Stuck: u_t = 0, lambda = Z w > 0.
+                                p.emit(&mut out[0], q.end, a, -a, q.end - s);
+                                let lambda = p.z * w;
+                                watch.force += lambda * (q.end - s);
+                                watch.min_force = watch.min_force.min(lambda);
+                                s = q.end;
+                            } else {
+                                let hit = impact(s, q.end, g, w * dt);
+                                let stop = hit.unwrap_or(q.end);
+                                p.emit(&mut out[0], stop, a, a, stop - s);
+                                watch.min_force = watch.min_force.min(0.0);
+                                if hit.is_some() {
+                                    p.u = n * gap; // at the obstacle: g = 0 exactly
+                                } else {
+                                    p.u += (stop - s) * dt * a;
+                                }
+                                s = stop;
+                            }
+                            watch.penetration = watch.penetration.max(n * p.u - gap);
+                        }
+                    }
+                    ports[0] = Some(p);
+                }
+                (Condition::Contact { gap, .. }, [Some(mut pa), Some(mut pb)]) => {
+                    let (ia, ib) = (&inc[0], &inc[1]);
+                    let (mut i, mut j) = (0, 0);
+                    let mut s = s0;
+                    let (out_a, out_b) = out.split_at_mut(1);
+                    let (out_a, out_b) = (&mut out_a[0], &mut out_b[0]);
+                    while i < ia.len() && j < ib.len() {
+                        let e = ia[i].end.min(ib[j].end);
+                        let (aa, ab) = (ia[i].value, ib[j].value);
+                        let (wa, wb) = (pa.n * aa, pb.n * ab);
+                        let w = wa + wb;
+                        while s < e {
+                            let g = gap - pa.n * pa.u - pb.n * pb.u;
+                            if g <= gap_tolerance(gap, &[pa.u, pb.u]) && w > 0.0 {
+                                // Stuck: common outward velocity V, lossless junction.
+                                let v = (pa.z * wa - pb.z * wb) / (pa.z + pb.z);
+                                let h = e - s;
+                                pa.emit(out_a, e, aa, pa.n * (2.0 * v - wa), h);
+                                pb.emit(out_b, e, ab, pb.n * (-2.0 * v - wb), h);
+                                pa.u += pa.n * v * h * dt;
+                                pb.u -= pb.n * v * h * dt;
+                                let lambda = pa.z * pb.z * w / (pa.z + pb.z);
+                                watch.force += lambda * h;
+                                watch.min_force = watch.min_force.min(lambda);
+                                s = e;
+                            } else {
+                                let hit = impact(s, e, g, w * dt);
+                                let stop = hit.unwrap_or(e);
+                                let h = stop - s;
+                                pa.emit(out_a, stop, aa, aa, h);
+                                pb.emit(out_b, stop, ab, ab, h);
+                                pa.u += h * dt * aa;
+                                pb.u += h * dt * ab;
+                                if hit.is_some() {
+                                    // Close the gap exactly (to rounding) at the impact.
+                                    let r = gap - pa.n * pa.u - pb.n * pb.u;
+                                    pa.u += pa.n * r;
+                                }
+                                watch.min_force = watch.min_force.min(0.0);
+                                s = stop;
+                            }
+                            let g = gap - pa.n * pa.u - pb.n * pb.u;
+                            watch.penetration = watch.penetration.max(-g);
+                        }
+                        if ia[i].end <= e {
+                            i += 1;
+                        }
+                        if ib[j].end <= e {
+                            j += 1;
+                        }
+                    }
+                    ports = [Some(pa), Some(pb)];
+                }
+                _ => unreachable!("a condition has as many ports as ends"),
+            }
+            if condition.is_unilateral() {
+                contact_force[ci] = watch.force / fraction;
+                min_force = min_force.min(watch.min_force);
+                penetration = penetration.max(watch.penetration);
+            }
+            for (k, end) in ends.iter().enumerate() {
+                let Some(p) = ports[k] else { continue };
+                let b = end.bar.index();
+                let cells = self.state.grid.cells(b) as f64;
+                let side = usize::from(end.end == End::Right);
+                let waves = &mut self.state.bars[b];
+                waves.ends[side] = p.u;
+                end_strain[b][side] = p.strain / fraction;
+                let wave = if side == 1 {
+                    &mut waves.left
+                } else {
+                    &mut waves.right
+                };
+                for &(until, value) in &self.outgoing[k] {
+                    wave.push_until(until + cells, value);
+                }
+            }
+        }
+        self.state.clock = s1;
+        StepSummary {
+            time: self.state.time(),
+            duration: fraction * dt,
+            end_strain,
+            contact_force,
+            min_contact_force: min_force,
+            max_penetration: penetration,
+        }
+    }
+}
+
+/// History of one bar end.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EndHistory {
+    /// The end.
+    pub end: EndRef,
+    /// Displacement at each instant of [`Trajectory::times`].
+    pub displacement: Vec<f64>,
+    /// Mean strain `u_x` over each step (one fewer entry than `times`).
+    pub strain: Vec<f64>,
+}
+
+/// History of one unilateral condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactHistory {
+    /// Index of the condition in the model.
+    pub condition: usize,
+    /// Gap at each instant of [`Trajectory::times`].
+    pub gap: Vec<f64>,
+    /// Mean contact force over each step (one fewer entry than `times`): the impulse of the
+    /// step divided by its length.
+    pub force: Vec<f64>,
+}
+
+/// Result of [`march`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// Instants: 0, then the end of every step.
+    pub times: Vec<f64>,
+    /// Energy at each instant (exact for the discrete state, see [`State::energy`]).
+    pub energy: Vec<f64>,
+    /// Every bar end, `[bar 0 left, bar 0 right, bar 1 left, ...]`.
+    pub ends: Vec<EndHistory>,
+    /// Every unilateral condition, in model order.
+    pub contacts: Vec<ContactHistory>,
+    /// Snapshots every [`MarchOptions::snapshot_every`] steps (and at `t = 0`).
+    pub snapshots: Vec<Snapshot>,
+    /// Largest penetration over the march (including the initial state).
+    pub max_penetration: f64,
+    /// Smallest contact force over the march (0 if some contact opened; `+inf` without
+    /// unilateral conditions).
+    pub min_contact_force: f64,
+    /// `max_t |E(t) - E(0)| / E(0)` (absolute if `E(0) = 0`).
+    pub energy_drift: f64,
+    /// The state at the end.
+    pub final_state: State,
+}
+
+/// Marches `initial` over `duration` (full steps, then one partial step for the remainder)
+/// and records end histories, contact histories, energy and snapshots.
+///
+/// # Errors
+/// [`VerifyError::InvalidParameter`] if `duration` is negative or not finite.
+pub fn march(
+    initial: &State,
+    duration: f64,
+    options: &MarchOptions,
+) -> Result<Trajectory, VerifyError> {
+    let dt = initial.grid().dt();
+    let total = duration / dt;
+    if !(duration.is_finite() && duration >= 0.0) {
+        return Err(VerifyError::InvalidParameter {
+            what: "march duration",
+            value: duration,
+        });
+    }
+    let full = (total + 1e-9).floor();
+    let rest = total - full;
+    let mut fractions = vec![1.0; full as usize];
+    if rest > 1e-9 {
+        fractions.push(rest);
+    }
+    let model = initial.model().clone();
+    let mut ends: Vec<EndHistory> = (0..model.bars().len())
+        .flat_map(|b| {
+            let id = crate::bar::BarId(b);
+            [id.left(), id.right()]
+        })
+        .map(|end| EndHistory {
+            end,
+            displacement: vec![initial.end_displacement(end)],
+            strain: Vec::with_capacity(fractions.len()),
+        })
+        .collect();
+    let mut contacts: Vec<ContactHistory> = model
+        .conditions()
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.is_unilateral())
+        .map(|(i, _)| ContactHistory {
+            condition: i,
+            gap: vec![initial.gap(i).unwrap_or(0.0)],
+            force: Vec::with_capacity(fractions.len()),
+        })
+        .collect();
+    let e0 = initial.energy();
+    let mut times = vec![0.0];
+    let mut energy = vec![e0];
+    let mut snapshots = Vec::new();
+    if options.snapshot_every > 0 {
+        snapshots.push(initial.snapshot());
+    }
+    let mut max_penetration = initial.penetration();
+    let mut min_contact_force = f64::INFINITY;
+    let mut integrator = Integrator::new(initial.clone(), *options);
+    for (k, &f) in fractions.iter().enumerate() {
+        let summary = integrator.advance_unchecked(f);
+        let state = integrator.state();
+        times.push(summary.time);
+        energy.push(state.energy());
+        for h in ends.iter_mut() {
+            h.displacement.push(state.end_displacement(h.end));
+            h.strain
+                .push(summary.end_strain[h.end.bar.index()][usize::from(h.end.end == End::Right)]);
+        }
+        for h in contacts.iter_mut() {
+            h.gap.push(state.gap(h.condition).unwrap_or(0.0));
+            h.force.push(summary.contact_force[h.condition]);
+        }
+        max_penetration = max_penetration.max(summary.max_penetration);
+        min_contact_force = min_contact_force.min(summary.min_contact_force);
+        if options.snapshot_every > 0 && (k + 1) % options.snapshot_every == 0 {
+            snapshots.push(state.snapshot());
+        }
+    }
+    let scale = if e0 > 0.0 { e0 } else { 1.0 };
+    let energy_drift = energy
+        .iter()
+        .fold(0.0f64, |m, e| m.max((e - e0).abs() / scale));
+    Ok(Trajectory {
+        times,
+        energy,
+        ends,
+        contacts,
+        snapshots,
+        max_penetration,
+        min_contact_force,
+        energy_drift,
+        final_state: integrator.into_state(),
+    })
+}

@@ -1,0 +1,741 @@
+//! Every bad input returns its typed error, carrying the numbers that explain it.
+
+use nonsmooth_modes::bar::{Bar, EndRef};
+use nonsmooth_modes::bc::{
+    BoundaryCondition, Contact, LinearRows, Quantity, Robin, Signorini, Term,
+};
+use nonsmooth_modes::continuation::{linspace, Sequential, SequentialOptions};
+use nonsmooth_modes::linalg::DenseMatrix;
+use nonsmooth_modes::modal::{
+    backbone, branch_seed, grazing_energy, natural_frequencies, BackboneOptions, ContactState,
+    PeriodGrid,
+};
+use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::solve::{
+    Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton,
+};
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::{ContinuationError, Error, ModelError, SettingsError, SolveError};
+use std::f64::consts::PI;
+
+const BAD: [f64; 6] = [0.0, -1.0, -0.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY];
+
+/// `value` as reported: the same number, or NaN for NaN.
+fn same(reported: f64, given: f64) -> bool {
+    reported == given && reported.is_sign_negative() == given.is_sign_negative()
+        || (reported.is_nan() && given.is_nan())
+}
+
+fn assert_not_positive(result: Result<impl std::fmt::Debug, ModelError>, what: &str, value: f64) {
+    match result {
+        Err(ModelError::NotPositive { what: w, value: v }) => {
+            assert_eq!(w, what);
+            assert!(same(v, value), "{what}: reported {v}, given {value}");
+        }
+        other => panic!("{what} = {value}: expected NotPositive, got {other:?}"),
+    }
+}
+
+fn clamped() -> BarSystem {
+    clamped_bar_with_obstacle(1e-3).unwrap()
+}
+
+fn linear_only() -> BarSystem {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.dirichlet(bar.left()).neumann(bar.right());
+    b.build().unwrap()
+}
+
+#[test]
+fn bad_bars() {
+    for v in BAD {
+        assert_not_positive(Bar::new(v, 1.0, 1.0), "bar length", v);
+        assert_not_positive(Bar::new(1.0, v, 1.0), "bar wave speed", v);
+        assert_not_positive(Bar::new(1.0, 1.0, v), "bar axial stiffness", v);
+    }
+    // The first bad value is reported.
+    assert_not_positive(Bar::new(-2.0, f64::NAN, 0.0), "bar length", -2.0);
+    assert!(Bar::new(f64::MIN_POSITIVE, f64::MAX, 1e-300).is_ok());
+}
+
+#[test]
+fn bad_condition_parameters() {
+    let mut b = AssemblyBuilder::new();
+    let one = b.add_bar(Bar::unit());
+    let two = b.add_bar(Bar::unit());
+    for v in BAD {
+        assert_not_positive(Signorini::new(one.right(), v), "Signorini gap", v);
+        assert_not_positive(Contact::new(one.right(), two.right(), v), "contact gap", v);
+        assert_not_positive(Robin::new(one.left(), v), "Robin spring stiffness", v);
+        let mut b = AssemblyBuilder::new();
+        let bar = b.add_bar(Bar::unit());
+        assert_not_positive(b.signorini(bar.right(), v).map(|_| ()), "Signorini gap", v);
+        assert_not_positive(
+            b.robin(bar.left(), v).map(|_| ()),
+            "Robin spring stiffness",
+            v,
+        );
+        assert_not_positive(
+            b.contact(bar.left(), bar.right(), v).map(|_| ()),
+            "contact gap",
+            v,
+        );
+    }
+}
+
+#[test]
+fn assembly_errors_name_the_end_or_condition() {
+    assert_eq!(
+        AssemblyBuilder::new().build().unwrap_err(),
+        ModelError::NoBars
+    );
+
+    // An end without a condition.
+    let mut b = AssemblyBuilder::new();
+    let one = b.add_bar(Bar::unit());
+    let two = b.add_bar(Bar::unit());
+    b.dirichlet(one.left())
+        .dirichlet(one.right())
+        .neumann(two.right());
+    assert_eq!(
+        b.build().unwrap_err(),
+        ModelError::UnconstrainedEnd { end: two.left() }
+    );
+    let message = b.build().unwrap_err().to_string();
+    assert!(message.contains("left (x = 0) of bar 1"), "{message}");
+
+    // An end with two conditions, named in order.
+    b.neumann(two.left()).signorini(two.left(), 0.1).unwrap();
+    match b.build().unwrap_err() {
+        ModelError::OverconstrainedEnd { end, first, second } => {
+            assert_eq!(end, two.left());
+            assert!(first.starts_with("Neumann"), "{first}");
+            assert!(second.starts_with("Signorini"), "{second}");
+        }
+        other => panic!("expected OverconstrainedEnd, got {other:?}"),
+    }
+
+    // A contact of an end with itself.
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.dirichlet(bar.left())
+        .contact(bar.right(), bar.right(), 0.1)
+        .unwrap();
+    assert!(matches!(
+        b.build(),
+        Err(ModelError::RepeatedEnd { end, .. }) if end == bar.right()
+    ));
+}
+
+#[test]
+fn unknown_bar_from_another_builder() {
+    let mut other = AssemblyBuilder::new();
+    other.add_bar(Bar::unit());
+    other.add_bar(Bar::unit());
+    let foreign = other.add_bar(Bar::unit());
+    assert_eq!(foreign.index(), 2);
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.dirichlet(bar.left())
+        .neumann(bar.right())
+        .dirichlet(foreign.left());
+    match b.build().unwrap_err() {
+        ModelError::UnknownBar {
+            condition,
+            bar,
+            bars,
+        } => {
+            assert_eq!((bar, bars), (2, 1));
+            assert!(condition.starts_with("Dirichlet"), "{condition}");
+        }
+        other => panic!("expected UnknownBar, got {other:?}"),
+    }
+}
+
+/// A condition that gives `rows` linear rows on `ends.len()` ends.
+#[derive(Debug)]
+struct Miscounted {
+    ends: Vec<EndRef>,
+    rows: usize,
+}
+
+impl BoundaryCondition for Miscounted {
+    fn name(&self) -> String {
+        "miscounted".into()
+    }
+    fn ends(&self) -> Vec<EndRef> {
+        self.ends.clone()
+    }
+    fn linear_rows(&self, _: f64, _: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
+        for _ in 0..self.rows {
+            rows.push(&[Term::new(self.ends[0], Quantity::Displacement, 1.0)]);
+        }
+    }
+}
+
+#[test]
+fn wrong_equation_count() {
+    for (ends, rows) in [(1, 0), (1, 2), (2, 1), (2, 3)] {
+        let mut b = AssemblyBuilder::new();
+        let bar = b.add_bar(Bar::unit());
+        let all = [bar.left(), bar.right()];
+        b.add_condition(Miscounted {
+            ends: all[..ends].to_vec(),
+            rows,
+        });
+        if ends == 1 {
+            b.neumann(bar.right());
+        }
+        assert_eq!(
+            b.build().unwrap_err(),
+            ModelError::EquationCount {
+                condition: "miscounted".into(),
+                ends,
+                rows,
+                laws: 0,
+            }
+        );
+    }
+}
+
+#[test]
+fn bad_harmonic_balance_settings() {
+    let system = clamped();
+    let err = |settings| NonsmoothSystem::new(&system, settings).unwrap_err();
+    let zero = HarmonicBalance {
+        harmonics: 0,
+        ..Default::default()
+    };
+    assert_eq!(err(zero), Error::Settings(SettingsError::ZeroHarmonics));
+    for n_h in [0, 1, 2] {
+        let s = HarmonicBalance {
+            samples_per_harmonic: n_h,
+            ..Default::default()
+        };
+        assert_eq!(
+            err(s),
+            Error::Settings(SettingsError::TooFewSamples { got: n_h, min: 3 })
+        );
+    }
+    assert!(NonsmoothSystem::new(
+        &system,
+        HarmonicBalance {
+            samples_per_harmonic: 3,
+            ..Default::default()
+        }
+    )
+    .is_ok());
+    for v in BAD {
+        match err(HarmonicBalance {
+            penalty: v,
+            ..Default::default()
+        }) {
+            Error::Settings(SettingsError::NotPositive { what, value }) => {
+                assert_eq!(what, "complementarity penalty a_c");
+                assert!(same(value, v));
+            }
+            other => panic!("penalty {v}: {other:?}"),
+        }
+    }
+    // Errors reach backbone unchanged.
+    assert_eq!(
+        backbone(
+            &system,
+            zero,
+            &BackboneOptions::default(),
+            SemismoothNewton::default()
+        )
+        .unwrap_err(),
+        Error::Settings(SettingsError::ZeroHarmonics)
+    );
+}
+
+#[test]
+fn system_without_contact() {
+    let system = linear_only();
+    assert_eq!(system.contact_count(), 0);
+    assert_eq!(
+        NonsmoothSystem::new(&system, HarmonicBalance::default()).unwrap_err(),
+        Error::Settings(SettingsError::NoContact)
+    );
+    assert_eq!(
+        grazing_energy(&system).unwrap_err(),
+        SettingsError::NoContact
+    );
+    assert_eq!(
+        backbone(
+            &system,
+            HarmonicBalance::default(),
+            &BackboneOptions::default(),
+            SemismoothNewton::default()
+        )
+        .unwrap_err(),
+        Error::Settings(SettingsError::NoContact)
+    );
+    // Linear modes of a linear system are fine.
+    let modes = natural_frequencies(&system, ContactState::Open, 5.0).unwrap();
+    assert_eq!(modes.len(), 2);
+}
+
+#[test]
+fn bad_modes_and_subharmonics() {
+    let system = clamped();
+    let settings = HarmonicBalance {
+        harmonics: 5,
+        ..Default::default()
+    };
+    let run = |mode, subharmonic| {
+        let options = BackboneOptions {
+            mode,
+            subharmonic,
+            ..Default::default()
+        };
+        backbone(&system, settings, &options, SemismoothNewton::default()).unwrap_err()
+    };
+    assert_eq!(
+        run(0, 1),
+        Error::Settings(SettingsError::ZeroIndex {
+            what: "mode number",
+            value: 0
+        })
+    );
+    assert_eq!(
+        run(1, 0),
+        Error::Settings(SettingsError::ZeroIndex {
+            what: "subharmonic order",
+            value: 0
+        })
+    );
+    assert_eq!(
+        run(1, 6),
+        Error::Settings(SettingsError::HarmonicOutOfRange {
+            subharmonic: 6,
+            harmonics: 5
+        })
+    );
+    let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+    for v in BAD {
+        match branch_seed(&mut problem, 1, 1, v).unwrap_err() {
+            Error::Settings(SettingsError::NotPositive { what, value }) => {
+                assert_eq!(what, "fundamental frequency");
+                assert!(same(value, v));
+            }
+            other => panic!("omega {v}: {other:?}"),
+        }
+    }
+    // A valid seed has no NaN and a subharmonic seed lives on its harmonic only.
+    let seed = branch_seed(&mut problem, 1, 5, 2.0 * PI / 3.9).unwrap();
+    assert!(seed.iter().all(|v| v.is_finite()));
+    for (i, v) in seed.iter().enumerate() {
+        assert_eq!(*v != 0.0, i / 2 == 5 && *v != 0.0, "entry {i}");
+    }
+    assert!(seed[problem.index(5, 0, 1)] != 0.0);
+    for v in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        match natural_frequencies(&system, ContactState::Open, v).unwrap_err() {
+            SettingsError::NotPositive { what, value } => {
+                assert_eq!(what, "upper frequency");
+                assert!(same(value, v));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
+
+/// The clamped system frozen at `T = 3.6`.
+fn frozen(
+    problem: &mut NonsmoothSystem,
+) -> nonsmooth_modes::continuation::AtParameter<'_, NonsmoothSystem> {
+    nonsmooth_modes::continuation::AtParameter {
+        problem,
+        lambda: 2.0 * PI / 3.6,
+    }
+}
+
+#[test]
+fn solver_input_errors() {
+    let settings = HarmonicBalance {
+        harmonics: 6,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(&clamped(), settings).unwrap();
+    let n = problem.dimension();
+    let solvers: [&dyn NonlinearSolver; 2] = [&SemismoothNewton::default(), &Dogleg::default()];
+    for solver in solvers {
+        let mut x = vec![0.0; n];
+        x[3] = f64::NAN;
+        assert_eq!(
+            solver.solve(&mut frozen(&mut problem), &mut x).unwrap_err(),
+            SolveError::NonFinite {
+                what: "initial guess",
+                iteration: 0
+            }
+        );
+        x[3] = f64::INFINITY;
+        assert!(matches!(
+            solver.solve(&mut frozen(&mut problem), &mut x),
+            Err(SolveError::NonFinite {
+                what: "initial guess",
+                ..
+            })
+        ));
+        for len in [0, n - 1, n + 1] {
+            let mut x = vec![0.0; len];
+            assert_eq!(
+                solver.solve(&mut frozen(&mut problem), &mut x).unwrap_err(),
+                SolveError::Dimension {
+                    got: len,
+                    expected: n
+                }
+            );
+        }
+    }
+}
+
+#[test]
+fn iteration_budget() {
+    let settings = HarmonicBalance {
+        harmonics: 6,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(&clamped(), settings).unwrap();
+    let omega = 2.0 * PI / 3.6;
+    // A poor start: the seed of the branch blown up five times, with every harmonic excited.
+    let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+    let start: Vec<f64> = seed
+        .iter()
+        .enumerate()
+        .map(|(i, s)| 5.0 * s + 1e-3 * ((i % 5) as f64 - 2.0))
+        .collect();
+    let tolerance = 1e-9 * 1e-3;
+    let newton = SemismoothNewton::new(NewtonOptions {
+        max_iterations: 1,
+        ..Default::default()
+    })
+    .unwrap();
+    let dogleg = Dogleg::new(DoglegOptions {
+        max_iterations: 1,
+        ..Default::default()
+    })
+    .unwrap();
+    let solvers: [&dyn NonlinearSolver; 2] = [&newton, &dogleg];
+    for solver in solvers {
+        let mut x = start.clone();
+        match solver.solve(&mut frozen(&mut problem), &mut x).unwrap_err() {
+            SolveError::MaxIterations {
+                iterations,
+                residual_norm,
+                tolerance: tol,
+            } => {
+                assert_eq!(iterations, 1);
+                assert!((tol / tolerance - 1.0).abs() < 1e-12, "tolerance {tol:e}");
+                assert!(residual_norm.is_finite() && residual_norm > tol);
+            }
+            other => panic!("expected MaxIterations, got {other:?}"),
+        }
+        // The last iterate is returned, finite.
+        assert!(x.iter().all(|v| v.is_finite()));
+        assert_ne!(x, start);
+    }
+    // With the default budget the same start converges (to a finite solution).
+    let mut x = start.clone();
+    let info = SemismoothNewton::default()
+        .solve(&mut frozen(&mut problem), &mut x)
+        .unwrap();
+    assert!(info.residual_norm <= tolerance && info.residual_norm.is_finite());
+    assert!(x.iter().all(|v| v.is_finite()));
+}
+
+/// `F(x) = x - 1` with a zero Jacobian.
+struct ZeroJacobian;
+
+impl Problem for ZeroJacobian {
+    fn dimension(&self) -> usize {
+        3
+    }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        for (fi, xi) in f.iter_mut().zip(x) {
+            *fi = xi - 1.0;
+        }
+    }
+    fn jacobian(&mut self, _: &[f64], jac: &mut DenseMatrix) {
+        jac.reset(3, 3);
+    }
+}
+
+/// `F(x) = x` with a NaN in the Jacobian.
+struct NanJacobian;
+
+impl Problem for NanJacobian {
+    fn dimension(&self) -> usize {
+        2
+    }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        f.copy_from_slice(x);
+    }
+    fn jacobian(&mut self, _: &[f64], jac: &mut DenseMatrix) {
+        jac.reset(2, 2);
+        jac[(0, 0)] = f64::NAN;
+        jac[(1, 1)] = 1.0;
+    }
+}
+
+#[test]
+fn singular_jacobian() {
+    let solvers: [&dyn NonlinearSolver; 2] = [&SemismoothNewton::default(), &Dogleg::default()];
+    for solver in solvers {
+        let mut x = vec![0.0; 3];
+        match solver.solve(&mut ZeroJacobian, &mut x).unwrap_err() {
+            SolveError::SingularJacobian {
+                iteration,
+                pivot,
+                ratio,
+            } => {
+                assert_eq!(iteration, 0);
+                assert!(pivot < 3);
+                assert_eq!(ratio, 0.0);
+            }
+            other => panic!("expected SingularJacobian, got {other:?}"),
+        }
+    }
+}
+
+/// A NaN in the Jacobian is reported as such by both solvers (the residual is finite).
+#[test]
+fn non_finite_jacobian() {
+    let solvers: [(&str, &dyn NonlinearSolver); 2] = [
+        ("newton", &SemismoothNewton::default()),
+        ("dogleg", &Dogleg::default()),
+    ];
+    for (name, solver) in solvers {
+        let mut x = vec![1.0, 1.0];
+        assert_eq!(
+            solver.solve(&mut NanJacobian, &mut x).unwrap_err(),
+            SolveError::NonFinite {
+                what: "Jacobian",
+                iteration: 0
+            },
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn invalid_solver_options() {
+    for v in BAD {
+        let check = |r: Result<(), SolveError>, what: &str| match r {
+            Err(SolveError::InvalidOption { what: w, value }) => {
+                assert_eq!(w, what);
+                assert!(same(value, v));
+            }
+            other => panic!("{what} = {v}: {other:?}"),
+        };
+        let o = NewtonOptions::default();
+        check(
+            SemismoothNewton::new(NewtonOptions { tolerance: v, ..o }).map(|_| ()),
+            "tolerance",
+        );
+        check(
+            SemismoothNewton::new(NewtonOptions { armijo: v, ..o }).map(|_| ()),
+            "armijo",
+        );
+        check(
+            SemismoothNewton::new(NewtonOptions { min_step: v, ..o }).map(|_| ()),
+            "min_step",
+        );
+        let o = DoglegOptions::default();
+        check(
+            Dogleg::new(DoglegOptions { tolerance: v, ..o }).map(|_| ()),
+            "tolerance",
+        );
+        check(
+            Dogleg::new(DoglegOptions {
+                initial_radius: v,
+                ..o
+            })
+            .map(|_| ()),
+            "initial_radius",
+        );
+        check(
+            Dogleg::new(DoglegOptions { min_radius: v, ..o }).map(|_| ()),
+            "min_radius",
+        );
+    }
+    assert!(SemismoothNewton::new(NewtonOptions::default()).is_ok());
+    assert!(Dogleg::new(DoglegOptions::default()).is_ok());
+}
+
+type Driver = Sequential<NonsmoothSystem, SemismoothNewton>;
+
+#[test]
+fn bad_continuation_ranges() {
+    let invalid = |r: Result<Vec<f64>, ContinuationError>, what: &str, value: f64| match r {
+        Err(ContinuationError::InvalidOption { what: w, value: v }) => {
+            assert_eq!(w, what);
+            assert!(same(v, value), "{what}: {v} vs {value}");
+        }
+        other => panic!("{what}: {other:?}"),
+    };
+    for steps in [0, 1] {
+        invalid(
+            linspace(3.9, 3.1, steps),
+            "steps (at least 2)",
+            steps as f64,
+        );
+    }
+    for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        invalid(linspace(v, 3.1, 10), "range end", v);
+        invalid(linspace(3.9, v, 10), "range end", v);
+    }
+    let values = linspace(3.9, 3.1, 5).unwrap();
+    assert_eq!(values.len(), 5);
+    assert!(values.iter().all(|v| v.is_finite()));
+
+    let settings = HarmonicBalance {
+        harmonics: 4,
+        ..Default::default()
+    };
+    let problem = || NonsmoothSystem::new(&clamped(), settings).unwrap();
+    let n = problem().dimension();
+    let new = |start: Vec<f64>, values: Vec<f64>| {
+        Driver::new(
+            problem(),
+            SemismoothNewton::default(),
+            start,
+            values,
+            SequentialOptions::default(),
+        )
+        .map(|_| ())
+    };
+    assert_eq!(
+        new(vec![0.0; n], vec![]).unwrap_err(),
+        ContinuationError::InvalidOption {
+            what: "number of parameter values",
+            value: 0.0
+        }
+    );
+    match new(vec![0.0; n], vec![1.0, f64::NAN]).unwrap_err() {
+        ContinuationError::InvalidOption { what, value } => {
+            assert_eq!(what, "parameter value");
+            assert!(value.is_nan());
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        new(vec![0.0; n + 2], vec![1.6]).unwrap_err(),
+        ContinuationError::Dimension {
+            got: n + 2,
+            expected: n
+        }
+    );
+    assert!(new(vec![0.0; n], vec![1.6]).is_ok());
+}
+
+#[test]
+fn bad_period_grids() {
+    let system = clamped();
+    let settings = HarmonicBalance {
+        harmonics: 4,
+        ..Default::default()
+    };
+    let run = |grid: PeriodGrid, trivial_energy: f64| {
+        let options = BackboneOptions {
+            grid,
+            trivial_energy,
+            ..Default::default()
+        };
+        backbone(&system, settings, &options, SemismoothNewton::default())
+    };
+    for v in BAD {
+        for grid in [
+            PeriodGrid {
+                start: v,
+                end: 3.5,
+                steps: 5,
+            },
+            PeriodGrid {
+                start: 3.9,
+                end: v,
+                steps: 5,
+            },
+        ] {
+            match run(grid, 1e-6).unwrap_err() {
+                Error::Continuation(ContinuationError::InvalidOption { what, value }) => {
+                    assert_eq!(what, "period");
+                    assert!(same(value, v));
+                }
+                other => panic!("grid {grid:?}: {other:?}"),
+            }
+        }
+    }
+    assert_eq!(
+        run(
+            PeriodGrid {
+                start: 3.9,
+                end: 3.5,
+                steps: 1
+            },
+            1e-6
+        )
+        .unwrap_err(),
+        Error::Continuation(ContinuationError::InvalidOption {
+            what: "steps (at least 2)",
+            value: 1.0
+        })
+    );
+    for v in [-1.0, f64::NAN, f64::INFINITY] {
+        match run(
+            PeriodGrid {
+                start: 3.9,
+                end: 3.5,
+                steps: 3,
+            },
+            v,
+        )
+        .unwrap_err()
+        {
+            Error::Continuation(ContinuationError::InvalidOption { what, value }) => {
+                assert_eq!(what, "trivial_energy");
+                assert!(same(value, v));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    // A good grid gives finite results everywhere, converged or not.
+    let points = run(
+        PeriodGrid {
+            start: 3.9,
+            end: 3.5,
+            steps: 5,
+        },
+        1e-6,
+    )
+    .unwrap();
+    assert_eq!(points.len(), 5);
+    for p in &points {
+        assert!(p.period.is_finite() && p.omega.is_finite());
+        assert!(p.energy.is_finite() && p.energy_normalized.is_finite());
+        assert!(p.residual_norm.is_finite());
+        assert!(p.x.iter().all(|v| v.is_finite()));
+    }
+}
+
+/// Errors display their numbers.
+#[test]
+fn error_messages_carry_the_numbers() {
+    let e = Error::from(SolveError::MaxIterations {
+        iterations: 7,
+        residual_norm: 2.5e-3,
+        tolerance: 1e-12,
+    });
+    let s = e.to_string();
+    assert!(
+        s.contains('7') && s.contains("2.5e-3") && s.contains("1e-12"),
+        "{s}"
+    );
+    let e = Error::from(ModelError::NotPositive {
+        what: "bar length",
+        value: -2.0,
+    });
+    assert!(e.to_string().contains("bar length") && e.to_string().contains("-2"));
+}

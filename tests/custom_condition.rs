@@ -1,0 +1,457 @@
+//! Boundary conditions written outside the crate, the way a downstream crate would: a linear
+//! end mass on a spring (with a frequency-dependent row) and a compliant obstacle (a new
+//! nonsmooth law).
+
+use nonsmooth_modes::bar::{Bar, EndRef};
+use nonsmooth_modes::bc::{
+    complementarity, BoundaryCondition, LawValue, LinearRows, Observable, Quantity, Term,
+    UnilateralLaw,
+};
+use nonsmooth_modes::continuation::{
+    ContinuationProblem, PeriodParametrised, Sequential, SequentialOptions,
+};
+use nonsmooth_modes::modal::{
+    backbone, branch_seed, energy, grazing_energy, natural_frequencies, BackboneOptions,
+    ContactState, PeriodGrid,
+};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, clamped_free_frequency, robin_bar_with_obstacle,
+    ROBIN_FREE_FREQUENCIES,
+};
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalance, NonsmoothSystem};
+use std::f64::consts::PI;
+
+const GAP: f64 = 1e-3;
+
+/// A point mass `m` on a ground spring `k_s` at a bar end. Newton's law of the mass,
+/// `m u_tt = -EA p - k_s u`, per harmonic of angular frequency `omega`:
+/// `EA p + (k_s - m omega^2) u = 0`. Written with the compressive force `lambda = -EA u_x`
+/// (`EA p = -n lambda`) to exercise another quantity than the built-in Robin condition.
+#[derive(Debug, Clone, Copy)]
+struct MassOnSpring {
+    end: EndRef,
+    mass: f64,
+    spring: f64,
+    /// Whether the row declares its `omega` derivative (`false` only to show it matters).
+    derivative: bool,
+}
+
+impl BoundaryCondition for MassOnSpring {
+    fn name(&self) -> String {
+        format!(
+            "mass {} on spring {} at {}",
+            self.mass, self.spring, self.end
+        )
+    }
+    fn ends(&self) -> Vec<EndRef> {
+        vec![self.end]
+    }
+    fn linear_rows(&self, omega: f64, _: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
+        let n = self.end.end.normal();
+        rows.push(&[
+            Term::new(self.end, Quantity::ContactForce, -n),
+            Term {
+                end: self.end,
+                quantity: Quantity::Displacement,
+                coefficient: self.spring - self.mass * omega * omega,
+                d_coefficient: if self.derivative {
+                    -2.0 * self.mass * omega
+                } else {
+                    0.0
+                },
+            },
+        ]);
+    }
+    fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
+        // Velocities vanish at t = 0 with the cosine basis: the mass has no kinetic energy.
+        0.5 * self.spring * displacement(self.end).powi(2)
+    }
+}
+
+fn mass_on_spring(mass: f64, spring: f64) -> MassOnSpring {
+    MassOnSpring {
+        end: EndRef {
+            bar: dummy_id(),
+            end: nonsmooth_modes::bar::End::Left,
+        },
+        mass,
+        spring,
+        derivative: true,
+    }
+}
+
+/// Any id: replaced by the builder's own below.
+fn dummy_id() -> nonsmooth_modes::bar::BarId {
+    AssemblyBuilder::new().add_bar(Bar::unit())
+}
+
+/// Unit bar clamped at `x = 0` with `condition` at `x = 1`.
+fn clamped_with(mut condition: MassOnSpring) -> BarSystem {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    condition.end = bar.right();
+    b.dirichlet(bar.left()).add_condition(condition);
+    b.build().unwrap()
+}
+
+/// Unit bar with `condition` at `x = 0` facing an obstacle at `x = 1`.
+fn obstacle_with(mut condition: MassOnSpring) -> BarSystem {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    condition.end = bar.left();
+    b.add_condition(condition)
+        .signorini(bar.right(), GAP)
+        .unwrap();
+    b.build().unwrap()
+}
+
+fn omegas(system: &BarSystem, max: f64) -> Vec<f64> {
+    natural_frequencies(system, ContactState::Open, max)
+        .unwrap()
+        .iter()
+        .map(|m| m.omega)
+        .collect()
+}
+
+/// A clamped bar with a mass `m` at its free end vibrates at `omega tan(omega) = 1/m`: for
+/// `m = 2` the Robin-free frequencies of formulation §8; as `m -> 0`, the clamped-free ones.
+#[test]
+fn end_mass_frequencies() {
+    let got = omegas(&clamped_with(mass_on_spring(2.0, 0.0)), 10.0);
+    assert_eq!(got.len(), 4, "{got:?}");
+    for (g, e) in got.iter().zip(ROBIN_FREE_FREQUENCIES) {
+        assert!((g - e).abs() < 1e-6, "{g} vs {e}");
+    }
+    for mass in [1e-9, 0.0] {
+        let got = omegas(&clamped_with(mass_on_spring(mass, 0.0)), 12.0);
+        assert_eq!(got.len(), 4, "{got:?}");
+        for (i, g) in got.iter().enumerate() {
+            let e = clamped_free_frequency(i + 1, 1.0, 1.0);
+            assert!((g - e).abs() < 1e-7 * e, "mass {mass}: {g} vs {e}");
+        }
+    }
+}
+
+/// Without mass the condition is the Robin condition written another way: the harmonic-balance
+/// system is the paper's Robin-Signorini system, residual, Jacobian and backbone alike.
+#[test]
+fn massless_spring_is_the_robin_condition() {
+    let settings = HarmonicBalance {
+        harmonics: 10,
+        ..Default::default()
+    };
+    let custom = obstacle_with(mass_on_spring(0.0, 0.5));
+    let robin = robin_bar_with_obstacle(0.5, GAP).unwrap();
+    let mut a = NonsmoothSystem::new(&custom, settings).unwrap();
+    let mut b = NonsmoothSystem::new(&robin, settings).unwrap();
+    let omega = 2.0 * PI / 8.0;
+    let seed = branch_seed(&mut b, 1, 1, omega).unwrap();
+    let x: Vec<f64> = seed
+        .iter()
+        .enumerate()
+        .map(|(i, s)| 1.4 * s + 1e-4 * (((i * 5) % 7) as f64 - 3.0))
+        .collect();
+    let n = x.len();
+    let (mut fa, mut fb) = (vec![0.0; n], vec![0.0; n]);
+    a.residual(&x, omega, &mut fa);
+    b.residual(&x, omega, &mut fb);
+    let close = |u: &[f64], v: &[f64]| {
+        let s = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        u.iter().zip(v).all(|(p, q)| (p - q).abs() <= 1e-13 * s)
+    };
+    assert!(close(&fa, &fb), "{fa:?}\n{fb:?}");
+    a.parameter_derivative(&x, omega, &mut fa);
+    b.parameter_derivative(&x, omega, &mut fb);
+    assert!(close(&fa, &fb));
+
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: 9.5,
+            end: 7.0,
+            steps: 11,
+        },
+        ..Default::default()
+    };
+    let pa = backbone(&custom, settings, &options, SemismoothNewton::default()).unwrap();
+    let pb = backbone(&robin, settings, &options, SemismoothNewton::default()).unwrap();
+    assert!(pb.iter().filter(|p| p.converged).count() >= 9);
+    for (p, q) in pa.iter().zip(&pb) {
+        assert_eq!(p.converged, q.converged);
+        // Same E/E_g: the spring's stored energy counts in both.
+        assert!(
+            (p.energy_normalized / q.energy_normalized - 1.0).abs() < 1e-9,
+            "T {}",
+            p.period
+        );
+        assert!(close(&p.x, &q.x));
+    }
+}
+
+/// The mass row depends on `omega`; its declared derivative reaches `dF/dOmega`, which matches
+/// a central difference (and does not without it).
+#[test]
+fn mass_row_derivative_reaches_the_system() {
+    let settings = HarmonicBalance {
+        harmonics: 8,
+        ..Default::default()
+    };
+    let omega = 2.0 * PI / 8.0;
+    let mut errors = Vec::new();
+    for derivative in [true, false] {
+        let condition = MassOnSpring {
+            derivative,
+            ..mass_on_spring(0.3, 0.5)
+        };
+        let system = obstacle_with(condition);
+        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+        let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+        let x: Vec<f64> = seed
+            .iter()
+            .enumerate()
+            .map(|(i, s)| 1.3 * s + 1e-4 * ((i % 3) as f64 - 1.0))
+            .collect();
+        let n = x.len();
+        let h = 1e-6 * omega;
+        let (mut fp, mut fm, mut df) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        problem.residual(&x, omega + h, &mut fp);
+        problem.residual(&x, omega - h, &mut fm);
+        problem.parameter_derivative(&x, omega, &mut df);
+        let scale = df.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let error = df
+            .iter()
+            .zip(fp.iter().zip(&fm))
+            .map(|(d, (p, m))| (d - (p - m) / (2.0 * h)).abs())
+            .fold(0.0, f64::max)
+            / scale;
+        errors.push(error);
+    }
+    assert!(
+        errors[0] < 1e-6,
+        "with the derivative: relative error {:e}",
+        errors[0]
+    );
+    assert!(
+        errors[1] > 1e-3,
+        "without the derivative the check must fail: {:e}",
+        errors[1]
+    );
+}
+
+/// A compliant obstacle: the end meets a spring of stiffness `k_c` at gap `g0`, so the force
+/// is `lambda = k_c max(0, -g)`. Equivalently, Signorini holds between `lambda` and the gap of
+/// the spring's free end `g + lambda / k_c`, so the law reuses the crate's complementarity
+/// function (and tends to the rigid obstacle as `k_c -> infinity`). A new nonsmooth law in a
+/// few lines. `penalty_form` uses `r = lambda - k_c max(0, -g)` instead.
+#[derive(Debug, Clone, Copy)]
+struct CompliantObstacle {
+    end: EndRef,
+    gap: f64,
+    stiffness: f64,
+    penalty_form: bool,
+}
+
+impl BoundaryCondition for CompliantObstacle {
+    fn name(&self) -> String {
+        format!(
+            "compliant obstacle (gap {}, stiffness {}) at {}",
+            self.gap, self.stiffness, self.end
+        )
+    }
+    fn ends(&self) -> Vec<EndRef> {
+        vec![self.end]
+    }
+    fn unilateral(&self) -> Option<&dyn UnilateralLaw> {
+        Some(self)
+    }
+    fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
+        let penetration = (self.end.end.normal() * displacement(self.end) - self.gap).max(0.0);
+        0.5 * self.stiffness * penetration * penetration
+    }
+}
+
+impl UnilateralLaw for CompliantObstacle {
+    fn gap(&self) -> Observable {
+        Observable {
+            offset: self.gap,
+            terms: vec![Term::new(self.end, Quantity::OutwardDisplacement, -1.0)],
+        }
+    }
+    fn force(&self) -> Observable {
+        Observable {
+            offset: 0.0,
+            terms: vec![Term::new(self.end, Quantity::ContactForce, 1.0)],
+        }
+    }
+    fn residual(&self, gap: f64, force: f64, penalty: f64) -> LawValue {
+        if self.penalty_form {
+            let d_gap = if gap < 0.0 { self.stiffness } else { 0.0 };
+            return LawValue {
+                value: force - self.stiffness * (-gap).max(0.0),
+                d_gap,
+                d_force: 1.0,
+            };
+        }
+        let v = complementarity(gap + force / self.stiffness, force, penalty);
+        LawValue {
+            d_force: v.d_force + v.d_gap / self.stiffness,
+            ..v
+        }
+    }
+}
+
+fn compliant_system(stiffness: f64, penalty_form: bool) -> BarSystem {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.dirichlet(bar.left()).add_condition(CompliantObstacle {
+        end: bar.right(),
+        gap: GAP,
+        stiffness,
+        penalty_form,
+    });
+    b.build().unwrap()
+}
+
+/// A backbone of the clamped bar against a compliant obstacle, driven with the public
+/// continuation API: the first open mode scaled to penetrate by half the gap (a grazing seed
+/// would be a solution of the open, linear system and fall to rest), continued in the period.
+/// Returns `(period, converged, E / E_g)`.
+fn compliant_backbone(
+    stiffness: f64,
+    settings: HarmonicBalance,
+    periods: &[f64],
+    seed_scale: f64,
+) -> Vec<(f64, bool, f64)> {
+    let system = compliant_system(stiffness, false);
+    // The open linear mode is the rigid obstacle's; `grazing_energy` of the compliant system
+    // would evaluate the (non-quadratic) spring energy on unit-sized mode shapes.
+    let (e_g, _) = grazing_energy(&clamped_bar_with_obstacle(GAP).unwrap()).unwrap();
+    let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+    let basis = problem.basis().clone();
+    let seed = branch_seed(&mut problem, 1, 1, 2.0 * PI / periods[0]).unwrap();
+    let start: Vec<f64> = seed.iter().map(|s| seed_scale * s).collect();
+    let (accept_system, accept_basis) = (system.clone(), basis.clone());
+    let driver = Sequential::new(
+        PeriodParametrised(problem),
+        SemismoothNewton::default(),
+        start,
+        periods.to_vec(),
+        SequentialOptions::default(),
+    )
+    .unwrap()
+    .with_acceptance(move |x, t| {
+        energy(&accept_system, &accept_basis, x, 2.0 * PI / t) > 1e-6 * e_g
+    });
+    driver
+        .map(|p| {
+            (
+                p.lambda,
+                p.converged,
+                energy(&system, &basis, &p.x, 2.0 * PI / p.lambda) / e_g,
+            )
+        })
+        .collect()
+}
+
+/// The compliant obstacle's backbone converges (from the sixth period on at least: the first
+/// periods, barely in contact, may fail from the crude seed), and its energy approaches the
+/// rigid obstacle's as the stiffness grows. Measured `E/E_g` at `T = 3.6`, m = 20: 2.381,
+/// 2.606, 3.226, 3.394 for `k_c = 1e2 .. 1e5`, rigid 3.415.
+#[test]
+fn compliant_obstacle_tends_to_the_rigid_one() {
+    let settings = HarmonicBalance {
+        harmonics: 20,
+        ..Default::default()
+    };
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.6,
+        steps: 8,
+    };
+    let periods: Vec<f64> = (0..grid.steps)
+        .map(|i| grid.start - 0.05 * i as f64)
+        .collect();
+    let rigid = backbone(
+        &clamped_bar_with_obstacle(GAP).unwrap(),
+        settings,
+        &BackboneOptions {
+            grid,
+            ..Default::default()
+        },
+        SemismoothNewton::default(),
+    )
+    .unwrap();
+    let reference = rigid.last().unwrap();
+    assert!(reference.converged);
+    assert!((reference.period - periods[7]).abs() < 1e-12);
+    let mut previous = f64::INFINITY;
+    for stiffness in [1e2, 1e3, 1e4, 1e5] {
+        let points = compliant_backbone(stiffness, settings, &periods, 1.1);
+        let converged = points.iter().filter(|p| p.1).count();
+        let (period, ok, e) = *points.last().unwrap();
+        let difference = (e / reference.energy_normalized - 1.0).abs();
+        println!(
+            "k_c = {stiffness}: {converged}/{} converged, E/E_g at T = {period} is {e:.5} (rigid {:.5}, difference {difference:.3e})",
+            points.len(), reference.energy_normalized
+        );
+        assert!(ok, "k_c = {stiffness}: last period did not converge");
+        assert!(
+            points[5..].iter().all(|p| p.1),
+            "k_c = {stiffness}: {points:?}"
+        );
+        assert!(
+            difference < previous,
+            "k_c = {stiffness}: difference {difference:e} did not shrink"
+        );
+        previous = difference;
+    }
+    assert!(
+        previous < 0.01,
+        "stiffest obstacle: difference {previous:e}"
+    );
+}
+
+/// A custom law whose generalised gradient has both a gap and a force part at the same
+/// instant (the built-in law never has): the assembled Jacobian still matches central
+/// differences, for both forms of the compliant law.
+#[test]
+fn custom_law_jacobian_matches_finite_differences() {
+    use nonsmooth_modes::linalg::DenseMatrix;
+    let settings = HarmonicBalance {
+        harmonics: 6,
+        ..Default::default()
+    };
+    let omega = 2.0 * PI / 3.7;
+    for penalty_form in [false, true] {
+        let system = compliant_system(50.0, penalty_form);
+        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+        let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+        let x: Vec<f64> = seed
+            .iter()
+            .enumerate()
+            .map(|(i, s)| 1.6 * s + 2e-4 * (((i * 3) % 5) as f64 - 2.0))
+            .collect();
+        let n = x.len();
+        let mut jac = DenseMatrix::zeros(n, n);
+        problem.jacobian(&x, omega, &mut jac);
+        let h = 1e-9;
+        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+        let mut worst = 0.0_f64;
+        for j in 0..n {
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[j] += h;
+            xm[j] -= h;
+            problem.residual(&xp, omega, &mut fp);
+            problem.residual(&xm, omega, &mut fm);
+            let col = jac.column(j);
+            let scale = col.iter().fold(1e-12_f64, |m, v| m.max(v.abs()));
+            for (a, (p, m)) in col.iter().zip(fp.iter().zip(&fm)) {
+                worst = worst.max((a - (p - m) / (2.0 * h)).abs() / scale);
+            }
+        }
+        assert!(
+            worst < 1e-5,
+            "penalty form {penalty_form}: worst relative error {worst:e}"
+        );
+    }
+}

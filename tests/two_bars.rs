@@ -1,0 +1,156 @@
+//! Two identical bars in contact against one bar and an obstacle at half the gap, and the
+//! degenerate harmonics of formulation §5.
+
+use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::modal::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use std::f64::consts::PI;
+
+const GAP: f64 = 1e-3;
+
+/// Relative distance of two vectors (`inf` norms).
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    let d = a
+        .iter()
+        .zip(b)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    let s = a.iter().chain(b).fold(0.0_f64, |m, x| m.max(x.abs()));
+    d / s.max(f64::MIN_POSITIVE)
+}
+
+/// Unknowns of bar `bar` of a two-bar solution (`(A, B)` of each harmonic).
+fn bar_unknowns(x: &[f64], bar: usize) -> Vec<f64> {
+    x.chunks(4)
+        .flat_map(|c| [c[2 * bar], c[2 * bar + 1]])
+        .collect()
+}
+
+/// Backbones of the two systems on the same grid: two unit bars (gap `g0`, penalty `a_c`)
+/// and one clamped unit bar (gap `g0/2`, penalty `2 a_c`).
+fn pair(
+    harmonics: usize,
+    penalty: f64,
+    grid: PeriodGrid,
+) -> (Vec<BackbonePoint>, Vec<BackbonePoint>) {
+    let options = BackboneOptions {
+        grid,
+        ..Default::default()
+    };
+    let twins = two_bars_in_contact(Bar::unit(), GAP).unwrap();
+    let settings = HarmonicBalance {
+        harmonics,
+        penalty,
+        ..Default::default()
+    };
+    let two = backbone(&twins, settings, &options, SemismoothNewton::default()).unwrap();
+    let single = clamped_bar_with_obstacle(0.5 * GAP).unwrap();
+    let settings = HarmonicBalance {
+        harmonics,
+        penalty: 2.0 * penalty,
+        ..Default::default()
+    };
+    let one = backbone(&single, settings, &options, SemismoothNewton::default()).unwrap();
+    (two, one)
+}
+
+/// Both systems are the same problem: with `v_A = v_B = v` the two-bar gap `g0 - 2v` is twice
+/// the single-bar gap `g0/2 - v`, so `-min(lambda, a_c (g0 - 2v)) = -min(lambda, 2 a_c (g0/2 - v))`.
+/// Truncated solutions depend on `a_c`, so the comparison needs the doubled penalty.
+#[test]
+fn two_identical_bars_move_like_one_bar_against_half_the_gap() {
+    for (harmonics, penalty) in [(10, 4.0), (20, 4.0), (12, 1.5)] {
+        let grid = PeriodGrid {
+            start: 3.95,
+            end: 3.3,
+            steps: 14,
+        };
+        let (two, one) = pair(harmonics, penalty, grid);
+        assert_eq!(two.len(), one.len());
+        let mut compared = 0;
+        for (p2, p1) in two.iter().zip(&one) {
+            assert_eq!(p2.period, p1.period);
+            assert_eq!(
+                p2.converged, p1.converged,
+                "T {}: converged differently",
+                p2.period
+            );
+            if !p1.converged {
+                continue;
+            }
+            let (a, b) = (bar_unknowns(&p2.x, 0), bar_unknowns(&p2.x, 1));
+            assert!(
+                distance(&a, &b) < 1e-9,
+                "T {}: bars A and B differ by {:e}",
+                p2.period,
+                distance(&a, &b)
+            );
+            let d = distance(&a, &p1.x);
+            assert!(d < 1e-9, "m {harmonics}, a_c {penalty}, T {}: two-bar vs single-bar unknowns differ by {d:e}", p2.period);
+            // Twice the bars, twice the energy; E_g doubles too (the twin first mode is double
+            // and the grazing motion of least energy moves both bars by g0/2).
+            assert!((p2.energy / (2.0 * p1.energy) - 1.0).abs() < 1e-8);
+            assert!((p2.energy_normalized / p1.energy_normalized - 1.0).abs() < 1e-8);
+            compared += 1;
+        }
+        assert!(
+            compared >= 10,
+            "m {harmonics}: only {compared} converged periods compared"
+        );
+    }
+}
+
+/// Formulation §5: at `T = 3.2` harmonic 4 of two identical unit bars sits on their common
+/// clamped-free frequency `5 pi / 2`; the linear rows lose rank (the bars can vibrate against
+/// each other without touching), `HarmonicRows::regularise` pins the invisible direction, and
+/// the backbone converges through `T = 3.2` to the single-bar solution.
+#[test]
+fn degenerate_harmonic_of_two_identical_bars() {
+    let twins = two_bars_in_contact(Bar::unit(), GAP).unwrap();
+    let settings = HarmonicBalance {
+        harmonics: 10,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(&twins, settings).unwrap();
+    let omega = 2.0 * PI / 3.2;
+    assert!((4.0 * omega - 2.5 * PI).abs() < 1e-14);
+    let rows = problem.rows_at(omega);
+    let regularised: Vec<usize> = (0..rows.len())
+        .filter(|&h| rows[h].is_regularised())
+        .collect();
+    // Harmonic 4 on 5 pi/2; harmonic 8 is on 5 pi, a clamped-clamped frequency, where the
+    // closed-contact rows are singular but the linear rows (contact open) keep their rank.
+    assert_eq!(regularised, vec![4], "regularised harmonics at T = 3.2");
+    // Away from the degeneracy nothing is regularised.
+    let rows = problem.rows_at(2.0 * PI / 3.23);
+    assert!(rows.iter().all(|r| !r.is_regularised()));
+    // A single bar never loses rank.
+    let mut single =
+        NonsmoothSystem::new(&clamped_bar_with_obstacle(0.5 * GAP).unwrap(), settings).unwrap();
+    assert!(single.rows_at(omega).iter().all(|r| !r.is_regularised()));
+
+    // 3.95 - 15 * 0.05 = 3.2: the grid hits the degenerate period.
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.2,
+        steps: 16,
+    };
+    let (two, one) = pair(10, 4.0, grid);
+    let at = two.last().unwrap();
+    assert!((at.period - 3.2).abs() < 1e-12, "last period {}", at.period);
+    assert!(
+        at.converged,
+        "two bars at T = 3.2: residual {:e}",
+        at.residual_norm
+    );
+    let reference = one.last().unwrap();
+    assert!(reference.converged);
+    let (a, b) = (bar_unknowns(&at.x, 0), bar_unknowns(&at.x, 1));
+    assert!(distance(&a, &b) < 1e-9);
+    assert!(
+        distance(&a, &reference.x) < 1e-9,
+        "distance {:e}",
+        distance(&a, &reference.x)
+    );
+}
