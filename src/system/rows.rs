@@ -169,7 +169,7 @@ impl HarmonicRows {
     /// zero. Returns whether it acted.
     pub fn regularise(&mut self, tolerance: f64) -> bool {
         let (n, r) = (self.unknowns, self.linear_count);
-        if r == 0 {
+        if r == 0 || hadamard_ratio(&self.linear, r, n) > HADAMARD_SCREEN {
             return false;
         }
         let (s, v) = svd_small(&self.linear, r, n);
@@ -217,6 +217,63 @@ impl HarmonicRows {
     }
 }
 
+/// Rows whose Hadamard ratio exceeds this are of full rank: no SVD needed. A rank loss with
+/// relative singular value `s` gives a ratio of order `s^2`, far below it.
+const HADAMARD_SCREEN: f64 = 1e-12;
+
+/// `det(L L^T) / prod |r_i|^2` of the `r x n` row-major rows `L`: 1 for orthogonal rows, 0 for
+/// dependent ones (Hadamard's inequality), by a Cholesky factorisation of the small Gram
+/// matrix. Returns 0 for a zero row or a failed factorisation.
+fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
+    let row = |i: usize| &rows[i * n..(i + 1) * n];
+    let norms: Vec<f64> = (0..r).map(|i| dot(row(i), row(i))).collect();
+    if norms.iter().any(|&v| !(v > 0.0)) {
+        return 0.0;
+    }
+    // Gram matrix of the normalised rows, factorised in place (lower triangle).
+    let mut g = vec![0.0; r * r];
+    for i in 0..r {
+        for j in 0..=i {
+            g[i * r + j] = dot(row(i), row(j)) / (norms[i] * norms[j]).sqrt();
+        }
+    }
+    let mut det = 1.0;
+    for j in 0..r {
+        let mut d = g[j * r + j];
+        for k in 0..j {
+            d -= g[j * r + k] * g[j * r + k];
+        }
+        if !(d > 0.0) {
+            return 0.0;
+        }
+        det *= d;
+        let d = d.sqrt();
+        g[j * r + j] = d;
+        for i in j + 1..r {
+            let mut v = g[i * r + j];
+            for k in 0..j {
+                v -= g[i * r + k] * g[j * r + k];
+            }
+            g[i * r + j] = v / d;
+        }
+    }
+    det
+}
+
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hadamard_ratio_separates_full_rank_from_dependent_rows() {
+        assert!((hadamard_ratio(&[1.0, 0.0, 0.0, 2.0], 2, 2) - 1.0).abs() < 1e-15);
+        assert!(hadamard_ratio(&[1.0, 1.0, 2.0, 2.0 + 1e-9], 2, 2) < 1e-15);
+        assert_eq!(hadamard_ratio(&[1.0, 1.0, 0.0, 0.0], 2, 2), 0.0);
+        let r = hadamard_ratio(&[1.0, 0.0, 1.0, 1.0], 2, 2);
+        assert!((r - 0.5).abs() < 1e-15);
+    }
 }
