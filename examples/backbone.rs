@@ -265,13 +265,17 @@ impl Sink<'_> {
         let Some(settings) = self.verify else {
             return String::new();
         };
-        let report = settings.cosine_basis().map_err(|e| e.to_string()).and_then(|basis| {
-            let options = PeriodicityOptions {
-                adjust_grid: true,
-                ..Default::default()
-            };
-            periodicity_check(system, &basis, &p.x, p.omega, &options).map_err(|e| e.to_string())
-        });
+        let report = settings
+            .cosine_basis()
+            .map_err(|e| e.to_string())
+            .and_then(|basis| {
+                let options = PeriodicityOptions {
+                    adjust_grid: true,
+                    ..Default::default()
+                };
+                periodicity_check(system, &basis, &p.x, p.omega, &options)
+                    .map_err(|e| e.to_string())
+            });
         match report {
             Ok(r) => format!(
                 ",{:.6e},{:.6e},{:.6e}",

@@ -739,3 +739,26 @@ fn error_messages_carry_the_numbers() {
     });
     assert!(e.to_string().contains("bar length") && e.to_string().contains("-2"));
 }
+
+#[test]
+fn kink_blend_must_be_non_negative_and_finite() {
+    let system = nonsmooth_modes::reference::clamped_bar_with_obstacle(1e-3).unwrap();
+    for v in [-1e-4, f64::NAN, f64::INFINITY] {
+        let settings = HarmonicBalance {
+            kink_blend: v,
+            ..Default::default()
+        };
+        match NonsmoothSystem::new(&system, settings) {
+            Err(Error::Settings(SettingsError::NotPositive { what, value })) => {
+                assert_eq!(what, "kink blend (non-negative)");
+                assert!(value.is_nan() || value == v);
+            }
+            other => panic!("kink blend {v}: {other:?}"),
+        }
+    }
+    let exact = HarmonicBalance {
+        kink_blend: 0.0,
+        ..Default::default()
+    };
+    assert!(NonsmoothSystem::new(&system, exact).is_ok());
+}

@@ -56,6 +56,8 @@ fn seed(which: usize, harmonics: usize) -> Vec<f64> {
                 let m = if k % 2 == 0 { 3 } else { 8 };
                 let settings = HarmonicBalance {
                     harmonics: m,
+                    // The exact generalised Jacobian is what is checked here.
+                    kink_blend: 0.0,
                     ..Default::default()
                 };
                 let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
@@ -183,7 +185,7 @@ proptest! {
         perturbation in proptest::collection::vec(-1.0..=1.0_f64, 36),
     ) {
         let (sys, t0, t1) = system(which);
-        let settings = HarmonicBalance { harmonics, ..Default::default() };
+        let settings = HarmonicBalance { harmonics, kink_blend: 0.0, ..Default::default() };
         let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
         let period = t0 + period_fraction * (t1 - t0);
         let omega = 2.0 * PI / period;
@@ -211,7 +213,7 @@ proptest! {
         perturbation in proptest::collection::vec(-1.0..=1.0_f64, 36),
     ) {
         let (sys, t0, t1) = system(which);
-        let settings = HarmonicBalance { harmonics: 8, ..Default::default() };
+        let settings = HarmonicBalance { harmonics: 8, kink_blend: 0.0, ..Default::default() };
         let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
         let period = t0 + period_fraction * (t1 - t0);
         let omega = 2.0 * PI / period;
@@ -274,6 +276,8 @@ fn jacobian_matches_finite_differences_near_converged_points() {
         for harmonics in [3, 8] {
             let settings = HarmonicBalance {
                 harmonics,
+                // The exact generalised Jacobian is what is checked here.
+                kink_blend: 0.0,
                 ..Default::default()
             };
             let options = BackboneOptions {

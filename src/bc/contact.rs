@@ -1,6 +1,9 @@
 //! Two bar ends facing each other.
 
-use super::{BoundaryCondition, LinearRows, Observable, Quantity, Term, UnilateralLaw};
+use super::{
+    smoothed_complementarity, BoundaryCondition, LawValue, LinearRows, Observable, Quantity, Term,
+    UnilateralLaw,
+};
 use crate::bar::EndRef;
 use crate::error::{positive, ModelError};
 
@@ -74,5 +77,8 @@ impl UnilateralLaw for Contact {
             offset: 0.0,
             terms: vec![Term::new(self.first, Quantity::ContactForce, 1.0)],
         }
+    }
+    fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
+        smoothed_complementarity(gap, force, penalty, smoothing)
     }
 }

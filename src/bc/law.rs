@@ -45,6 +45,24 @@ pub fn complementarity(gap: f64, force: f64, penalty: f64) -> LawValue {
     }
 }
 
+/// The smoothed complementarity `r = -min_eps(lambda, a_c g)` with the Chen–Harker–Kanzow–Smale
+/// smoothing `min_eps(a, b) = (a + b - sqrt((a - b)^2 + 4 eps^2)) / 2`: smooth for `eps > 0`,
+/// equal to [`complementarity`] for `eps = 0` (up to the choice at the kink). Solvers use it
+/// for homotopies `eps -> 0` ([`crate::solve::SmoothingHomotopy`]).
+pub fn smoothed_complementarity(gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
+    if smoothing <= 0.0 {
+        return complementarity(gap, force, penalty);
+    }
+    let (a, b) = (force, penalty * gap);
+    let root = ((a - b) * (a - b) + 4.0 * smoothing * smoothing).sqrt();
+    let t = (a - b) / root;
+    LawValue {
+        value: -0.5 * (a + b - root),
+        d_gap: -0.5 * penalty * (1.0 + t),
+        d_force: -0.5 * (1.0 - t),
+    }
+}
+
 /// A nonsmooth law between a gap and a force, enforced in time by harmonic balance.
 ///
 /// The system samples `gap` and `force` on the time grid, evaluates [`UnilateralLaw::residual`]
@@ -62,11 +80,43 @@ pub trait UnilateralLaw: Debug + Send + Sync {
     fn residual(&self, gap: f64, force: f64, penalty: f64) -> LawValue {
         complementarity(gap, force, penalty)
     }
+
+    /// A smoothed version of [`UnilateralLaw::residual`] with smoothing `smoothing >= 0`
+    /// (a force), used by smoothing homotopies; it must equal `residual` at `smoothing = 0`.
+    /// The default ignores the smoothing (a law that overrides `residual` keeps its own
+    /// nonsmooth form); Signorini and contact use [`smoothed_complementarity`].
+    fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
+        let _ = smoothing;
+        self.residual(gap, force, penalty)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn smoothing_tends_to_the_nonsmooth_law_with_consistent_derivatives() {
+        for (g, l) in [(0.3, 0.1), (0.01, 2.0), (-0.2, 0.5), (0.5, -0.3)] {
+            let exact = complementarity(g, l, 4.0);
+            let smooth = smoothed_complementarity(g, l, 4.0, 1e-9);
+            assert!((exact.value - smooth.value).abs() < 1e-8);
+            let eps = 0.05;
+            let v = smoothed_complementarity(g, l, 4.0, eps);
+            let h = 1e-7;
+            let dg = (smoothed_complementarity(g + h, l, 4.0, eps).value
+                - smoothed_complementarity(g - h, l, 4.0, eps).value)
+                / (2.0 * h);
+            let dl = (smoothed_complementarity(g, l + h, 4.0, eps).value
+                - smoothed_complementarity(g, l - h, 4.0, eps).value)
+                / (2.0 * h);
+            assert!((v.d_gap - dg).abs() < 1e-6 && (v.d_force - dl).abs() < 1e-6);
+        }
+        assert_eq!(
+            smoothed_complementarity(0.2, 0.1, 4.0, 0.0),
+            complementarity(0.2, 0.1, 4.0)
+        );
+    }
 
     #[test]
     fn complementarity_zero_exactly_on_the_signorini_graph() {

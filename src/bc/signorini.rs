@@ -1,6 +1,9 @@
 //! An end facing a rigid obstacle.
 
-use super::{BoundaryCondition, Observable, Quantity, Term, UnilateralLaw};
+use super::{
+    smoothed_complementarity, BoundaryCondition, LawValue, Observable, Quantity, Term,
+    UnilateralLaw,
+};
 use crate::bar::EndRef;
 use crate::error::{positive, ModelError};
 
@@ -58,5 +61,8 @@ impl UnilateralLaw for Signorini {
             offset: 0.0,
             terms: vec![Term::new(self.end, Quantity::ContactForce, 1.0)],
         }
+    }
+    fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
+        smoothed_complementarity(gap, force, penalty, smoothing)
     }
 }

@@ -323,6 +323,9 @@ impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
     fn dimension(&self) -> usize {
         self.problem.dimension() + 1
     }
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.problem.set_smoothing(smoothing)
+    }
     fn residual(&mut self, y: &[f64], f: &mut [f64]) {
         let n = self.problem.dimension();
         self.problem.residual(&y[..n], y[n], &mut f[..n]);

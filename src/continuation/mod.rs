@@ -51,6 +51,13 @@ pub trait ContinuationProblem {
         None
     }
 
+    /// Sets the smoothing of the nonsmooth terms (see [`Problem::set_smoothing`]); returns
+    /// whether the problem supports it (`false` by default).
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        let _ = smoothing;
+        false
+    }
+
     /// For nonsmooth problems: the size of the active set of each unilateral law at
     /// `(x, lambda)` (for harmonic balance, the number of time samples in contact). Drivers
     /// report a grazing event when one of these appears or vanishes. `None` by default.
@@ -82,6 +89,9 @@ impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
     fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
         (**self).state_weights(lambda)
     }
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        (**self).set_smoothing(smoothing)
+    }
 }
 
 /// A continuation problem frozen at one parameter value: a [`Problem`] for the solvers.
@@ -96,6 +106,9 @@ pub struct AtParameter<'a, P: ?Sized> {
 impl<P: ContinuationProblem + ?Sized> Problem for AtParameter<'_, P> {
     fn dimension(&self) -> usize {
         self.problem.dimension()
+    }
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.problem.set_smoothing(smoothing)
     }
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
         self.problem.residual(x, self.lambda, f)
@@ -140,6 +153,9 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
     }
     fn state_weights(&mut self, period: f64) -> Option<Vec<f64>> {
         self.0.state_weights(omega_of(period))
+    }
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.0.set_smoothing(smoothing)
     }
 }
 

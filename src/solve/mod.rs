@@ -10,9 +10,11 @@
 //! | [`Dogleg`] | Powell's dogleg between Newton and Cauchy steps | trust region |
 
 mod dogleg;
+mod homotopy;
 mod newton;
 
 pub use dogleg::{Dogleg, DoglegOptions};
+pub use homotopy::SmoothingHomotopy;
 pub use newton::{NewtonOptions, SemismoothNewton};
 
 use crate::error::SolveError;
@@ -29,6 +31,14 @@ pub trait Problem {
 
     /// Writes a generalised Jacobian `J(x)` into `jac` (resized to `n x n` by the callee).
     fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix);
+
+    /// Sets a smoothing `eps >= 0` of the problem's nonsmooth terms (`eps = 0`: the original
+    /// problem) and returns whether the problem supports it; `false` by default. Used by
+    /// [`SmoothingHomotopy`].
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        let _ = smoothing;
+        false
+    }
 
     /// Typical magnitude of the residual's entries (tolerances are relative to it); 1 by
     /// default.

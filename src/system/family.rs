@@ -47,6 +47,7 @@ pub struct ParameterFamily<F> {
     omega: f64,
     current: Option<(f64, Option<NonsmoothSystem>)>,
     dimension: usize,
+    smoothing: f64,
 }
 
 impl<F: SystemFamily> ParameterFamily<F> {
@@ -80,6 +81,7 @@ impl<F: SystemFamily> ParameterFamily<F> {
             family,
             settings,
             omega,
+            smoothing: 0.0,
         })
     }
 
@@ -97,7 +99,11 @@ impl<F: SystemFamily> ParameterFamily<F> {
                 .build(value)
                 .ok()
                 .and_then(|s| NonsmoothSystem::new(&s, self.settings).ok())
-                .filter(|s| s.dimension() == self.dimension);
+                .filter(|s| s.dimension() == self.dimension)
+                .map(|mut s| {
+                    s.set_smoothing(self.smoothing);
+                    s
+                });
             self.current = Some((value, system));
         }
         self.current.as_mut().and_then(|(_, s)| s.as_mut())
@@ -145,6 +151,14 @@ impl<F: SystemFamily> ContinuationProblem for ParameterFamily<F> {
             Some((_, Some(s))) => s.residual_scale(),
             _ => 1.0,
         }
+    }
+
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.smoothing = smoothing.max(0.0);
+        if let Some((_, Some(s))) = &mut self.current {
+            s.set_smoothing(self.smoothing);
+        }
+        true
     }
 
     fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
