@@ -28,11 +28,23 @@
 //! | [`bc::BoundaryCondition`] | trait of all conditions: [`bc::Dirichlet`], [`bc::Neumann`], [`bc::Robin`], [`bc::Signorini`], [`bc::Contact`] |
 //! | [`system::AssemblyBuilder`] → [`system::BarSystem`] | compose and validate |
 //! | [`system::NonsmoothSystem`] | `F(x; Omega)`, Jacobian, `dF/dOmega` for a [`fourier::Basis`] |
-//! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`] |
-//! | [`continuation::ContinuationProblem`], [`continuation::Sequential`] | continuation |
-//! | [`modal::backbone`] | one call: a backbone with `E / E_g` |
-//! | [`reference`] | the paper's systems and exact solutions |
+//! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`], [`solve::SmoothingHomotopy`] |
+//! | [`continuation::ContinuationProblem`] | [`continuation::Sequential`], [`continuation::Arclength`] (with [`continuation::StallEscape`]), [`system::ParameterFamily`] for any system parameter |
+//! | [`modal::backbone()`], [`modal::arclength_backbone`] | one call: a backbone with `E / E_g` |
+//! | [`modal::diagnose`], [`modal::FieldEvaluator`] | residual norm `R^(m)`, penetration, fields, histories of a point |
+//! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |
+//! | [`mod@reference`] | the paper's systems and exact solutions |
+//! | [`io`] | CSV, and JSON with the `serde` feature |
 //! | [`sweep::backbones`] | many backbones at once; in parallel with the `parallel` feature (rayon), results identical to the serial run |
+//!
+//! ## Features
+//!
+//! | feature | adds |
+//! |---|---|
+//! | `parallel` | [`sweep::backbones`] on rayon's thread pool |
+//! | `serde` | `Serialize` on points, branches and diagnostics; `io::to_json` |
+//! | `plot` | the `plot` module: SVG figures |
+//! | `proptest` | the `strategies` module: proptest strategies |
 //!
 //! ## Quick start
 //!

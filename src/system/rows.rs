@@ -227,7 +227,8 @@ const HADAMARD_SCREEN: f64 = 1e-12;
 fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
     let row = |i: usize| &rows[i * n..(i + 1) * n];
     let norms: Vec<f64> = (0..r).map(|i| dot(row(i), row(i))).collect();
-    if norms.iter().any(|&v| !(v > 0.0)) {
+    // `v > 0` fails for zero and NaN alike.
+    if !norms.iter().all(|&v| v > 0.0) {
         return 0.0;
     }
     // Gram matrix of the normalised rows, factorised in place (lower triangle).
@@ -243,7 +244,7 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
         for k in 0..j {
             d -= g[j * r + k] * g[j * r + k];
         }
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return 0.0;
         }
         det *= d;
