@@ -446,19 +446,7 @@ fn run_parameter(
         };
         let e = energy(&system, &basis, &p.x, omega);
         let e_g = grazing_energy(&system).map(|g| g.0).unwrap_or(f64::NAN);
-        let point = BackbonePoint {
-            step: p.step,
-            period: start.period,
-            omega,
-            energy: e,
-            energy_normalized: e / e_g,
-            converged: p.converged,
-            residual_norm: p.residual_norm,
-            iterations: p.iterations,
-            x: p.x.clone(),
-            step_size: p.step_size,
-            events: p.events.clone(),
-        };
+        let point = BackbonePoint::from_point(p, omega, e, e_g);
         sink.row(&system, &point, p.lambda)
     };
     if a.arclength {

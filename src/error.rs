@@ -135,6 +135,18 @@ pub enum SettingsError {
         /// Harmonics of the basis.
         harmonics: usize,
     },
+    /// A natural-frequency scan would need more samples than allowed.
+    #[error(
+        "scanning up to omega = {omega_max} needs {samples} samples, more than the limit {limit}"
+    )]
+    ScanTooLong {
+        /// Upper end of the requested range.
+        omega_max: f64,
+        /// Samples the scan would need.
+        samples: usize,
+        /// The limit.
+        limit: usize,
+    },
     /// No natural frequency of the open-contact system was found in the searched range.
     #[error("no natural frequency number {mode} found below omega = {omega_max}")]
     ModeNotFound {

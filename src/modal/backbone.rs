@@ -97,7 +97,9 @@ pub struct BackbonePoint {
 }
 
 impl BackbonePoint {
-    fn new(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
+    /// The backbone view of a continuation point at fundamental frequency `omega`, with its
+    /// energy `energy` and the grazing energy `e_g` used for normalisation.
+    pub fn from_point(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
         Self {
             step: p.step,
             period: 2.0 * PI / omega,
@@ -174,7 +176,7 @@ pub fn backbone_with<S: NonlinearSolver>(
     });
     driver.run(|p: &Point| {
         let omega = 2.0 * PI / p.lambda;
-        observer(&BackbonePoint::new(
+        observer(&BackbonePoint::from_point(
             p,
             omega,
             energy(system, &basis, &p.x, omega),
@@ -273,7 +275,7 @@ pub fn arclength_backbone<S: NonlinearSolver>(
     let mut driver = driver
         .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
     let mut report = |p: &Point| {
-        observer(&BackbonePoint::new(
+        observer(&BackbonePoint::from_point(
             p,
             p.lambda,
             energy(system, &basis, &p.x, p.lambda),

@@ -64,11 +64,15 @@ fn singularity(system: &BarSystem, omega: f64, state: ContactState) -> f64 {
     s[n - 1] / s[0]
 }
 
+/// Largest number of scan samples of [`natural_frequencies`] (about 1000 modes of one bar).
+pub const MAX_SCAN: usize = 200_000;
+
 /// Natural frequencies in `(0, omega_max]` of the linear system in `state`, ascending, each
 /// refined to about `1e-13` relative, with its mode shapes.
 ///
 /// # Errors
-/// [`SettingsError::NotPositive`] if `omega_max` is not positive and finite.
+/// [`SettingsError::NotPositive`] if `omega_max` is not positive and finite;
+/// [`SettingsError::ScanTooLong`] beyond [`MAX_SCAN`] samples.
 pub fn natural_frequencies(
     system: &BarSystem,
     state: ContactState,
@@ -88,7 +92,15 @@ pub fn natural_frequencies(
         .map(|b| std::f64::consts::PI * b.wave_speed() / b.length())
         .fold(f64::INFINITY, f64::min);
     let h = spacing / 200.0;
-    let steps = (omega_max / h).ceil() as usize + 1;
+    let samples = omega_max / h;
+    if samples > MAX_SCAN as f64 {
+        return Err(SettingsError::ScanTooLong {
+            omega_max,
+            samples: samples.min(usize::MAX as f64) as usize,
+            limit: MAX_SCAN,
+        });
+    }
+    let steps = samples.ceil() as usize + 1;
     let values: Vec<f64> = (0..=steps)
         .map(|i| singularity(system, (i as f64 + 0.5) * h, state))
         .collect();
@@ -160,7 +172,11 @@ fn open_mode(system: &BarSystem, mode: usize) -> Result<LinearMode, SettingsErro
         .fold(f64::INFINITY, f64::min);
     let mut omega_max = base * (mode as f64 + 1.0);
     for _ in 0..6 {
-        let modes = natural_frequencies(system, ContactState::Open, omega_max)?;
+        let modes = match natural_frequencies(system, ContactState::Open, omega_max) {
+            Ok(modes) => modes,
+            Err(SettingsError::ScanTooLong { .. }) => break,
+            Err(e) => return Err(e),
+        };
         if let Some(m) = modes.into_iter().nth(mode - 1) {
             return Ok(m);
         }
