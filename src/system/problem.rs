@@ -288,16 +288,28 @@ impl<B: Basis> NonsmoothSystem<B> {
     }
 
     /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid).
+    ///
+    /// # Panics
+    /// If `l` is not below the number of unilateral conditions or `x` has the wrong length
+    /// ([`crate::modal::law_history`] returns an error instead).
     pub fn gap_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
         self.history(x, omega, l, true)
     }
 
     /// Contact-force samples of law `l` over one period at `omega`.
+    ///
+    /// # Panics
+    /// If `l` is not below the number of unilateral conditions or `x` has the wrong length
+    /// ([`crate::modal::law_history`] returns an error instead).
     pub fn force_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
         self.history(x, omega, l, false)
     }
 
     /// Pointwise law residual `r(theta_k)` of law `l` over one period at `omega`.
+    ///
+    /// # Panics
+    /// If `l` is not below the number of unilateral conditions or `x` has the wrong length
+    /// ([`crate::modal::law_history`] returns an error instead).
     pub fn law_residual_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
         let g = self.gap_history(x, omega, l);
         let f = self.force_history(x, omega, l);
