@@ -68,6 +68,11 @@
 //! # Ok::<(), nonsmooth_modes::Error>(())
 //! ```
 
+/// The README's quick start, compiled and run as a doctest so that it cannot rot.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 pub mod bar;
 pub mod bc;
 pub mod bem;
