@@ -149,14 +149,7 @@ impl NonlinearSolver for Dogleg {
                     }
                 }
             }
-            if r <= tol {
-                return Ok(it.info(o.max_iterations, r));
-            }
-            Err(SolveError::MaxIterations {
-                iterations: o.max_iterations,
-                residual_norm: r,
-                tolerance: tol,
-            })
+            it.exhausted(o.max_iterations, r, tol)
         })
     }
 }

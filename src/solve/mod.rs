@@ -230,6 +230,24 @@ impl<'p> Iteration<'p> {
             jacobian_evaluations: self.jacobians,
         }
     }
+
+    /// The outcome once the budget of `iterations` is spent with residual norm `r`.
+    pub fn exhausted(
+        &self,
+        iterations: usize,
+        r: f64,
+        tolerance: f64,
+    ) -> Result<SolveInfo, SolveError> {
+        if r <= tolerance {
+            Ok(self.info(iterations, r))
+        } else {
+            Err(SolveError::MaxIterations {
+                iterations,
+                residual_norm: r,
+                tolerance,
+            })
+        }
+    }
 }
 
 pub(crate) fn check_positive(what: &'static str, value: f64) -> Result<(), SolveError> {
