@@ -557,20 +557,7 @@ fn exact_seeded_point(m: usize, period: f64) -> Res<Option<BackbonePoint>> {
     let mut problem = NonsmoothSystem::new(&system, settings(m))?;
     let omega = 2.0 * PI / period;
     let exact = ClampedFirstMode::new(GAP, period);
-    let mut x = vec![0.0; problem.dimension()];
-    // u(x, t) = sum_j B_j sin(k_j x)/k_j cos(j Omega t) (A_j = 0 by the clamp); take B_j from
-    // whichever of u_j(1) = B_j sinc(k_j) and u_x,j(1) = B_j cos(k_j) is better conditioned.
-    // The constant function of the basis is 1/2, hence the factor 2 on harmonic 0.
-    x[problem.index(0, 0, 1)] = 2.0 * exact.displacement_mean();
-    for j in 1..=m {
-        let k = system.bars()[0].wavenumber(j as f64 * omega);
-        let (s, c) = (k.sin() / k, k.cos());
-        x[problem.index(j, 0, 1)] = if s.abs() > c.abs() {
-            exact.displacement_harmonic(j) / s
-        } else {
-            exact.strain_harmonic(j) / c
-        };
-    }
+    let mut x = exact.unknowns(m);
     let solver = SemismoothNewton::default();
     let mut frozen = AtParameter {
         problem: &mut problem,

@@ -149,6 +149,28 @@ impl ClampedFirstMode {
             * (PI * jf * self.contact_duration() / self.period).sin()
     }
 
+    /// The first `harmonics` harmonics of the exact mode as the unknown vector of
+    /// [`NonsmoothSystem`](crate::system::NonsmoothSystem) for
+    /// [`clamped_bar_with_obstacle`] with the cosine basis: `A_j = 0` (the clamp) and `B_j`
+    /// from `u_j(1) = B_j sin(k_j)/k_j` or `u_x,j(1) = B_j cos(k_j)`, whichever is better
+    /// conditioned (`k_j = 2 pi j / T`). The constant basis function is `1/2`, so harmonic 0
+    /// carries twice the mean. A starting point for Newton and an oracle for tests.
+    pub fn unknowns(&self, harmonics: usize) -> Vec<f64> {
+        let omega = 2.0 * PI / self.period;
+        let mut x = vec![0.0; 2 * (harmonics + 1)];
+        x[1] = 2.0 * self.displacement_mean();
+        for j in 1..=harmonics {
+            let k = j as f64 * omega;
+            let (s, c) = (k.sin() / k, k.cos());
+            x[2 * j + 1] = if s.abs() > c.abs() {
+                self.displacement_harmonic(j) / s
+            } else {
+                self.strain_harmonic(j) / c
+            };
+        }
+        x
+    }
+
     /// Mean of `p(1, t)`: `-(g0/(T-3)) t_c / T`.
     pub fn strain_mean(&self) -> f64 {
         -self.gap / (self.period - 3.0) * self.contact_duration() / self.period

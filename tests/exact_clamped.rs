@@ -300,6 +300,11 @@ fn solved_energy_near_the_exact_mode() {
         let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
         let basis = problem.basis().clone();
         let mut x = exact_unknowns(&mode, m);
+        // The library's construction of the same vector agrees with this independent one.
+        let library = mode.unknowns(m);
+        for (a, b) in x.iter().zip(&library) {
+            assert!((a - b).abs() <= 1e-12 * (a.abs() + b.abs()) + 1e-18);
+        }
         let solver = SemismoothNewton::default();
         let info = solver
             .solve(
