@@ -158,6 +158,17 @@ impl BarSystem {
         &self.bars
     }
 
+    /// The ids of the bars, in the order they were added (bar `i` has index `i`).
+    pub fn bar_ids(&self) -> impl Iterator<Item = BarId> {
+        (0..self.bars.len()).map(BarId)
+    }
+
+    /// The id of bar number `index`, if the system has that many bars (for systems built
+    /// elsewhere, such as the [`crate::reference`] systems).
+    pub fn bar_id(&self, index: usize) -> Option<BarId> {
+        (index < self.bars.len()).then_some(BarId(index))
+    }
+
     /// The bar with id `id`.
     ///
     /// # Panics
@@ -195,6 +206,16 @@ impl BarSystem {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ids_of_a_built_system() {
+        let system = crate::reference::two_bars_in_contact(Bar::unit(), 1e-3).unwrap();
+        let ids: Vec<BarId> = system.bar_ids().collect();
+        assert_eq!(ids.len(), 2);
+        assert_eq!(system.bar_id(1), Some(ids[1]));
+        assert_eq!(system.bar_id(2), None);
+        assert_eq!(system.bar(ids[0]).length(), 1.0);
+    }
 
     #[test]
     fn names_the_offending_end() {
