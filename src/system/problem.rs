@@ -85,6 +85,12 @@ struct Workspace {
 ///
 /// It implements [`ContinuationProblem`] with parameter `Omega`: residual, generalised
 /// Jacobian and `dF/dOmega`, all analytic.
+///
+/// # Panics
+/// The [`ContinuationProblem`] methods panic if `x` (or an output slice) does not have length
+/// [`NonsmoothSystem::dimension`]: a programmer contract, which the solvers and drivers check
+/// before calling them (they return [`SolveError::Dimension`](crate::SolveError::Dimension) /
+/// [`ContinuationError::Dimension`](crate::ContinuationError::Dimension) instead).
 #[derive(Debug, Clone)]
 pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     system: BarSystem,
