@@ -9,7 +9,7 @@ use std::cell::RefCell;
 use std::ops::{Index, IndexMut};
 
 /// A dense, column-major `f64` matrix.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct DenseMatrix {
     nrows: usize,
     ncols: usize,

@@ -22,7 +22,7 @@ pub use sequential::{linspace, Predictor, Sequential, SequentialOptions, StepOut
 
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;
-use crate::solve::Problem;
+use crate::solve::{Problem, SingularStep};
 
 /// A family of square systems `F(x, lambda) = 0` in one scalar parameter.
 pub trait ContinuationProblem {
@@ -48,6 +48,19 @@ pub trait ContinuationProblem {
     /// for their scaled norm; `None` (default) means all weights 1.
     fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
         let _ = lambda;
+        None
+    }
+
+    /// A structured Newton step at parameter `lambda` (see [`Problem::newton_step`]); `None`
+    /// by default.
+    fn newton_step(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        f: &[f64],
+        dx: &mut [f64],
+    ) -> Option<Result<(), SingularStep>> {
+        let _ = (x, lambda, f, dx);
         None
     }
 
@@ -92,6 +105,15 @@ impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
         (**self).set_smoothing(smoothing)
     }
+    fn newton_step(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        f: &[f64],
+        dx: &mut [f64],
+    ) -> Option<Result<(), SingularStep>> {
+        (**self).newton_step(x, lambda, f, dx)
+    }
 }
 
 /// A continuation problem frozen at one parameter value: a [`Problem`] for the solvers.
@@ -109,6 +131,14 @@ impl<P: ContinuationProblem + ?Sized> Problem for AtParameter<'_, P> {
     }
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
         self.problem.set_smoothing(smoothing)
+    }
+    fn newton_step(
+        &mut self,
+        x: &[f64],
+        f: &[f64],
+        dx: &mut [f64],
+    ) -> Option<Result<(), SingularStep>> {
+        self.problem.newton_step(x, self.lambda, f, dx)
     }
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
         self.problem.residual(x, self.lambda, f)
@@ -156,6 +186,15 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
     }
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
         self.0.set_smoothing(smoothing)
+    }
+    fn newton_step(
+        &mut self,
+        x: &[f64],
+        period: f64,
+        f: &[f64],
+        dx: &mut [f64],
+    ) -> Option<Result<(), SingularStep>> {
+        self.0.newton_step(x, omega_of(period), f, dx)
     }
 }
 

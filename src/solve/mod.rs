@@ -40,11 +40,35 @@ pub trait Problem {
         false
     }
 
+    /// A structured Newton step: writes into `dx` the solution of `J(x) dx = -f`, where
+    /// `f = F(x)`, exploiting the problem's structure instead of factorising the dense
+    /// Jacobian. `None` (the default): no structured step, the solver factorises
+    /// [`Problem::jacobian`]; `Some(Err(..))`: the reduced system is singular.
+    fn newton_step(
+        &mut self,
+        x: &[f64],
+        f: &[f64],
+        dx: &mut [f64],
+    ) -> Option<Result<(), SingularStep>> {
+        let _ = (x, f, dx);
+        None
+    }
+
     /// Typical magnitude of the residual's entries (tolerances are relative to it); 1 by
     /// default.
     fn residual_scale(&self) -> f64 {
         1.0
     }
+}
+
+/// A singular (reduced) matrix met by [`Problem::newton_step`]: the smallest pivot of its LU
+/// and its ratio to the largest, as in [`SolveError::SingularJacobian`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SingularStep {
+    /// Index of the smallest pivot.
+    pub pivot: usize,
+    /// `|u_pivot| / max |u_jj|`.
+    pub ratio: f64,
 }
 
 /// What a successful solve did.

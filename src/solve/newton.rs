@@ -81,11 +81,31 @@ impl NonlinearSolver for SemismoothNewton {
                 if r <= tol {
                     return Ok(it.info(iteration, r));
                 }
-                it.factor_jacobian(x, jac, lu, iteration)?;
-                for (d, fi) in dx.iter_mut().zip(f.iter()) {
-                    *d = -fi;
+                match it.problem.newton_step(x, f, dx) {
+                    Some(Ok(())) => {
+                        it.jacobians += 1;
+                        if !dx.iter().all(|v| v.is_finite()) {
+                            return Err(SolveError::NonFinite {
+                                what: "Jacobian",
+                                iteration,
+                            });
+                        }
+                    }
+                    Some(Err(p)) => {
+                        return Err(SolveError::SingularJacobian {
+                            iteration,
+                            pivot: p.pivot,
+                            ratio: p.ratio,
+                        })
+                    }
+                    None => {
+                        it.factor_jacobian(x, jac, lu, iteration)?;
+                        for (d, fi) in dx.iter_mut().zip(f.iter()) {
+                            *d = -fi;
+                        }
+                        lu.solve_in_place(dx);
+                    }
                 }
-                lu.solve_in_place(dx);
                 let mut t = 1.0;
                 loop {
                     for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(dx.iter()) {

@@ -7,6 +7,7 @@
 //!   `dF/dOmega`.
 
 pub mod assembly;
+mod condense;
 pub mod family;
 pub mod problem;
 pub mod rows;

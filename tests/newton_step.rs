@@ -1,0 +1,90 @@
+//! The structured Newton step (linear rows condensed) equals the dense solve of `J dx = -F`.
+
+use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::continuation::ContinuationProblem;
+use nonsmooth_modes::linalg::DenseMatrix;
+use nonsmooth_modes::modal::branch_seed;
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
+};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use std::f64::consts::PI;
+
+/// Gaussian elimination with partial pivoting: the dense reference.
+fn dense_solve(j: &DenseMatrix, f: &[f64]) -> Vec<f64> {
+    let n = f.len();
+    let mut a: Vec<Vec<f64>> = (0..n)
+        .map(|r| (0..n).map(|c| j[(r, c)]).collect())
+        .collect();
+    let mut b: Vec<f64> = f.iter().map(|v| -v).collect();
+    for k in 0..n {
+        let p = (k..n)
+            .max_by(|&x, &y| a[x][k].abs().total_cmp(&a[y][k].abs()))
+            .unwrap();
+        a.swap(k, p);
+        b.swap(k, p);
+        let (pivot_rows, rest) = a.split_at_mut(k + 1);
+        let pivot = &pivot_rows[k];
+        for (offset, row) in rest.iter_mut().enumerate() {
+            let m = row[k] / pivot[k];
+            for (v, p) in row[k..].iter_mut().zip(&pivot[k..]) {
+                *v -= m * p;
+            }
+            b[k + 1 + offset] -= m * b[k];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for k in (0..n).rev() {
+        let s: f64 = (k + 1..n).map(|c| a[k][c] * x[c]).sum();
+        x[k] = (b[k] - s) / a[k][k];
+    }
+    x
+}
+
+fn check(system: &BarSystem, harmonics: usize, period: f64) {
+    let settings = HarmonicBalance {
+        harmonics,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(system, settings).unwrap();
+    let omega = 2.0 * PI / period;
+    let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+    // A point that uses both branches of the law: the seed scaled up, plus a perturbation.
+    let x: Vec<f64> = seed
+        .iter()
+        .enumerate()
+        .map(|(i, s)| 1.7 * s + 2e-5 * (((i * 7) % 11) as f64 - 5.0))
+        .collect();
+    let n = problem.dimension();
+    let mut f = vec![0.0; n];
+    problem.residual(&x, omega, &mut f);
+    let mut jac = DenseMatrix::zeros(n, n);
+    problem.jacobian(&x, omega, &mut jac);
+    let want = dense_solve(&jac, &f);
+    let mut got = vec![0.0; n];
+    problem
+        .newton_step(&x, omega, &f, &mut got)
+        .expect("a structured step")
+        .expect("regular");
+    let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let err = want
+        .iter()
+        .zip(&got)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        err <= 1e-9 * scale,
+        "m {harmonics}, T {period}: {err:e} vs {scale:e}"
+    );
+}
+
+#[test]
+fn structured_step_matches_the_dense_solve() {
+    let clamped = clamped_bar_with_obstacle(1e-3).unwrap();
+    let robin = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let two = two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 1e-3).unwrap();
+    for m in [3, 8, 17] {
+        check(&clamped, m, 3.63);
+        check(&robin, m, 9.1);
+        check(&two, m, 3.71);
+    }
+}
