@@ -334,6 +334,17 @@ impl<B: Basis> NonsmoothSystem<B> {
         self.ws = ws;
     }
 
+    /// The Gram matrices `G(w_gap)` and `G(w_force)` of law `l` (after [`Self::sample_laws`]),
+    /// into the workspace: the two halves of the law's Jacobian block.
+    fn law_grams(&self, ws: &mut Workspace, l: usize) {
+        let n = self.basis.samples();
+        let range = l * n..(l + 1) * n;
+        self.basis
+            .weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
+        self.basis
+            .weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+    }
+
     /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid).
     ///
     /// # Panics
@@ -420,12 +431,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
 
     fn jacobian(&mut self, x: &[f64], omega: f64, jac: &mut DenseMatrix) {
         self.prepare(omega);
-        let (len, n, un, rpc) = (
-            self.basis.len(),
-            self.basis.samples(),
-            self.unknowns,
-            self.linear_count,
-        );
+        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
         jac.reset(self.dimension(), self.dimension());
         for i in 0..len {
             let rows = &self.rows[self.basis.harmonic(i)];
@@ -439,11 +445,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let base = len * rpc;
         let mut ws = std::mem::take(&mut self.ws);
         for l in 0..self.laws {
-            let range = l * n..(l + 1) * n;
-            self.basis
-                .weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
-            self.basis
-                .weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+            self.law_grams(&mut ws, l);
             // Column by column (the matrix is column-major): contiguous writes.
             for i in 0..len {
                 let rows = &self.rows[self.basis.harmonic(i)];
@@ -544,12 +546,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         if self.condensed.iter().any(Option::is_none) {
             return None;
         }
-        let (len, n, un, rpc) = (
-            self.basis.len(),
-            self.basis.samples(),
-            self.unknowns,
-            self.linear_count,
-        );
+        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
         let c = un - rpc;
         let base = len * rpc;
         // Particular part from the linear rows.
@@ -576,11 +573,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         red.gap_p.resize(len, 0.0);
         red.force_p.resize(len, 0.0);
         for l in 0..self.laws {
-            let range = l * n..(l + 1) * n;
-            self.basis
-                .weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
-            self.basis
-                .weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+            self.law_grams(&mut ws, l);
             for i in 0..len {
                 let h = self.basis.harmonic(i);
                 let cd = self.condensed[h]
