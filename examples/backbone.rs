@@ -38,10 +38,10 @@ use nonsmooth_modes::modal::{
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo};
+use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
-use nonsmooth_modes::{ModelError, SolveError};
+use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -354,11 +354,11 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
         error: None,
         progress: a.progress,
     };
-    let solver = DynSolver(if a.dogleg {
+    let solver: Box<dyn NonlinearSolver> = if a.dogleg {
         Box::new(Dogleg::default())
     } else {
         Box::new(SemismoothNewton::default())
-    });
+    };
     if a.parameter != Parameter::Omega {
         run_parameter(a, t0, solver, &mut sink)?;
     } else if a.arclength {
@@ -406,7 +406,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
 fn run_parameter(
     a: &Args,
     period: f64,
-    solver: DynSolver,
+    solver: Box<dyn NonlinearSolver>,
     sink: &mut Sink<'_>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let parameter = a.parameter;
@@ -484,18 +484,6 @@ fn run_parameter(
         driver.run(|p| report(p))?;
     }
     Ok(())
-}
-
-/// Lets a boxed solver stand where a generic one is expected.
-struct DynSolver(Box<dyn NonlinearSolver>);
-
-impl NonlinearSolver for DynSolver {
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
-        self.0.solve(problem, x)
-    }
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
-        self.0.tolerance(problem)
-    }
 }
 
 fn main() -> ExitCode {

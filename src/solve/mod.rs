@@ -99,6 +99,25 @@ pub trait NonlinearSolver {
     fn tolerance(&self, problem: &dyn Problem) -> f64;
 }
 
+impl<S: NonlinearSolver + ?Sized> NonlinearSolver for &S {
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+        (**self).solve(problem, x)
+    }
+    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+        (**self).tolerance(problem)
+    }
+}
+
+/// A boxed solver (`Box<dyn NonlinearSolver>`, chosen at run time) is a solver.
+impl<S: NonlinearSolver + ?Sized> NonlinearSolver for Box<S> {
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+        (**self).solve(problem, x)
+    }
+    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+        (**self).tolerance(problem)
+    }
+}
+
 /// Relative pivot threshold of the LU factorisations.
 pub(crate) const PIVOT_TOLERANCE: f64 = 1e-13;
 
