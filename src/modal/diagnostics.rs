@@ -12,7 +12,7 @@ use crate::modal::backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGri
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
 use crate::solve::NonlinearSolver;
-use crate::system::rows::quantity_weights;
+use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::f64::consts::PI;
 
@@ -125,10 +125,11 @@ pub struct LawHistory {
     pub residual: Vec<f64>,
 }
 
-/// Histories of law `law` over one period on `samples` instants.
+/// Histories of law `law` over one period on `samples` instants, from the same per-harmonic
+/// gap and force rows ([`HarmonicRows`]) as the residual, evaluated at any phase.
 ///
 /// # Errors
-/// [`SettingsError::Length`] if `law` is out of range.
+/// [`SettingsError::Length`] if `law` is out of range or `x` has the wrong length.
 pub fn law_history<B: Basis>(
     problem: &NonsmoothSystem<B>,
     x: &[f64],
@@ -145,35 +146,35 @@ pub fn law_history<B: Basis>(
             expected: laws.len(),
         });
     };
-    let (gap, force) = (law_ref.gap(), law_ref.force());
+    if x.len() != problem.dimension() {
+        return Err(SettingsError::Length {
+            what: "unknown vector",
+            got: x.len(),
+            expected: problem.dimension(),
+        });
+    }
     let basis = problem.basis();
-    let fields = FieldEvaluator::new(system, basis, x, omega);
-    let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
+    let unknowns = system.unknowns_per_harmonic();
+    let rows: Vec<HarmonicRows> = (0..=basis.harmonics())
+        .map(|h| HarmonicRows::new(system, h as f64 * omega))
+        .collect();
+    // Coefficients of the gap and force signals on the basis.
+    let (gap, force): (Vec<f64>, Vec<f64>) = (0..basis.len())
+        .map(|i| {
+            let r = &rows[basis.harmonic(i)];
+            let xi = &x[i * unknowns..(i + 1) * unknowns];
+            (dot(r.gap_row(law), xi), dot(r.force_row(law), xi))
+        })
+        .unzip();
+    let (g0, f0) = (law_ref.gap().offset, law_ref.force().offset);
+    let mut phi = vec![0.0; basis.len()];
     let period = 2.0 * PI / omega;
     let mut h = LawHistory::default();
     for k in 0..samples {
         let t = period * k as f64 / samples as f64;
         basis.functions_at(omega * t, &mut phi);
-        basis.derivatives_at(omega * t, &mut dphi);
-        let value = |o: &crate::bc::Observable| {
-            o.offset
-                + o.terms
-                    .iter()
-                    .map(|term| {
-                        let bar = system.bar(term.end.bar);
-                        let position = match term.end.end {
-                            End::Left => 0.0,
-                            End::Right => bar.length(),
-                        };
-                        let f = fields.with_functions(term.end.bar.index(), position, &phi, &dphi);
-                        let (wu, wp) =
-                            quantity_weights(term.quantity, term.end.end, bar.stiffness());
-                        let p = term.end.end.normal() * f.strain;
-                        term.coefficient * (wu * f.displacement + wp * p)
-                    })
-                    .sum::<f64>()
-        };
-        let (g, l) = (value(&gap), value(&force));
+        let g = g0 + dot(&phi, &gap);
+        let l = f0 + dot(&phi, &force);
         h.time.push(t);
         h.gap.push(g);
         h.force.push(l);
