@@ -316,6 +316,16 @@ struct Bordered<'a, P: ?Sized> {
     tangent: &'a [f64],
     predicted: &'a [f64],
     metric: &'a Metric,
+    scratch: &'a mut BorderScratch,
+}
+
+/// Storage of the bordered Jacobian's blocks, kept by the driver across corrector iterations
+/// and steps.
+#[derive(Debug, Default)]
+struct BorderScratch {
+    /// `dF/dx`.
+    inner: DenseMatrix,
+    /// `dF/dlambda`.
     df: Vec<f64>,
 }
 
@@ -332,12 +342,13 @@ impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
         f[n] =
             self.problem.residual_scale() * self.metric.dot_diff(self.tangent, y, self.predicted);
     }
+    /// `[dF/dx, dF/dlambda; s t^T W]` with `s` the residual scale.
     fn jacobian(&mut self, y: &[f64], jac: &mut DenseMatrix) {
         let n = self.problem.dimension();
-        let mut inner = DenseMatrix::zeros(n, n);
-        self.problem.jacobian(&y[..n], y[n], &mut inner);
-        self.problem
-            .parameter_derivative(&y[..n], y[n], &mut self.df);
+        let BorderScratch { inner, df } = &mut *self.scratch;
+        df.resize(n, 0.0);
+        self.problem.jacobian(&y[..n], y[n], inner);
+        self.problem.parameter_derivative(&y[..n], y[n], df);
         jac.reset(n + 1, n + 1);
         for j in 0..n {
             for i in 0..n {
@@ -346,7 +357,7 @@ impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
         }
         let s = self.problem.residual_scale();
         for i in 0..n {
-            jac[(i, n)] = self.df[i];
+            jac[(i, n)] = df[i];
         }
         for i in 0..=n {
             jac[(n, i)] = s * self.tangent[i] * self.metric.weight(i);
@@ -402,6 +413,7 @@ pub struct Arclength<P, S> {
     history: std::collections::VecDeque<(f64, Vec<f64>)>,
     frontier: Option<(f64, Vec<f64>)>,
     accept: Option<Acceptance>,
+    border: BorderScratch,
 }
 
 /// A test that a converged solution `(x, lambda)` belongs to the branch.
@@ -486,6 +498,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             history: Default::default(),
             frontier: None,
             accept: None,
+            border: BorderScratch::default(),
         };
         driver.tangent = driver
             .tangent_at(&driver.y.clone(), &seed)
@@ -533,22 +546,17 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     /// Unit tangent at `y` oriented along `reference` (`<t, reference>_W > 0`).
     fn tangent_at(&mut self, y: &[f64], reference: &[f64]) -> Option<Vec<f64>> {
         let n = self.problem.dimension();
-        let mut jac = DenseMatrix::zeros(n, n);
-        let mut df = vec![0.0; n];
-        self.problem.jacobian(&y[..n], y[n], &mut jac);
-        self.problem.parameter_derivative(&y[..n], y[n], &mut df);
-        let mut b = DenseMatrix::zeros(n + 1, n + 1);
-        for j in 0..n {
-            for i in 0..n {
-                b[(i, j)] = jac[(i, j)];
-            }
+        // The bordered Jacobian with `reference` as border: its solution for `e_n` is the
+        // tangent (up to scale) oriented along `reference`.
+        let mut b = DenseMatrix::default();
+        Bordered {
+            problem: &mut self.problem,
+            tangent: reference,
+            predicted: y,
+            metric: &self.metric,
+            scratch: &mut self.border,
         }
-        for i in 0..n {
-            b[(i, n)] = df[i];
-        }
-        for i in 0..=n {
-            b[(n, i)] = reference[i] * self.metric.weight(i);
-        }
+        .jacobian(y, &mut b);
         let lu = Lu::factor(&b, PIVOT_TOLERANCE).ok()?;
         let mut t = vec![0.0; n + 1];
         t[n] = 1.0;
@@ -630,7 +638,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 tangent: &direction,
                 predicted: &predicted,
                 metric: &self.metric,
-                df: vec![0.0; n],
+                scratch: &mut self.border,
             };
             self.solver.solve(&mut bordered, &mut y)
         };
