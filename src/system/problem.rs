@@ -87,6 +87,11 @@ struct Workspace {
     projection: Vec<f64>,
     gram_gap: Vec<f64>,
     gram_force: Vec<f64>,
+    /// The unknowns the law samples (`values`, `w_gap`, `w_force`) were computed for, at the
+    /// current `Omega`, smoothing and blend; `None` when they are stale. Newton evaluates the
+    /// residual at the accepted point and then its Jacobian there: the second sampling is
+    /// skipped.
+    sampled: Option<Vec<f64>>,
 }
 
 /// A bar system under harmonic balance at a variable fundamental frequency `Omega`.
@@ -196,6 +201,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             projection: vec![0.0; len],
             gram_gap: vec![0.0; len * len],
             gram_force: vec![0.0; len * len],
+            sampled: None,
         };
         Ok(Self {
             system: system.clone(),
@@ -227,6 +233,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             });
         }
         self.kink_blend = blend;
+        self.ws.sampled = None;
         Ok(())
     }
 
@@ -268,6 +275,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         }
         self.omega = omega;
         self.condensed.clear();
+        self.ws.sampled = None;
         // Reuse the outer vector (the rows of each harmonic are rebuilt).
         let system = &self.system;
         self.rows.clear();
@@ -305,6 +313,9 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// Samples gap, force, pointwise residual and its generalised gradient of every law
     /// (law `l` occupies `l * N..(l + 1) * N` of each buffer).
     fn sample_laws(&mut self, x: &[f64]) {
+        if self.ws.sampled.as_deref() == Some(x) {
+            return;
+        }
         let n = self.basis.samples();
         let blend = self.kink_blend * self.residual_scale();
         let mut ws = std::mem::take(&mut self.ws);
@@ -331,6 +342,10 @@ impl<B: Basis> NonsmoothSystem<B> {
                 ws.w_force[k] = v.d_force;
             }
         }
+        let mut sampled = ws.sampled.take().unwrap_or_default();
+        sampled.clear();
+        sampled.extend_from_slice(x);
+        ws.sampled = Some(sampled);
         self.ws = ws;
     }
 
@@ -473,6 +488,8 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let base = len * self.linear_count;
         let mut ws = std::mem::take(&mut self.ws);
         for l in 0..self.laws {
+            // The gap samples are not part of the cached state (only values and weights are
+            // read after sampling), so their buffer serves as scratch here.
             let dg = &mut ws.gap[..n];
             self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
             self.basis.synthesize(&ws.coefficients, dg);
@@ -524,6 +541,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
 
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
         self.smoothing = smoothing.max(0.0);
+        self.ws.sampled = None;
         true
     }
 
