@@ -142,6 +142,12 @@ impl Ctx {
         Ok(())
     }
 
+    /// Writes `stem.svg` and `stem.csv`, the two files of one figure.
+    fn figure(&self, stats: &mut Stats, stem: &str, figure: &Figure, csv: &str) -> Res<()> {
+        self.svg(stats, &format!("{stem}.svg"), figure)?;
+        self.csv(stats, &format!("{stem}.csv"), csv)
+    }
+
     fn csv(&self, stats: &mut Stats, name: &str, text: &str) -> Res<()> {
         std::fs::write(self.path(name), text)?;
         stats.files.push(name.to_string());
@@ -1122,18 +1128,14 @@ fn fig09(ctx: &Ctx) -> Res<Stats> {
         )?);
     }
     stats.note = notes.join("; ");
-    ctx.svg(
+    ctx.figure(
         &mut stats,
-        "fig09_internal_resonances.svg",
+        "fig09_internal_resonances",
         &Figure::new(
             "Fig. 9: internally resonant NSM1 solutions, m = 40",
             2,
             panels,
         ),
-    )?;
-    ctx.csv(
-        &mut stats,
-        "fig09_internal_resonances.csv",
         &backbone_csv(&[&r], w1, Some(&|_: &Run, t: f64| exact_family(1, t))),
     )?;
     Ok(stats)
@@ -1290,14 +1292,10 @@ fn fig12(ctx: &Ctx) -> Res<Stats> {
     mark(&mut bb, "points e, d", &marks);
     let mut all = vec![Panel::Lines(bb)];
     all.extend(panels);
-    ctx.svg(
+    ctx.figure(
         &mut stats,
-        "fig12_robin_nsm2.svg",
+        "fig12_robin_nsm2",
         &Figure::new("Fig. 12: NSM2 of the Robin-Signorini bar", 3, all),
-    )?;
-    ctx.csv(
-        &mut stats,
-        "fig12_robin_nsm2.csv",
         &backbone_csv(&[&r], w1, None),
     )?;
     Ok(stats)
@@ -1378,14 +1376,10 @@ fn fig13(ctx: &Ctx) -> Res<Stats> {
     mark(&mut bb, "points g, f", &marks);
     let mut all = vec![Panel::Lines(bb)];
     all.extend(panels);
-    ctx.svg(
+    ctx.figure(
         &mut stats,
-        "fig13_robin_nsm2_sub3.svg",
+        "fig13_robin_nsm2_sub3",
         &Figure::new("Fig. 13: NSM2 sub3 of the Robin-Signorini bar", 3, all),
-    )?;
-    ctx.csv(
-        &mut stats,
-        "fig13_robin_nsm2_sub3.csv",
         &backbone_csv(&[&r], w1, None),
     )?;
     Ok(stats)
