@@ -5,7 +5,7 @@
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
-//!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--stall-window K] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
@@ -24,6 +24,10 @@
 //! continues in that parameter at the fixed period `--period-start` inside
 //! `--parameter-range` (default: a decade either side), starting from the branch point at that
 //! period (reached by a short sequential run from the system's default start).
+//!
+//! Newton gives up on a step whose residual does not halve within `--stall-window` iterations
+//! (default 5 for sequential runs, `NewtonOptions::fail_fast`; 0 for arclength runs, whose
+//! stall escapes solve from far starts; `--stall-window 0` switches it off).
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
@@ -38,7 +42,7 @@ use nonsmooth_modes::modal::{
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{Dogleg, NewtonOptions, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use nonsmooth_modes::ModelError;
@@ -50,7 +54,7 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
   [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--out FILE] [--method sequential|arclength]
+  [--solver newton|dogleg] [--stall-window K] [--out FILE] [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
   [--progress] [--verify]";
@@ -87,6 +91,7 @@ struct Args {
     period_end: Option<f64>,
     steps: usize,
     dogleg: bool,
+    stall_window: Option<usize>,
     out: Option<String>,
     arclength: bool,
     driver: ArclengthOptions,
@@ -136,6 +141,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         period_end: None,
         steps: 181,
         dogleg: false,
+        stall_window: None,
         out: None,
         arclength: false,
         driver: ArclengthOptions {
@@ -181,6 +187,7 @@ fn parse() -> Result<Args, lexopt::Error> {
                     other => return Err(format!("unknown solver `{other}`").into()),
                 }
             }
+            Long("stall-window") => a.stall_window = Some(parser.value()?.parse()?),
             Long("out") => a.out = Some(parser.value()?.string()?),
             Long("method") => {
                 a.arclength = match parser.value()?.string()?.as_str() {
@@ -357,7 +364,17 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
     let solver: Box<dyn NonlinearSolver> = if a.dogleg {
         Box::new(Dogleg::default())
     } else {
-        Box::new(SemismoothNewton::default())
+        // Sequential steps start from a converged neighbour: give up on stagnation. Arclength's
+        // stall escapes solve from far starts: keep the full budget.
+        let default_window = if a.arclength {
+            0
+        } else {
+            NewtonOptions::fail_fast().stall_window
+        };
+        Box::new(SemismoothNewton::new(NewtonOptions {
+            stall_window: a.stall_window.unwrap_or(default_window),
+            ..NewtonOptions::fail_fast()
+        })?)
     };
     if a.parameter != Parameter::Omega {
         run_parameter(a, t0, solver, &mut sink)?;

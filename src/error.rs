@@ -191,6 +191,19 @@ pub enum SolveError {
         /// Last step length tried.
         step: f64,
     },
+    /// The residual norm stopped decreasing: not below `stall_ratio` times its value `window`
+    /// iterations earlier (see [`NewtonOptions::stall_window`](crate::solve::NewtonOptions)).
+    #[error("stagnated at iteration {iteration}: residual norm {residual_norm:e}, {earlier_residual_norm:e} {window} iterations earlier")]
+    Stagnated {
+        /// Iteration at which it was detected.
+        iteration: usize,
+        /// Residual norm then.
+        residual_norm: f64,
+        /// Residual norm `window` iterations earlier.
+        earlier_residual_norm: f64,
+        /// The window.
+        window: usize,
+    },
     /// The trust region shrank below its minimum radius.
     #[error("trust region collapsed at iteration {iteration}: radius {radius:e}, residual norm {residual_norm:e}")]
     TrustRegion {

@@ -449,6 +449,38 @@ fn iteration_budget() {
     let info = generous.solve(&mut frozen(&mut problem), &mut x).unwrap();
     assert!(info.residual_norm <= tolerance && info.residual_norm.is_finite());
     assert!(x.iter().all(|v| v.is_finite()));
+    // The same poor start under `fail_fast`: its residual does not halve within five
+    // iterations, so the solve stops early with the two norms that show it.
+    let mut x = start.clone();
+    let fast = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
+    match fast.solve(&mut frozen(&mut problem), &mut x).unwrap_err() {
+        SolveError::Stagnated {
+            iteration,
+            residual_norm,
+            earlier_residual_norm,
+            window,
+        } => {
+            assert_eq!(window, 5);
+            assert!(iteration >= 5 && iteration < info.iterations);
+            assert!(residual_norm > 0.5 * earlier_residual_norm);
+            assert!(residual_norm.is_finite() && residual_norm > tolerance);
+        }
+        other => panic!("expected Stagnated, got {other:?}"),
+    }
+    assert!(x.iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn stall_ratio_above_one_is_refused() {
+    let e = SemismoothNewton::new(NewtonOptions {
+        stall_ratio: 1.5,
+        ..NewtonOptions::fail_fast()
+    })
+    .unwrap_err();
+    assert!(
+        matches!(e, SolveError::InvalidOption { value, .. } if value == 1.5),
+        "{e:?}"
+    );
 }
 
 /// `F(x) = x - 1` with a zero Jacobian.
@@ -547,6 +579,14 @@ fn invalid_solver_options() {
         check(
             SemismoothNewton::new(NewtonOptions { min_step: v, ..o }).map(|_| ()),
             "min_step",
+        );
+        check(
+            SemismoothNewton::new(NewtonOptions {
+                stall_ratio: v,
+                ..o
+            })
+            .map(|_| ()),
+            "stall_ratio",
         );
         let o = DoglegOptions::default();
         check(

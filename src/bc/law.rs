@@ -23,6 +23,17 @@ pub struct LawValue {
     pub d_force: f64,
 }
 
+/// Output buffers of [`UnilateralLaw::sample`], one entry per time sample.
+#[derive(Debug)]
+pub struct LawSamples<'a> {
+    /// `r` at each sample.
+    pub values: &'a mut [f64],
+    /// `dr / d gap` at each sample.
+    pub d_gap: &'a mut [f64],
+    /// `dr / d force` at each sample.
+    pub d_force: &'a mut [f64],
+}
+
 /// The Signorini complementarity `g >= 0, lambda >= 0, g lambda = 0` as one equation
 /// (formulation §3): `r = -min(lambda, a_c g)`, `a_c > 0` (the paper's `penalty`, default 4).
 ///
@@ -88,6 +99,37 @@ pub trait UnilateralLaw: Debug + Send + Sync {
     fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
         let _ = smoothing;
         self.residual(gap, force, penalty)
+    }
+
+    /// [`UnilateralLaw::smoothed_residual`] at every sample `(gaps[k], forces[k])` of a time
+    /// grid. The default loops over `smoothed_residual`; being a provided method, the loop is
+    /// compiled for each law type, so the system's sampling makes one dynamic call per law
+    /// instead of one per sample, and the per-sample law can be inlined and vectorised.
+    ///
+    /// # Panics
+    /// If the slices do not all have the same length (a programmer contract of the caller).
+    fn sample(
+        &self,
+        gaps: &[f64],
+        forces: &[f64],
+        penalty: f64,
+        smoothing: f64,
+        out: LawSamples<'_>,
+    ) {
+        let n = gaps.len();
+        assert!(
+            forces.len() == n
+                && out.values.len() == n
+                && out.d_gap.len() == n
+                && out.d_force.len() == n,
+            "law samples of unequal lengths"
+        );
+        for k in 0..n {
+            let v = self.smoothed_residual(gaps[k], forces[k], penalty, smoothing);
+            out.values[k] = v.value;
+            out.d_gap[k] = v.d_gap;
+            out.d_force[k] = v.d_force;
+        }
     }
 }
 

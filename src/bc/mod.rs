@@ -13,7 +13,9 @@ mod linear;
 mod signorini;
 
 pub use contact::Contact;
-pub use law::{complementarity, smoothed_complementarity, LawValue, Observable, UnilateralLaw};
+pub use law::{
+    complementarity, smoothed_complementarity, LawSamples, LawValue, Observable, UnilateralLaw,
+};
 pub use linear::{Dirichlet, Neumann, Robin};
 pub use signorini::Signorini;
 

@@ -206,6 +206,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                             SolveError::LineSearch { iteration, .. }
                             | SolveError::SingularJacobian { iteration, .. }
                             | SolveError::TrustRegion { iteration, .. }
+                            | SolveError::Stagnated { iteration, .. }
                             | SolveError::NonFinite { iteration, .. },
                         ),
                         _,

@@ -9,7 +9,7 @@
 
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
-use crate::linalg::{svd_small, DenseMatrix, Lu};
+use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
 use crate::modal::energy::energy;
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, NonsmoothSystem};
@@ -60,7 +60,8 @@ fn state_matrix(system: &BarSystem, omega: f64, state: ContactState) -> (Vec<f64
 
 fn singularity(system: &BarSystem, omega: f64, state: ContactState) -> f64 {
     let (m, n) = state_matrix(system, omega, state);
-    let (s, _) = svd_small(&m, n, n);
+    let mut s = vec![0.0; n];
+    singular_values_small(&m, n, n, &mut s);
     s[n - 1] / s[0]
 }
 

@@ -14,6 +14,7 @@
 //! (Toeplitz + Hankel for cosines: formulation §6). `dF/dOmega` at fixed `x` comes only through
 //! the wave numbers `k = n Omega / c` in the rows.
 
+use crate::bc::LawSamples;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
@@ -328,18 +329,36 @@ impl<B: Basis> NonsmoothSystem<B> {
             self.observable_coefficients(x, l, false, false, &mut ws.coefficients);
             self.basis
                 .synthesize(&ws.coefficients, &mut ws.force[range.clone()]);
-            for k in range {
+            for k in range.clone() {
                 ws.gap[k] += g0;
                 ws.force[k] += f0;
-                let v = law.smoothed_residual(ws.gap[k], ws.force[k], self.penalty, self.smoothing);
-                ws.values[k] = v.value;
-                let v = if blend > 0.0 && self.smoothing == 0.0 {
-                    law.smoothed_residual(ws.gap[k], ws.force[k], self.penalty, blend)
-                } else {
-                    v
-                };
-                ws.w_gap[k] = v.d_gap;
-                ws.w_force[k] = v.d_force;
+            }
+            let (gaps, forces) = (&ws.gap[range.clone()], &ws.force[range.clone()]);
+            let (w_gap, w_force) = (&mut ws.w_gap[range.clone()], &mut ws.w_force[range.clone()]);
+            law.sample(
+                gaps,
+                forces,
+                self.penalty,
+                self.smoothing,
+                LawSamples {
+                    values: &mut ws.values[range],
+                    d_gap: w_gap,
+                    d_force: w_force,
+                },
+            );
+            if blend > 0.0 && self.smoothing == 0.0 {
+                // Residual exact, Jacobian weights from the blended law.
+                law.sample(
+                    gaps,
+                    forces,
+                    self.penalty,
+                    blend,
+                    LawSamples {
+                        values: &mut ws.scratch,
+                        d_gap: w_gap,
+                        d_force: w_force,
+                    },
+                );
             }
         }
         let mut sampled = ws.sampled.take().unwrap_or_default();
