@@ -10,8 +10,10 @@ use crate::modal::energy::energy;
 use crate::modal::linear::{branch_seed, grazing_energy};
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use std::cell::RefCell;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
+use std::rc::Rc;
 
 /// `steps` equispaced periods from `start` to `end` (both included).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -162,6 +164,9 @@ pub fn backbone_with<S: NonlinearSolver>(
         max_consecutive_failures: options.max_consecutive_failures,
     };
     let floor = options.trivial_energy * e_g;
+    // The acceptance test computes each converged point's energy; the observer reuses it.
+    let last_energy = Rc::new(RefCell::new((Vec::new(), f64::NAN, f64::NAN)));
+    let accepted_energy = Rc::clone(&last_energy);
     let accept_system = system.clone();
     let accept_basis = basis.clone();
     let mut driver = Sequential::new(
@@ -172,16 +177,21 @@ pub fn backbone_with<S: NonlinearSolver>(
         seq_options,
     )?
     .with_acceptance(move |x, period| {
-        energy(&accept_system, &accept_basis, x, 2.0 * PI / period) > floor
+        let e = energy(&accept_system, &accept_basis, x, 2.0 * PI / period);
+        let mut last = accepted_energy.borrow_mut();
+        last.0.clear();
+        last.0.extend_from_slice(x);
+        (last.1, last.2) = (period, e);
+        e > floor
     });
     driver.run(|p: &Point| {
         let omega = 2.0 * PI / p.lambda;
-        observer(&BackbonePoint::from_point(
-            p,
-            omega,
-            energy(system, &basis, &p.x, omega),
-            e_g,
-        ))
+        let known = {
+            let last = last_energy.borrow();
+            (last.1 == p.lambda && last.0 == p.x).then_some(last.2)
+        };
+        let e = known.unwrap_or_else(|| energy(system, &basis, &p.x, omega));
+        observer(&BackbonePoint::from_point(p, omega, e, e_g))
     })?;
     Ok(e_g)
 }
