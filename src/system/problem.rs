@@ -20,8 +20,8 @@ use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::SingularStep;
-use crate::system::condense::{condense, Condensed};
-use crate::system::rows::{dot, HarmonicRows};
+use crate::system::condense::{condense_into, CondenseScratch, Condensed};
+use crate::system::rows::{dot, HarmonicRows, RowsScratch};
 use crate::system::BarSystem;
 
 /// Harmonic-balance settings.
@@ -120,8 +120,13 @@ pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     offsets: Vec<(f64, f64)>,
     omega: f64,
     rows: Vec<HarmonicRows>,
-    /// Null bases and pseudo-inverses of `rows` (empty until a structured step needs them).
-    condensed: Vec<Option<Condensed>>,
+    rows_scratch: RowsScratch,
+    /// Null bases and pseudo-inverses of `rows` (storage kept across frequencies).
+    condensed: Vec<Condensed>,
+    /// Whether `condensed` is up to date (`None`: stale) and every harmonic's rows had full
+    /// rank.
+    condensed_state: Option<bool>,
+    condense_scratch: CondenseScratch,
     reduced: Reduced,
     ws: Workspace,
 }
@@ -216,7 +221,10 @@ impl<B: Basis> NonsmoothSystem<B> {
             offsets,
             omega: f64::NAN,
             rows: Vec::new(),
+            rows_scratch: RowsScratch::default(),
             condensed: Vec::new(),
+            condensed_state: None,
+            condense_scratch: CondenseScratch::default(),
             reduced: Reduced::default(),
             ws,
         })
@@ -275,16 +283,21 @@ impl<B: Basis> NonsmoothSystem<B> {
             return;
         }
         self.omega = omega;
-        self.condensed.clear();
+        self.condensed_state = None;
         self.ws.sampled = None;
-        // Reuse the outer vector (the rows of each harmonic are rebuilt).
-        let system = &self.system;
-        self.rows.clear();
-        self.rows.extend((0..=self.basis.harmonics()).map(|h| {
+        // Rebuild every harmonic's rows in their own storage.
+        let (system, scratch) = (&self.system, &mut self.rows_scratch);
+        let harmonics = self.basis.harmonics() + 1;
+        self.rows.truncate(harmonics);
+        for (h, rows) in self.rows.iter_mut().enumerate() {
+            rows.rebuild(system, h as f64 * omega, scratch);
+            rows.regularise(RANK_TOLERANCE);
+        }
+        for h in self.rows.len()..harmonics {
             let mut rows = HarmonicRows::new(system, h as f64 * omega);
             rows.regularise(RANK_TOLERANCE);
-            rows
-        }));
+            self.rows.push(rows);
+        }
     }
 
     /// Coefficients of the gap (`gap == true`) or force of law `l`, one per basis function.
@@ -577,10 +590,20 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         dx: &mut [f64],
     ) -> Option<Result<(), SingularStep>> {
         self.prepare(omega);
-        if self.condensed.is_empty() {
-            self.condensed = self.rows.iter().map(condense).collect();
+        if self.condensed_state.is_none() {
+            self.condensed
+                .resize_with(self.rows.len(), Condensed::default);
+            let scratch = &mut self.condense_scratch;
+            let all = self
+                .rows
+                .iter()
+                .zip(self.condensed.iter_mut())
+                .fold(true, |ok, (rows, out)| {
+                    condense_into(rows, out, scratch) && ok
+                });
+            self.condensed_state = Some(all);
         }
-        if self.condensed.iter().any(Option::is_none) {
+        if self.condensed_state != Some(true) {
             return None;
         }
         let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
@@ -588,7 +611,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let base = len * rpc;
         // Particular part from the linear rows.
         for i in 0..len {
-            let cd = self.condensed[self.basis.harmonic(i)].as_ref()?;
+            let cd = &self.condensed[self.basis.harmonic(i)];
             let fi = &f[i * rpc..(i + 1) * rpc];
             let dxi = &mut dx[i * un..(i + 1) * un];
             dxi.fill(0.0);
@@ -613,9 +636,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             self.law_grams(&mut ws, l);
             for i in 0..len {
                 let h = self.basis.harmonic(i);
-                let cd = self.condensed[h]
-                    .as_ref()
-                    .expect("every harmonic condensed above");
+                let cd = &self.condensed[h];
                 let rows = &self.rows[h];
                 let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
                 let dxi = &dx[i * un..(i + 1) * un];
@@ -651,9 +672,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         }
         red.lu.solve_in_place(&mut red.rhs);
         for i in 0..len {
-            let cd = self.condensed[self.basis.harmonic(i)]
-                .as_ref()
-                .expect("every harmonic condensed above");
+            let cd = &self.condensed[self.basis.harmonic(i)];
             let dxi = &mut dx[i * un..(i + 1) * un];
             for k in 0..c {
                 let b = red.rhs[i * c + k];

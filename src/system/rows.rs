@@ -6,7 +6,7 @@
 //! `omega`.
 
 use crate::bar::{End, EndRef};
-use crate::bc::{LinearRows, Quantity, Term};
+use crate::bc::{LinearRows, Observable, Quantity, Term};
 use crate::bem::HelmholtzMap;
 use crate::linalg::svd_small;
 use crate::system::BarSystem;
@@ -62,50 +62,112 @@ pub struct HarmonicRows {
     regularised: bool,
 }
 
+/// Inputs of [`HarmonicRows::rebuild`] kept between frequencies: the laws' observables (fixed
+/// for a system) and the per-frequency maps and condition rows, so that rebuilding the rows
+/// of every harmonic at a new `Omega` does not allocate.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RowsScratch {
+    observables: Vec<(Observable, Observable)>,
+    maps: Vec<HelmholtzMap>,
+    rows: LinearRows,
+}
+
+/// Writes `count` dense rows (and their derivatives in `omega`) over `unknowns` Helmholtz
+/// unknowns into `v` and `d`, row `r` from the terms `terms_of(r)`.
+fn fill_dense<'t>(
+    terms_of: impl Iterator<Item = &'t [Term]>,
+    count: usize,
+    unknowns: usize,
+    maps: &[HelmholtzMap],
+    system: &BarSystem,
+    (v, d): (&mut Vec<f64>, &mut Vec<f64>),
+) {
+    v.clear();
+    v.resize(count * unknowns, 0.0);
+    d.clear();
+    d.resize(count * unknowns, 0.0);
+    for (r, terms) in terms_of.enumerate() {
+        let (row, d_row) = (
+            &mut v[r * unknowns..(r + 1) * unknowns],
+            &mut d[r * unknowns..(r + 1) * unknowns],
+        );
+        for t in terms {
+            add_term(t, maps, system.stiffness_at(t.end), row, d_row);
+        }
+    }
+}
+
 impl HarmonicRows {
     /// Rows of `system` for the harmonic of angular frequency `omega` (0 for the constant).
     pub fn new(system: &BarSystem, omega: f64) -> Self {
-        let maps: Vec<HelmholtzMap> = system
-            .bars()
-            .iter()
-            .map(|bar| HelmholtzMap::new(bar, omega))
-            .collect();
+        let mut rows = Self {
+            unknowns: 0,
+            linear_count: 0,
+            linear: Vec::new(),
+            d_linear: Vec::new(),
+            gap: Vec::new(),
+            d_gap: Vec::new(),
+            force: Vec::new(),
+            d_force: Vec::new(),
+            regularised: false,
+        };
+        rows.rebuild(system, omega, &mut RowsScratch::default());
+        rows
+    }
+
+    /// Rebuilds these rows for `system` at `omega` in place (as [`HarmonicRows::new`]),
+    /// reusing their storage and `scratch`.
+    pub(crate) fn rebuild(&mut self, system: &BarSystem, omega: f64, scratch: &mut RowsScratch) {
+        if scratch.observables.len() != system.contact_count() {
+            scratch.observables = system.laws().map(|l| (l.gap(), l.force())).collect();
+        }
+        let RowsScratch {
+            observables,
+            maps,
+            rows,
+        } = scratch;
+        maps.clear();
+        maps.extend(
+            system
+                .bars()
+                .iter()
+                .map(|bar| HelmholtzMap::new(bar, omega)),
+        );
         let unknowns = system.unknowns_per_harmonic();
         let stiffness = |e: EndRef| system.stiffness_at(e);
-        let mut rows = LinearRows::new();
+        rows.clear();
         for condition in system.conditions() {
-            condition.linear_rows(omega, &stiffness, &mut rows);
+            condition.linear_rows(omega, &stiffness, rows);
         }
-        let dense = |terms_of: &mut dyn Iterator<Item = &[Term]>, count: usize| {
-            let mut v = vec![0.0; count * unknowns];
-            let mut d = vec![0.0; count * unknowns];
-            for (r, terms) in terms_of.enumerate() {
-                let (row, d_row) = (
-                    &mut v[r * unknowns..(r + 1) * unknowns],
-                    &mut d[r * unknowns..(r + 1) * unknowns],
-                );
-                for t in terms {
-                    add_term(t, &maps, stiffness(t.end), row, d_row);
-                }
-            }
-            (v, d)
-        };
-        let (linear, d_linear) = dense(&mut (0..rows.len()).map(|i| rows.row(i)), rows.len());
-        let gaps: Vec<_> = system.laws().map(|l| l.gap().terms).collect();
-        let forces: Vec<_> = system.laws().map(|l| l.force().terms).collect();
-        let (gap, d_gap) = dense(&mut gaps.iter().map(|t| t.as_slice()), gaps.len());
-        let (force, d_force) = dense(&mut forces.iter().map(|t| t.as_slice()), forces.len());
-        Self {
+        let count = rows.len();
+        fill_dense(
+            (0..count).map(|i| rows.row(i)),
+            count,
             unknowns,
-            linear_count: rows.len(),
-            linear,
-            d_linear,
-            gap,
-            d_gap,
-            force,
-            d_force,
-            regularised: false,
-        }
+            maps,
+            system,
+            (&mut self.linear, &mut self.d_linear),
+        );
+        let laws = observables.len();
+        fill_dense(
+            observables.iter().map(|(g, _)| g.terms.as_slice()),
+            laws,
+            unknowns,
+            maps,
+            system,
+            (&mut self.gap, &mut self.d_gap),
+        );
+        fill_dense(
+            observables.iter().map(|(_, f)| f.terms.as_slice()),
+            laws,
+            unknowns,
+            maps,
+            system,
+            (&mut self.force, &mut self.d_force),
+        );
+        self.unknowns = unknowns;
+        self.linear_count = count;
+        self.regularised = false;
     }
 
     /// Number of unknowns `2 n_bars`.
