@@ -5,7 +5,7 @@
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
-//!     [--stall-window K] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--newton fail-fast|full] [--no-retry] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
@@ -25,9 +25,11 @@
 //! `--parameter-range` (default: a decade either side), starting from the branch point at that
 //! period (reached by a short sequential run from the system's default start).
 //!
-//! Newton gives up on a step whose residual does not halve within `--stall-window` iterations
-//! (default 5 for sequential runs, `NewtonOptions::fail_fast`; 0 for arclength runs, whose
-//! stall escapes solve from far starts; `--stall-window 0` switches it off).
+//! Newton's budget: `--newton fail-fast` (`NewtonOptions::fail_fast`, the default of sequential
+//! runs: each step starts from a converged neighbour and a failed step is skipped) or
+//! `--newton full` (`NewtonOptions::default`, the default of arclength runs, whose stall
+//! escapes solve from far starts). A failed sequential step is retried from the converged
+//! point before the last one (`SequentialOptions::retry_from_previous`) unless `--no-retry`.
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
@@ -54,7 +56,8 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
   [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--stall-window K] [--out FILE] [--method sequential|arclength]
+  [--solver newton|dogleg] [--newton fail-fast|full] [--no-retry] [--out FILE]
+  [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
   [--progress] [--verify]";
@@ -91,7 +94,9 @@ struct Args {
     period_end: Option<f64>,
     steps: usize,
     dogleg: bool,
-    stall_window: Option<usize>,
+    /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
+    fail_fast: Option<bool>,
+    retry: bool,
     out: Option<String>,
     arclength: bool,
     driver: ArclengthOptions,
@@ -141,7 +146,8 @@ fn parse() -> Result<Args, lexopt::Error> {
         period_end: None,
         steps: 181,
         dogleg: false,
-        stall_window: None,
+        fail_fast: None,
+        retry: true,
         out: None,
         arclength: false,
         driver: ArclengthOptions {
@@ -187,7 +193,14 @@ fn parse() -> Result<Args, lexopt::Error> {
                     other => return Err(format!("unknown solver `{other}`").into()),
                 }
             }
-            Long("stall-window") => a.stall_window = Some(parser.value()?.parse()?),
+            Long("newton") => {
+                a.fail_fast = match parser.value()?.string()?.as_str() {
+                    "fail-fast" => Some(true),
+                    "full" => Some(false),
+                    other => return Err(format!("unknown Newton budget `{other}`").into()),
+                }
+            }
+            Long("no-retry") => a.retry = false,
             Long("out") => a.out = Some(parser.value()?.string()?),
             Long("method") => {
                 a.arclength = match parser.value()?.string()?.as_str() {
@@ -363,18 +376,12 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
     };
     let solver: Box<dyn NonlinearSolver> = if a.dogleg {
         Box::new(Dogleg::default())
+    } else if a.fail_fast.unwrap_or(!a.arclength) {
+        // Sequential steps start from a converged neighbour: give up early.
+        Box::new(SemismoothNewton::new(NewtonOptions::fail_fast())?)
     } else {
-        // Sequential steps start from a converged neighbour: give up on stagnation. Arclength's
-        // stall escapes solve from far starts: keep the full budget.
-        let default_window = if a.arclength {
-            0
-        } else {
-            NewtonOptions::fail_fast().stall_window
-        };
-        Box::new(SemismoothNewton::new(NewtonOptions {
-            stall_window: a.stall_window.unwrap_or(default_window),
-            ..NewtonOptions::fail_fast()
-        })?)
+        // Arclength's stall escapes solve from far starts: the full budget.
+        Box::new(SemismoothNewton::default())
     };
     if a.parameter != Parameter::Omega {
         run_parameter(a, t0, solver, &mut sink)?;
@@ -407,6 +414,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             },
             mode: a.mode,
             subharmonic: a.subharmonic,
+            retry_from_previous: a.retry,
             ..Default::default()
         };
         backbone_with(&system, a.settings, &options, solver, |p| {
@@ -496,7 +504,10 @@ fn run_parameter(
             solver,
             start.x,
             values,
-            SequentialOptions::default(),
+            SequentialOptions {
+                retry_from_previous: a.retry,
+                ..Default::default()
+            },
         )?;
         driver.run(|p| report(p))?;
     }

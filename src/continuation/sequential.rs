@@ -23,6 +23,12 @@ pub struct SequentialOptions {
     /// Stop with [`ContinuationError::Stalled`] after this many consecutive failed steps
     /// (default 40; `usize::MAX` never stops).
     pub max_consecutive_failures: usize,
+    /// When a step fails from the prediction, solve once more from the converged point before
+    /// the last one (default `true`; `false` is the paper's plain sequential continuation). Near an internal resonance the last point can be a
+    /// resonance spike of the truncated system whose neighbourhood holds no solution at the
+    /// next parameter, while the point before it still leads back to the backbone. A
+    /// successful retry drops the spike from the predictor's history.
+    pub retry_from_previous: bool,
 }
 
 impl Default for SequentialOptions {
@@ -30,6 +36,7 @@ impl Default for SequentialOptions {
         Self {
             predictor: Predictor::Constant,
             max_consecutive_failures: 40,
+            retry_from_previous: true,
         }
     }
 }
@@ -48,8 +55,10 @@ pub enum StepOutcome {
 }
 
 /// Sequential continuation over a fixed list of parameter values: at each value, solve
-/// `F(x, lambda) = 0` from the predicted guess. Failed steps are reported and skipped; the
-/// next step starts again from the last converged solution.
+/// `F(x, lambda) = 0` from the predicted guess (and, if that fails and
+/// [`SequentialOptions::retry_from_previous`] is set, from the converged point before the
+/// last). Failed steps are reported and skipped; the next step starts again from the last
+/// converged solution.
 pub struct Sequential<P, S> {
     problem: P,
     solver: S,
@@ -150,6 +159,25 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         self.values[step.saturating_sub(1)]
     }
 
+    /// Solves at `lambda` from `x`; returns the solver's result and whether the acceptance
+    /// test (if any) took the solution.
+    fn attempt(
+        &mut self,
+        lambda: f64,
+        x: &mut [f64],
+    ) -> (Result<crate::solve::SolveInfo, SolveError>, bool) {
+        let mut frozen = AtParameter {
+            problem: &mut self.problem,
+            lambda,
+        };
+        let result = self.solver.solve(&mut frozen, x);
+        let accepted = match (&result, self.accept.as_mut()) {
+            (Ok(_), Some(accept)) => accept(x, lambda),
+            _ => true,
+        };
+        (result, accepted)
+    }
+
     /// Solves at the next parameter value.
     pub fn step(&mut self) -> StepOutcome {
         if self.stalled {
@@ -161,22 +189,24 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         let step = self.next;
         self.next += 1;
         let mut x = self.predict(lambda);
-        let mut frozen = AtParameter {
-            problem: &mut self.problem,
-            lambda,
-        };
-        let result = self.solver.solve(&mut frozen, &mut x);
-        let accepted = match (&result, self.accept.as_mut()) {
-            (Ok(_), Some(accept)) => accept(&x, lambda),
-            _ => true,
-        };
+        let (mut result, mut accepted) = self.attempt(lambda, &mut x);
+        let mut retried = false;
+        if !(result.is_ok() && accepted) && self.options.retry_from_previous {
+            if let Some((previous, _)) = &self.previous {
+                let mut y = previous.clone();
+                let (second, second_accepted) = self.attempt(lambda, &mut y);
+                if second.is_ok() && second_accepted {
+                    (x, result, accepted, retried) = (y, second, true, true);
+                }
+            }
+        }
         match result {
             Ok(info) if accepted => {
                 self.failures = 0;
-                self.previous = Some((
-                    std::mem::replace(&mut self.last, x.clone()),
-                    self.last_lambda,
-                ));
+                let last = std::mem::replace(&mut self.last, x.clone());
+                if !retried {
+                    self.previous = Some((last, self.last_lambda));
+                }
                 self.last_lambda = lambda;
                 StepOutcome::Converged(Point {
                     step,
