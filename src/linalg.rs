@@ -49,7 +49,16 @@ impl DenseMatrix {
         self.data.resize(nrows * ncols, 0.0);
     }
 
-    /// Column `j` as a slice.
+    /// Column `j` as a mutable slice.
+    ///
+    /// # Panics
+    /// If `j >= ncols`.
+    pub fn column_mut(&mut self, j: usize) -> &mut [f64] {
+        let n = self.nrows;
+        &mut self.data[j * n..(j + 1) * n]
+    }
+
+    /// Column `j` as a slice (the storage is column-major).
     pub fn column(&self, j: usize) -> &[f64] {
         &self.data[j * self.nrows..(j + 1) * self.nrows]
     }

@@ -88,3 +88,58 @@ fn structured_step_matches_the_dense_solve() {
         check(&two, m, 3.71);
     }
 }
+
+/// `residual_along` (observables synthesised once per direction, affine in `t`) equals the
+/// residual at `x + t dx`, for cached and fresh directions, and after a change of frequency.
+#[test]
+fn line_search_residual_equals_the_residual_at_the_trial_point() {
+    let systems = [
+        clamped_bar_with_obstacle(1e-3).unwrap(),
+        robin_bar_with_obstacle(0.5, 1e-3).unwrap(),
+        two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 1e-3).unwrap(),
+    ];
+    for system in &systems {
+        let settings = HarmonicBalance {
+            harmonics: 12,
+            ..Default::default()
+        };
+        let mut problem = NonsmoothSystem::new(system, settings).unwrap();
+        let n = problem.dimension();
+        for (period, scale) in [(3.6, 1.7), (3.3, 0.4)] {
+            let omega = 2.0 * PI / period;
+            let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+            let x: Vec<f64> = seed.iter().map(|s| scale * s).collect();
+            let mut f = vec![0.0; n];
+            problem.residual(&x, omega, &mut f);
+            for shift in [0usize, 3] {
+                let dx: Vec<f64> = seed
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| -0.6 * s + 3e-5 * ((((i + shift) * 7) % 11) as f64 - 5.0))
+                    .collect();
+                // The same direction at a second frequency: nothing cached may leak across.
+                for (t, omega) in [1.0, 0.5, 0.125, 1e-3, 0.5].into_iter().zip([
+                    omega,
+                    omega,
+                    omega,
+                    omega,
+                    1.01 * omega,
+                ]) {
+                    let (mut trial, mut along) = (vec![0.0; n], vec![0.0; n]);
+                    problem.residual_along(&x, &dx, t, omega, &mut trial, &mut along);
+                    let point: Vec<f64> = x.iter().zip(&dx).map(|(a, d)| a + t * d).collect();
+                    assert_eq!(trial, point);
+                    let mut direct = vec![0.0; n];
+                    problem.residual(&point, omega, &mut direct);
+                    let scale = direct.iter().fold(1e-3_f64, |m, v| m.max(v.abs()));
+                    for (k, (a, b)) in along.iter().zip(&direct).enumerate() {
+                        assert!(
+                            (a - b).abs() <= 1e-12 * scale,
+                            "T = {period}, t = {t}, entry {k}: {a:e} vs {b:e}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

@@ -35,6 +35,23 @@ pub trait ContinuationProblem {
     /// Generalised Jacobian `dF/dx` into `jac` (resized by the callee).
     fn jacobian(&mut self, x: &[f64], lambda: f64, jac: &mut DenseMatrix);
 
+    /// `x + t dx` into `trial` and `F(x + t dx, lambda)` into `f` (see
+    /// [`Problem::residual_along`]); the default forms the point and calls `residual`.
+    fn residual_along(
+        &mut self,
+        x: &[f64],
+        dx: &[f64],
+        t: f64,
+        lambda: f64,
+        trial: &mut [f64],
+        f: &mut [f64],
+    ) {
+        for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
+            *p = a + t * d;
+        }
+        self.residual(trial, lambda, f);
+    }
+
     /// `dF/dlambda` at fixed `x` into `df`.
     fn parameter_derivative(&mut self, x: &[f64], lambda: f64, df: &mut [f64]);
 
@@ -86,6 +103,17 @@ impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
     }
     fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
         (**self).residual(x, lambda, f)
+    }
+    fn residual_along(
+        &mut self,
+        x: &[f64],
+        dx: &[f64],
+        t: f64,
+        lambda: f64,
+        trial: &mut [f64],
+        f: &mut [f64],
+    ) {
+        (**self).residual_along(x, dx, t, lambda, trial, f)
     }
     fn jacobian(&mut self, x: &[f64], lambda: f64, jac: &mut DenseMatrix) {
         (**self).jacobian(x, lambda, jac)
@@ -143,6 +171,9 @@ impl<P: ContinuationProblem + ?Sized> Problem for AtParameter<'_, P> {
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
         self.problem.residual(x, self.lambda, f)
     }
+    fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
+        self.problem.residual_along(x, dx, t, self.lambda, trial, f)
+    }
     fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
         self.problem.jacobian(x, self.lambda, jac)
     }
@@ -166,6 +197,17 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
     }
     fn residual(&mut self, x: &[f64], period: f64, f: &mut [f64]) {
         self.0.residual(x, omega_of(period), f)
+    }
+    fn residual_along(
+        &mut self,
+        x: &[f64],
+        dx: &[f64],
+        t: f64,
+        period: f64,
+        trial: &mut [f64],
+        f: &mut [f64],
+    ) {
+        self.0.residual_along(x, dx, t, omega_of(period), trial, f)
     }
     fn jacobian(&mut self, x: &[f64], period: f64, jac: &mut DenseMatrix) {
         self.0.jacobian(x, omega_of(period), jac)

@@ -32,6 +32,17 @@ pub trait Problem {
     /// Writes a generalised Jacobian `J(x)` into `jac` (resized to `n x n` by the callee).
     fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix);
 
+    /// A line search's evaluation: writes `x + t dx` into `trial` and `F(x + t dx)` into `f`.
+    /// The default forms the point and calls [`Problem::residual`]; a problem whose residual
+    /// is cheaper along a fixed direction overrides it (harmonic balance: the time samples
+    /// are affine in `t`, so a whole line search needs one synthesis).
+    fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
+        for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
+            *p = a + t * d;
+        }
+        self.residual(trial, f);
+    }
+
     /// Sets a smoothing `eps >= 0` of the problem's nonsmooth terms (`eps = 0`: the original
     /// problem) and returns whether the problem supports it; `false` by default. Used by
     /// [`SmoothingHomotopy`].
@@ -228,6 +239,28 @@ impl<'p> Iteration<'p> {
         iteration: usize,
     ) -> Result<f64, SolveError> {
         self.problem.residual(x, out);
+        self.residuals += 1;
+        let r = norm(out);
+        if r.is_finite() {
+            Ok(r)
+        } else {
+            Err(SolveError::NonFinite {
+                what: "residual",
+                iteration,
+            })
+        }
+    }
+
+    /// [`Problem::residual_along`] with its norm, counted and checked like
+    /// [`Iteration::residual_into`].
+    pub fn residual_along_into(
+        &mut self,
+        (x, dx, t): (&[f64], &[f64], f64),
+        trial: &mut [f64],
+        out: &mut [f64],
+        iteration: usize,
+    ) -> Result<f64, SolveError> {
+        self.problem.residual_along(x, dx, t, trial, out);
         self.residuals += 1;
         let r = norm(out);
         if r.is_finite() {

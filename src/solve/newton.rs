@@ -151,10 +151,7 @@ impl NonlinearSolver for SemismoothNewton {
                 }
                 let mut t = 1.0;
                 loop {
-                    for ((xt, xi), d) in trial.iter_mut().zip(x.iter()).zip(dx.iter()) {
-                        *xt = xi + t * d;
-                    }
-                    let rt = it.residual_into(trial, f_trial, iteration)?;
+                    let rt = it.residual_along_into((x, dx, t), trial, f_trial, iteration)?;
                     if rt * rt <= (1.0 - 2.0 * o.armijo * t) * r * r || rt <= tol {
                         x.copy_from_slice(trial);
                         std::mem::swap(f, f_trial);

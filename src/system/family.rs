@@ -123,6 +123,27 @@ impl<F: SystemFamily> ContinuationProblem for ParameterFamily<F> {
         }
     }
 
+    fn residual_along(
+        &mut self,
+        x: &[f64],
+        dx: &[f64],
+        t: f64,
+        lambda: f64,
+        trial: &mut [f64],
+        f: &mut [f64],
+    ) {
+        let omega = self.omega;
+        match self.system_at(lambda) {
+            Some(s) => s.residual_along(x, dx, t, omega, trial, f),
+            None => {
+                for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
+                    *p = a + t * d;
+                }
+                f.fill(f64::NAN);
+            }
+        }
+    }
+
     fn jacobian(&mut self, x: &[f64], lambda: f64, jac: &mut DenseMatrix) {
         let (omega, n) = (self.omega, self.dimension);
         match self.system_at(lambda) {

@@ -85,14 +85,47 @@ struct Workspace {
     w_gap: Vec<f64>,
     w_force: Vec<f64>,
     scratch: Vec<f64>,
+    /// Samples of `d gap / d Omega` (scratch of `dF/dOmega`).
+    d_samples: Vec<f64>,
     projection: Vec<f64>,
     gram_gap: Vec<f64>,
     gram_force: Vec<f64>,
     /// The unknowns the law samples (`values`, `w_gap`, `w_force`) were computed for, at the
     /// current `Omega`, smoothing and blend; `None` when they are stale. Newton evaluates the
     /// residual at the accepted point and then its Jacobian there: the second sampling is
-    /// skipped.
+    /// skipped. `gap` and `force` hold that point's samples too.
     sampled: Option<Vec<f64>>,
+    along: LineSamples,
+}
+
+/// Samples of a line search `x + t dx` at the current `Omega`: gap, force and linear rows of
+/// `x` and of `dx` (see `residual_along`).
+#[derive(Debug, Clone, Default)]
+struct LineSamples {
+    start: Option<Vec<f64>>,
+    direction: Option<Vec<f64>>,
+    gap: Vec<f64>,
+    force: Vec<f64>,
+    d_gap: Vec<f64>,
+    d_force: Vec<f64>,
+    linear: Vec<f64>,
+    d_linear: Vec<f64>,
+}
+
+impl Workspace {
+    /// Forgets every cached sample (after a change of `Omega`, smoothing or blend).
+    fn invalidate(&mut self) {
+        self.sampled = None;
+        self.along.start = None;
+    }
+}
+
+/// Sets a cache key to a copy of `v`, reusing its storage.
+fn set_key(key: &mut Option<Vec<f64>>, v: &[f64]) {
+    let mut k = key.take().unwrap_or_default();
+    k.clear();
+    k.extend_from_slice(v);
+    *key = Some(k);
 }
 
 /// A bar system under harmonic balance at a variable fundamental frequency `Omega`.
@@ -204,10 +237,18 @@ impl<B: Basis> NonsmoothSystem<B> {
             w_gap: vec![0.0; laws * n],
             w_force: vec![0.0; laws * n],
             scratch: vec![0.0; n],
+            d_samples: vec![0.0; n],
             projection: vec![0.0; len],
             gram_gap: vec![0.0; len * len],
             gram_force: vec![0.0; len * len],
             sampled: None,
+            along: LineSamples {
+                gap: vec![0.0; laws * n],
+                force: vec![0.0; laws * n],
+                d_gap: vec![0.0; laws * n],
+                d_force: vec![0.0; laws * n],
+                ..Default::default()
+            },
         };
         Ok(Self {
             system: system.clone(),
@@ -242,7 +283,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             });
         }
         self.kink_blend = blend;
-        self.ws.sampled = None;
+        self.ws.invalidate();
         Ok(())
     }
 
@@ -284,7 +325,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         }
         self.omega = omega;
         self.condensed_state = None;
-        self.ws.sampled = None;
+        self.ws.invalidate();
         // Rebuild every harmonic's rows in their own storage.
         let (system, scratch) = (&self.system, &mut self.rows_scratch);
         let harmonics = self.basis.harmonics() + 1;
@@ -330,22 +371,44 @@ impl<B: Basis> NonsmoothSystem<B> {
         if self.ws.sampled.as_deref() == Some(x) {
             return;
         }
+        let mut ws = std::mem::take(&mut self.ws);
+        self.synthesize_observables(x, true, &mut ws.coefficients, &mut ws.gap, &mut ws.force);
+        self.evaluate_laws(&mut ws, x);
+        self.ws = ws;
+    }
+
+    /// Time samples of every law's gap and force for the unknowns `x` (with the offsets of
+    /// the observables if `offsets`, else their linear part only, as for a direction).
+    fn synthesize_observables(
+        &self,
+        x: &[f64],
+        offsets: bool,
+        coefficients: &mut [f64],
+        gap: &mut [f64],
+        force: &mut [f64],
+    ) {
+        let n = self.basis.samples();
+        for l in 0..self.laws {
+            let range = l * n..(l + 1) * n;
+            for (is_gap, out) in [(true, &mut gap[range.clone()]), (false, &mut force[range])] {
+                self.observable_coefficients(x, l, is_gap, false, coefficients);
+                self.basis.synthesize(coefficients, out);
+                if offsets {
+                    let (g0, f0) = self.offsets[l];
+                    let offset = if is_gap { g0 } else { f0 };
+                    out.iter_mut().for_each(|v| *v += offset);
+                }
+            }
+        }
+    }
+
+    /// Evaluates every law on the gap and force samples of `ws` (those of the unknowns `x`),
+    /// and marks the samples as those of `x`.
+    fn evaluate_laws(&self, ws: &mut Workspace, x: &[f64]) {
         let n = self.basis.samples();
         let blend = self.kink_blend * self.residual_scale();
-        let mut ws = std::mem::take(&mut self.ws);
         for (l, law) in self.system.laws().enumerate() {
             let range = l * n..(l + 1) * n;
-            let (g0, f0) = self.offsets[l];
-            self.observable_coefficients(x, l, true, false, &mut ws.coefficients);
-            self.basis
-                .synthesize(&ws.coefficients, &mut ws.gap[range.clone()]);
-            self.observable_coefficients(x, l, false, false, &mut ws.coefficients);
-            self.basis
-                .synthesize(&ws.coefficients, &mut ws.force[range.clone()]);
-            for k in range.clone() {
-                ws.gap[k] += g0;
-                ws.force[k] += f0;
-            }
             let (gaps, forces) = (&ws.gap[range.clone()], &ws.force[range.clone()]);
             let (w_gap, w_force) = (&mut ws.w_gap[range.clone()], &mut ws.w_force[range.clone()]);
             law.sample(
@@ -378,7 +441,18 @@ impl<B: Basis> NonsmoothSystem<B> {
         sampled.clear();
         sampled.extend_from_slice(x);
         ws.sampled = Some(sampled);
-        self.ws = ws;
+    }
+
+    /// The law block of `F` from the sampled law values, into `f`.
+    fn project_laws(&self, f: &mut [f64]) {
+        let (len, n) = (self.basis.len(), self.basis.samples());
+        let base = len * self.linear_count;
+        for l in 0..self.laws {
+            self.basis.project(
+                &self.ws.values[l * n..(l + 1) * n],
+                &mut f[base + l * len..base + (l + 1) * len],
+            );
+        }
     }
 
     /// The Gram matrices `G(w_gap)` and `G(w_force)` of law `l` (after [`Self::sample_laws`]),
@@ -465,15 +539,77 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
     fn residual(&mut self, x: &[f64], omega: f64, f: &mut [f64]) {
         self.prepare(omega);
         self.linear_block(x, false, f);
-        let (len, n) = (self.basis.len(), self.basis.samples());
-        let base = len * self.linear_count;
         self.sample_laws(x);
-        for l in 0..self.laws {
-            self.basis.project(
-                &self.ws.values[l * n..(l + 1) * n],
-                &mut f[base + l * len..base + (l + 1) * len],
-            );
+        self.project_laws(f);
+    }
+
+    /// Along a line search the observables are affine in `t`: the samples of `x` (kept from
+    /// its residual) and of `dx` are synthesised once per direction, and each trial costs the
+    /// law evaluation and one projection instead of three transforms.
+    fn residual_along(
+        &mut self,
+        x: &[f64],
+        dx: &[f64],
+        t: f64,
+        omega: f64,
+        trial: &mut [f64],
+        f: &mut [f64],
+    ) {
+        self.prepare(omega);
+        for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
+            *p = a + t * d;
         }
+        let mut ws = std::mem::take(&mut self.ws);
+        let same = |v: &Option<Vec<f64>>, w: &[f64]| v.as_deref() == Some(w);
+        if !(same(&ws.along.start, x) && same(&ws.along.direction, dx)) {
+            let along = &mut ws.along;
+            if same(&ws.sampled, x) {
+                along.gap.clone_from(&ws.gap);
+                along.force.clone_from(&ws.force);
+            } else {
+                self.synthesize_observables(
+                    x,
+                    true,
+                    &mut ws.coefficients,
+                    &mut along.gap,
+                    &mut along.force,
+                );
+            }
+            self.synthesize_observables(
+                dx,
+                false,
+                &mut ws.coefficients,
+                &mut along.d_gap,
+                &mut along.d_force,
+            );
+            along
+                .linear
+                .resize(self.basis.len() * self.linear_count, 0.0);
+            along
+                .d_linear
+                .resize(self.basis.len() * self.linear_count, 0.0);
+            self.linear_block(x, false, &mut along.linear);
+            self.linear_block(dx, false, &mut along.d_linear);
+            set_key(&mut along.start, x);
+            set_key(&mut along.direction, dx);
+        }
+        let along = &ws.along;
+        for (g, (a, d)) in ws.gap.iter_mut().zip(along.gap.iter().zip(&along.d_gap)) {
+            *g = a + t * d;
+        }
+        for (g, (a, d)) in ws
+            .force
+            .iter_mut()
+            .zip(along.force.iter().zip(&along.d_force))
+        {
+            *g = a + t * d;
+        }
+        for (o, (a, d)) in f.iter_mut().zip(along.linear.iter().zip(&along.d_linear)) {
+            *o = a + t * d;
+        }
+        self.evaluate_laws(&mut ws, trial);
+        self.ws = ws;
+        self.project_laws(f);
     }
 
     fn jacobian(&mut self, x: &[f64], omega: f64, jac: &mut DenseMatrix) {
@@ -520,16 +656,17 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let base = len * self.linear_count;
         let mut ws = std::mem::take(&mut self.ws);
         for l in 0..self.laws {
-            // The gap samples are not part of the cached state (only values and weights are
-            // read after sampling), so their buffer serves as scratch here.
-            let dg = &mut ws.gap[..n];
+            let dg = &mut ws.d_samples;
             self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
             self.basis.synthesize(&ws.coefficients, dg);
             self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
             self.basis.synthesize(&ws.coefficients, &mut ws.scratch);
-            for k in 0..n {
-                ws.scratch[k] =
-                    ws.w_gap[l * n + k] * ws.gap[k] + ws.w_force[l * n + k] * ws.scratch[k];
+            let (w_gap, w_force) = (
+                &ws.w_gap[l * n..(l + 1) * n],
+                &ws.w_force[l * n..(l + 1) * n],
+            );
+            for (((s, d), wg), wf) in ws.scratch.iter_mut().zip(dg.iter()).zip(w_gap).zip(w_force) {
+                *s = wg * d + wf * *s;
             }
             self.basis.project(&ws.scratch, &mut ws.projection);
             df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
@@ -573,7 +710,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
 
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
         self.smoothing = smoothing.max(0.0);
-        self.ws.sampled = None;
+        self.ws.invalidate();
         true
     }
 
@@ -650,16 +787,20 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             }
             for j in 0..len {
                 let row = l * len + j;
-                let mut rhs = -f[base + row];
-                for i in 0..len {
-                    let (gg, gf) = (ws.gram_gap[j * len + i], ws.gram_force[j * len + i]);
-                    rhs -= gg * red.gap_p[i] + gf * red.force_p[i];
-                    for k in 0..c {
-                        red.matrix[(row, i * c + k)] =
-                            gg * red.gap_z[i * c + k] + gf * red.force_z[i * c + k];
-                    }
+                let (gg, gf) = (
+                    &ws.gram_gap[j * len..(j + 1) * len],
+                    &ws.gram_force[j * len..(j + 1) * len],
+                );
+                red.rhs[row] = -f[base + row] - dot(gg, &red.gap_p) - dot(gf, &red.force_p);
+            }
+            // Column by column (the matrix is column-major): contiguous writes.
+            for col in 0..len * c {
+                let (gz, fz) = (red.gap_z[col], red.force_z[col]);
+                let i = col / c;
+                let column = &mut red.matrix.column_mut(col)[l * len..(l + 1) * len];
+                for (j, m) in column.iter_mut().enumerate() {
+                    *m = ws.gram_gap[j * len + i] * gz + ws.gram_force[j * len + i] * fz;
                 }
-                red.rhs[row] = rhs;
             }
         }
         self.ws = ws;
