@@ -248,10 +248,18 @@ impl Basis for CosineBasis {
             self.cosine_moments(weights, scratch);
             let sigma = &scratch.real;
             // (2/N) sum w cos(j t) cos(i t) = (sigma_|j-i| + sigma_(j+i)) / 2: Toeplitz + Hankel.
+            // Row j: the Toeplitz part reads sigma[j], ..., sigma[1] then sigma[0], sigma[1], ...
+            // and the Hankel part sigma[j..j + len]; slices keep the loops free of index math.
             for (j, row) in gram.chunks_exact_mut(len).take(len).enumerate() {
-                for (i, g) in row.iter_mut().enumerate() {
-                    *g = constant_half(i) * 0.5 * (sigma[j.abs_diff(i)] + sigma[j + i]);
+                let (below, above) = row.split_at_mut(j);
+                let hankel = &sigma[j..j + len];
+                for ((g, t), h) in below.iter_mut().zip(sigma[1..=j].iter().rev()).zip(hankel) {
+                    *g = 0.5 * (t + h);
                 }
+                for ((g, t), h) in above.iter_mut().zip(&sigma[..len - j]).zip(&hankel[j..]) {
+                    *g = 0.5 * (t + h);
+                }
+                row[0] *= constant_half(0);
             }
         });
     }
