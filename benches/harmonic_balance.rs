@@ -14,7 +14,7 @@ use nonsmooth_modes::continuation::{AtParameter, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::hint::black_box;
@@ -128,7 +128,9 @@ fn whole_backbone(c: &mut Criterion) {
     for m in [20, 40, 80] {
         group.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, &m| {
             b.iter(|| {
-                backbone(&system, settings(m), &options, SemismoothNewton::default()).unwrap()
+                // The `backbone` example's solver: the fail-fast budget of sequential runs.
+                let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
+                backbone(&system, settings(m), &options, solver).unwrap()
             });
         });
     }

@@ -209,3 +209,97 @@ fn iterator_restart_and_reverse_direction() {
     }
     assert!(grew);
 }
+
+/// `F(x, lambda) = x - s(lambda)` with a spike `s(0.2) = 0.55` between `s(0.1) = 0.1` and
+/// `s(0.3) = 0`.
+struct Spiky;
+
+impl ContinuationProblem for Spiky {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
+        let s = if (lambda - 0.2).abs() < 1e-12 {
+            0.55
+        } else if (lambda - 0.3).abs() < 1e-12 {
+            0.0
+        } else {
+            lambda
+        };
+        f[0] = x[0] - s;
+    }
+    fn jacobian(&mut self, _: &[f64], _: f64, jac: &mut nonsmooth_modes::linalg::DenseMatrix) {
+        jac.reset(1, 1);
+        jac[(0, 0)] = 1.0;
+    }
+    fn parameter_derivative(&mut self, _: &[f64], _: f64, df: &mut [f64]) {
+        df[0] = -1.0;
+    }
+}
+
+/// A local solver: one exact Newton step when the start is within 0.5 of the solution,
+/// otherwise a failure.
+struct Local;
+
+impl nonsmooth_modes::solve::NonlinearSolver for Local {
+    fn solve(
+        &self,
+        problem: &mut dyn nonsmooth_modes::solve::Problem,
+        x: &mut [f64],
+    ) -> Result<nonsmooth_modes::solve::SolveInfo, nonsmooth_modes::SolveError> {
+        let mut f = [0.0];
+        problem.residual(x, &mut f);
+        if f[0].abs() > 0.5 {
+            return Err(nonsmooth_modes::SolveError::MaxIterations {
+                iterations: 0,
+                residual_norm: f[0].abs(),
+                tolerance: 0.0,
+            });
+        }
+        x[0] -= f[0];
+        Ok(nonsmooth_modes::solve::SolveInfo {
+            iterations: 1,
+            residual_norm: 0.0,
+            residual_evaluations: 1,
+            jacobian_evaluations: 0,
+        })
+    }
+    fn tolerance(&self, _: &dyn nonsmooth_modes::solve::Problem) -> f64 {
+        0.0
+    }
+}
+
+/// After a spike, the step that fails from the spike is retried from the point before it, and
+/// the branch goes on from there; without the retry it is lost.
+#[test]
+fn sequential_retry_steps_back_over_a_spike() {
+    use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
+    let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
+    let run = |retry| {
+        let options = SequentialOptions {
+            retry_from_previous: retry,
+            ..Default::default()
+        };
+        Sequential::new(Spiky, Local, vec![0.0], values.clone(), options)
+            .unwrap()
+            .map(|p| (p.converged, p.x[0]))
+            .collect::<Vec<_>>()
+    };
+    let with = run(true);
+    assert_eq!(
+        with,
+        vec![
+            (true, 0.0),
+            (true, 0.1),
+            (true, 0.55),
+            (true, 0.0),
+            (true, 0.4)
+        ]
+    );
+    let without = run(false);
+    // From the spike 0.55 the solution 0 at lambda = 0.3 is out of reach; then 0.4 is reached
+    // again from the spike.
+    assert!(!without[3].0);
+    assert_eq!(without[4], (true, 0.4));
+    assert!(SequentialOptions::default().retry_from_previous);
+}

@@ -77,7 +77,7 @@ fn paper_grid_with_semismooth_newton() {
     assert!((first.energy_normalized / exact - 1.0).abs() < 0.02);
 }
 
-/// The same grid with Powell's dogleg (the paper's `fsolve`). Measured: 175/181 converged,
+/// The same grid with Powell's dogleg (the paper's `fsolve`). Measured: 176/181 converged,
 /// 110/181 within 5%, as with Newton; asserted with some slack.
 #[test]
 fn paper_grid_with_dogleg() {
