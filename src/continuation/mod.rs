@@ -22,7 +22,7 @@ pub use sequential::{linspace, Predictor, Sequential, SequentialOptions, StepOut
 
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;
-use crate::solve::{Problem, SingularStep};
+use crate::solve::{point_on_ray, Problem, SingularStep};
 
 /// A family of square systems `F(x, lambda) = 0` in one scalar parameter.
 pub trait ContinuationProblem {
@@ -46,9 +46,7 @@ pub trait ContinuationProblem {
         trial: &mut [f64],
         f: &mut [f64],
     ) {
-        for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
-            *p = a + t * d;
-        }
+        point_on_ray(x, dx, t, trial);
         self.residual(trial, lambda, f);
     }
 

@@ -37,9 +37,7 @@ pub trait Problem {
     /// is cheaper along a fixed direction overrides it (harmonic balance: the time samples
     /// are affine in `t`, so a whole line search needs one synthesis).
     fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
-        for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
-            *p = a + t * d;
-        }
+        point_on_ray(x, dx, t, trial);
         self.residual(trial, f);
     }
 
@@ -131,6 +129,13 @@ impl<S: NonlinearSolver + ?Sized> NonlinearSolver for Box<S> {
 
 /// Relative pivot threshold of the LU factorisations.
 pub(crate) const PIVOT_TOLERANCE: f64 = 1e-13;
+
+/// `out = x + t dx`: a line search's trial point.
+pub(crate) fn point_on_ray(x: &[f64], dx: &[f64], t: f64, out: &mut [f64]) {
+    for ((p, a), d) in out.iter_mut().zip(x).zip(dx) {
+        *p = a + t * d;
+    }
+}
 
 pub(crate) fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
@@ -239,8 +244,13 @@ impl<'p> Iteration<'p> {
         iteration: usize,
     ) -> Result<f64, SolveError> {
         self.problem.residual(x, out);
+        self.counted_norm(out, iteration)
+    }
+
+    /// Counts a residual evaluation and returns its norm, or an error if it is not finite.
+    fn counted_norm(&mut self, f: &[f64], iteration: usize) -> Result<f64, SolveError> {
         self.residuals += 1;
-        let r = norm(out);
+        let r = norm(f);
         if r.is_finite() {
             Ok(r)
         } else {
@@ -261,16 +271,7 @@ impl<'p> Iteration<'p> {
         iteration: usize,
     ) -> Result<f64, SolveError> {
         self.problem.residual_along(x, dx, t, trial, out);
-        self.residuals += 1;
-        let r = norm(out);
-        if r.is_finite() {
-            Ok(r)
-        } else {
-            Err(SolveError::NonFinite {
-                what: "residual",
-                iteration,
-            })
-        }
+        self.counted_norm(out, iteration)
     }
 
     /// Evaluates the Jacobian at `x` into `jac` and factorises it into `lu` (in place, reusing

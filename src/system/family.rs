@@ -17,6 +17,7 @@
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, ModelError, SettingsError};
 use crate::linalg::DenseMatrix;
+use crate::solve::point_on_ray;
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 
 /// A one-parameter family of bar systems.
@@ -136,9 +137,7 @@ impl<F: SystemFamily> ContinuationProblem for ParameterFamily<F> {
         match self.system_at(lambda) {
             Some(s) => s.residual_along(x, dx, t, omega, trial, f),
             None => {
-                for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
-                    *p = a + t * d;
-                }
+                point_on_ray(x, dx, t, trial);
                 f.fill(f64::NAN);
             }
         }

@@ -19,7 +19,7 @@ use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::solve::SingularStep;
+use crate::solve::{point_on_ray, SingularStep};
 use crate::system::condense::{condense_into, CondenseScratch, Condensed};
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
 use crate::system::BarSystem;
@@ -556,9 +556,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         f: &mut [f64],
     ) {
         self.prepare(omega);
-        for ((p, a), d) in trial.iter_mut().zip(x).zip(dx) {
-            *p = a + t * d;
-        }
+        point_on_ray(x, dx, t, trial);
         let mut ws = std::mem::take(&mut self.ws);
         let same = |v: &Option<Vec<f64>>, w: &[f64]| v.as_deref() == Some(w);
         if !(same(&ws.along.start, x) && same(&ws.along.direction, dx)) {
