@@ -5,7 +5,7 @@
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
-//!     [--newton fail-fast|full] [--no-retry] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--newton fail-fast|full] [--retry-depth K] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
@@ -28,8 +28,9 @@
 //! Newton's budget: `--newton fail-fast` (`NewtonOptions::fail_fast`, the default of sequential
 //! runs: each step starts from a converged neighbour and a failed step is skipped) or
 //! `--newton full` (`NewtonOptions::default`, the default of arclength runs, whose stall
-//! escapes solve from far starts). A failed sequential step is retried from the converged
-//! point before the last one (`SequentialOptions::retry_from_previous`) unless `--no-retry`.
+//! escapes solve from far starts). A failed sequential step is retried from up to
+//! `--retry-depth` earlier converged points (`SequentialOptions::retry_depth`, default 1; 0
+//! switches the retry off).
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
@@ -56,7 +57,7 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
   [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--newton fail-fast|full] [--no-retry] [--out FILE]
+  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--out FILE]
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
@@ -96,7 +97,7 @@ struct Args {
     dogleg: bool,
     /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
     fail_fast: Option<bool>,
-    retry: bool,
+    retry_depth: usize,
     out: Option<String>,
     arclength: bool,
     driver: ArclengthOptions,
@@ -147,7 +148,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         steps: 181,
         dogleg: false,
         fail_fast: None,
-        retry: true,
+        retry_depth: 1,
         out: None,
         arclength: false,
         driver: ArclengthOptions {
@@ -200,7 +201,7 @@ fn parse() -> Result<Args, lexopt::Error> {
                     other => return Err(format!("unknown Newton budget `{other}`").into()),
                 }
             }
-            Long("no-retry") => a.retry = false,
+            Long("retry-depth") => a.retry_depth = parser.value()?.parse()?,
             Long("out") => a.out = Some(parser.value()?.string()?),
             Long("method") => {
                 a.arclength = match parser.value()?.string()?.as_str() {
@@ -414,7 +415,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             },
             mode: a.mode,
             subharmonic: a.subharmonic,
-            retry_from_previous: a.retry,
+            retry_depth: a.retry_depth,
             ..Default::default()
         };
         backbone_with(&system, a.settings, &options, solver, |p| {
@@ -505,7 +506,7 @@ fn run_parameter(
             start.x,
             values,
             SequentialOptions {
-                retry_from_previous: a.retry,
+                retry_depth: a.retry_depth,
                 ..Default::default()
             },
         )?;

@@ -275,9 +275,9 @@ impl nonsmooth_modes::solve::NonlinearSolver for Local {
 fn sequential_retry_steps_back_over_a_spike() {
     use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
     let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
-    let run = |retry| {
+    let run = |retry_depth| {
         let options = SequentialOptions {
-            retry_from_previous: retry,
+            retry_depth,
             ..Default::default()
         };
         Sequential::new(Spiky, Local, vec![0.0], values.clone(), options)
@@ -285,7 +285,7 @@ fn sequential_retry_steps_back_over_a_spike() {
             .map(|p| (p.converged, p.x[0]))
             .collect::<Vec<_>>()
     };
-    let with = run(true);
+    let with = run(1);
     assert_eq!(
         with,
         vec![
@@ -296,10 +296,10 @@ fn sequential_retry_steps_back_over_a_spike() {
             (true, 0.4)
         ]
     );
-    let without = run(false);
+    let without = run(0);
     // From the spike 0.55 the solution 0 at lambda = 0.3 is out of reach; then 0.4 is reached
     // again from the spike.
     assert!(!without[3].0);
     assert_eq!(without[4], (true, 0.4));
-    assert!(SequentialOptions::default().retry_from_previous);
+    assert_eq!(SequentialOptions::default().retry_depth, 1);
 }

@@ -3,6 +3,7 @@
 use super::{AtParameter, ContinuationProblem, Point};
 use crate::error::{ContinuationError, SolveError};
 use crate::solve::{norm, NonlinearSolver};
+use std::collections::VecDeque;
 use std::ops::ControlFlow;
 
 /// How the next starting guess is formed.
@@ -23,12 +24,13 @@ pub struct SequentialOptions {
     /// Stop with [`ContinuationError::Stalled`] after this many consecutive failed steps
     /// (default 40; `usize::MAX` never stops).
     pub max_consecutive_failures: usize,
-    /// When a step fails from the prediction, solve once more from the converged point before
-    /// the last one (default `true`; `false` is the paper's plain sequential continuation). Near an internal resonance the last point can be a
-    /// resonance spike of the truncated system whose neighbourhood holds no solution at the
-    /// next parameter, while the point before it still leads back to the backbone. A
-    /// successful retry drops the spike from the predictor's history.
-    pub retry_from_previous: bool,
+    /// When a step fails from the prediction, solve it again from up to `retry_depth` earlier
+    /// converged points, the most recent first (default 1: the point before the last; 0 is the
+    /// paper's plain sequential continuation). Near an internal resonance the last point can
+    /// be a resonance spike of the truncated system whose neighbourhood holds no solution at
+    /// the next parameter, while an earlier point still leads back to the backbone. A
+    /// successful retry drops the points it stepped over from the driver's history.
+    pub retry_depth: usize,
 }
 
 impl Default for SequentialOptions {
@@ -36,7 +38,7 @@ impl Default for SequentialOptions {
         Self {
             predictor: Predictor::Constant,
             max_consecutive_failures: 40,
-            retry_from_previous: true,
+            retry_depth: 1,
         }
     }
 }
@@ -56,8 +58,7 @@ pub enum StepOutcome {
 
 /// Sequential continuation over a fixed list of parameter values: at each value, solve
 /// `F(x, lambda) = 0` from the predicted guess (and, if that fails and
-/// [`SequentialOptions::retry_from_previous`] is set, from the converged point before the
-/// last). Failed steps are reported and skipped; the next step starts again from the last
+/// [`SequentialOptions::retry_depth`] allows, from earlier converged points). Failed steps are reported and skipped; the next step starts again from the last
 /// converged solution.
 pub struct Sequential<P, S> {
     problem: P,
@@ -67,7 +68,8 @@ pub struct Sequential<P, S> {
     next: usize,
     last: Vec<f64>,
     last_lambda: f64,
-    previous: Option<(Vec<f64>, f64)>,
+    /// Converged points before `last`, the most recent first (at most `max(retry_depth, 1)`).
+    history: VecDeque<(Vec<f64>, f64)>,
     failures: usize,
     stalled: bool,
     accept: Option<Acceptance>,
@@ -115,7 +117,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             options,
             next: 0,
             last: start,
-            previous: None,
+            history: VecDeque::new(),
             failures: 0,
             stalled: false,
             accept: None,
@@ -141,7 +143,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     }
 
     fn predict(&self, lambda: f64) -> Vec<f64> {
-        match (self.options.predictor, &self.previous) {
+        match (self.options.predictor, self.history.front()) {
             (Predictor::Secant, Some((prev, prev_lambda))) if *prev_lambda != self.last_lambda => {
                 let s = (lambda - self.last_lambda) / (self.last_lambda - prev_lambda);
                 self.last
@@ -190,13 +192,16 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         self.next += 1;
         let mut x = self.predict(lambda);
         let (mut result, mut accepted) = self.attempt(lambda, &mut x);
-        let mut retried = false;
-        if !(result.is_ok() && accepted) && self.options.retry_from_previous {
-            if let Some((previous, _)) = &self.previous {
-                let mut y = previous.clone();
-                let (second, second_accepted) = self.attempt(lambda, &mut y);
-                if second.is_ok() && second_accepted {
-                    (x, result, accepted, retried) = (y, second, true, true);
+        // Which start converged: `None` for the prediction, `Some(d)` for `history[d]`.
+        let mut from_history = None;
+        if !(result.is_ok() && accepted) {
+            let depth = self.options.retry_depth.min(self.history.len());
+            for d in 0..depth {
+                let mut y = self.history[d].0.clone();
+                let (again, again_accepted) = self.attempt(lambda, &mut y);
+                if again.is_ok() && again_accepted {
+                    (x, result, accepted, from_history) = (y, again, true, Some(d));
+                    break;
                 }
             }
         }
@@ -204,8 +209,13 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             Ok(info) if accepted => {
                 self.failures = 0;
                 let last = std::mem::replace(&mut self.last, x.clone());
-                if !retried {
-                    self.previous = Some((last, self.last_lambda));
+                match from_history {
+                    None => {
+                        self.history.push_front((last, self.last_lambda));
+                        self.history.truncate(self.options.retry_depth.max(1));
+                    }
+                    // Drop the points stepped over; the start used heads the history.
+                    Some(d) => drop(self.history.drain(..d)),
                 }
                 self.last_lambda = lambda;
                 StepOutcome::Converged(Point {

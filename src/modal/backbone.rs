@@ -52,9 +52,9 @@ pub struct BackboneOptions {
     pub predictor: Predictor,
     /// Consecutive failures before the run stops (default 40).
     pub max_consecutive_failures: usize,
-    /// Retry a failed step from the converged point before the last one
-    /// ([`SequentialOptions::retry_from_previous`]; default `true`).
-    pub retry_from_previous: bool,
+    /// Retry a failed step from up to this many earlier converged points
+    /// ([`SequentialOptions::retry_depth`]; default 1).
+    pub retry_depth: usize,
     /// Converged points with `E < trivial_energy * E_g` count as collapsed to rest and are
     /// not accepted (default `1e-6`).
     pub trivial_energy: f64,
@@ -68,7 +68,7 @@ impl Default for BackboneOptions {
             subharmonic: 1,
             predictor: Predictor::Constant,
             max_consecutive_failures: 40,
-            retry_from_previous: true,
+            retry_depth: 1,
             trivial_energy: 1e-6,
         }
     }
@@ -166,7 +166,7 @@ pub fn backbone_with<S: NonlinearSolver>(
     let seq_options = SequentialOptions {
         predictor: options.predictor,
         max_consecutive_failures: options.max_consecutive_failures,
-        retry_from_previous: options.retry_from_previous,
+        retry_depth: options.retry_depth,
     };
     let floor = options.trivial_energy * e_g;
     // The acceptance test computes each converged point's energy; the observer reuses it.
