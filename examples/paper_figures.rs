@@ -1290,6 +1290,8 @@ fn fig12(ctx: &Ctx) -> Res<Stats> {
         }
     }
     mark(&mut bb, "points e, d", &marks);
+    // The resonant point d sits at the top left, where the legend would hide it.
+    bb.legend = LegendPosition::LowerRight;
     let mut all = vec![Panel::Lines(bb)];
     all.extend(panels);
     ctx.figure(
