@@ -109,3 +109,40 @@ fn a_mode_beyond_the_searched_range_is_a_typed_error() {
         Err(SettingsError::NotPositive { .. })
     ));
 }
+
+/// A seed from the mode that `grazing_energy` returns equals the seed that searches the mode
+/// again; a mode without shape or of the wrong size is refused with a typed error.
+#[test]
+fn seed_from_a_known_mode_equals_the_searched_seed() {
+    use nonsmooth_modes::modal::{grazing_energy, seed_from_mode, LinearMode};
+    use nonsmooth_modes::SolveError;
+    for system in [
+        clamped_bar_with_obstacle(1e-3).unwrap(),
+        robin_bar_with_obstacle(0.5, 1e-3).unwrap(),
+        two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 1e-3).unwrap(),
+    ] {
+        let mut problem = NonsmoothSystem::new(&system, HarmonicBalance::default()).unwrap();
+        let (_, first) = grazing_energy(&system).unwrap();
+        for (subharmonic, omega) in [(1, 0.9 * first.omega), (3, 2.9 * first.omega)] {
+            let searched = branch_seed(&mut problem, 1, subharmonic, omega).unwrap();
+            let known = seed_from_mode(&mut problem, &first, subharmonic, omega).unwrap();
+            assert_eq!(searched, known);
+        }
+        let empty = LinearMode {
+            omega: first.omega,
+            shapes: Vec::new(),
+        };
+        assert!(matches!(
+            seed_from_mode(&mut problem, &empty, 1, first.omega),
+            Err(Error::Settings(SettingsError::NoGrazing { .. }))
+        ));
+        let short = LinearMode {
+            omega: first.omega,
+            shapes: vec![vec![1.0]],
+        };
+        assert!(matches!(
+            seed_from_mode(&mut problem, &short, 1, first.omega),
+            Err(Error::Solve(SolveError::Dimension { got: 1, .. }))
+        ));
+    }
+}

@@ -7,7 +7,7 @@ use crate::continuation::{
 };
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
-use crate::modal::linear::{branch_seed, grazing_energy};
+use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode, LinearMode};
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::cell::RefCell;
@@ -155,9 +155,10 @@ pub fn backbone_with<S: NonlinearSolver>(
         .into());
     }
     let values = linspace(grid.start, grid.end, grid.steps)?;
-    let (e_g, _) = grazing_energy(system)?;
-    let start = branch_seed(
+    let (e_g, first_mode) = grazing_energy(system)?;
+    let start = seed(
         &mut problem,
+        &first_mode,
         options.mode,
         options.subharmonic,
         2.0 * PI / grid.start,
@@ -199,6 +200,22 @@ pub fn backbone_with<S: NonlinearSolver>(
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
     })?;
     Ok(e_g)
+}
+
+/// The seed of NSM `mode` sub `subharmonic`, reusing the first mode (found for `E_g`) when
+/// `mode == 1`.
+fn seed(
+    problem: &mut NonsmoothSystem,
+    first_mode: &LinearMode,
+    mode: usize,
+    subharmonic: usize,
+    omega: f64,
+) -> Result<Vec<f64>, Error> {
+    if mode == 1 {
+        seed_from_mode(problem, first_mode, subharmonic, omega)
+    } else {
+        branch_seed(problem, mode, subharmonic, omega)
+    }
 }
 
 /// [`backbone_with`] collecting every point.
@@ -277,8 +294,14 @@ pub fn arclength_backbone<S: NonlinearSolver>(
         .into());
     }
     let omega0 = 2.0 * PI / options.start_period;
-    let (e_g, _) = grazing_energy(system)?;
-    let start = branch_seed(&mut problem, options.mode, options.subharmonic, omega0)?;
+    let (e_g, first_mode) = grazing_energy(system)?;
+    let start = seed(
+        &mut problem,
+        &first_mode,
+        options.mode,
+        options.subharmonic,
+        omega0,
+    )?;
     let basis = problem.basis().clone();
     let arclength = ArclengthOptions {
         parameter_range: options.omega_range,

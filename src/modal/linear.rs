@@ -7,7 +7,7 @@
 //! located as minima of `sigma_min(D) / sigma_max(D)` on a scan of step `pi c / (200 l)` (which also finds double
 //! roots, where `det D` does not change sign) and refined by golden-section search.
 
-use crate::error::{Error, SettingsError};
+use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
 use crate::modal::energy::energy;
@@ -253,21 +253,12 @@ pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsE
     }
 }
 
-/// A starting guess for the branch "NSM `mode` sub `subharmonic`" at fundamental frequency
-/// `omega`: the open-contact linear mode `mode`, placed on harmonic `subharmonic` (its period
-/// is `subharmonic` periods of the mode) and scaled so that its first contact just closes at
-/// `t = 0`.
-///
-/// # Errors
-/// [`SettingsError::ZeroIndex`] for `mode = 0` or `subharmonic = 0`,
-/// [`SettingsError::HarmonicOutOfRange`] if the basis has fewer harmonics, or a failed mode
-/// search.
-pub fn branch_seed<B: Basis>(
-    problem: &mut NonsmoothSystem<B>,
-    mode: usize,
+/// The arguments of a seed that do not depend on the mode.
+fn check_seed<B: Basis>(
+    problem: &NonsmoothSystem<B>,
     subharmonic: usize,
     omega: f64,
-) -> Result<Vec<f64>, Error> {
+) -> Result<(), Error> {
     if subharmonic == 0 {
         return Err(SettingsError::ZeroIndex {
             what: "subharmonic order",
@@ -290,8 +281,55 @@ pub fn branch_seed<B: Basis>(
         }
         .into());
     }
+    Ok(())
+}
+
+/// A starting guess for the branch "NSM `mode` sub `subharmonic`" at fundamental frequency
+/// `omega`: the open-contact linear mode `mode`, placed on harmonic `subharmonic` (its period
+/// is `subharmonic` periods of the mode) and scaled so that its first contact just closes at
+/// `t = 0`.
+///
+/// # Errors
+/// [`SettingsError::ZeroIndex`] for `mode = 0` or `subharmonic = 0`,
+/// [`SettingsError::HarmonicOutOfRange`] if the basis has fewer harmonics, or a failed mode
+/// search.
+pub fn branch_seed<B: Basis>(
+    problem: &mut NonsmoothSystem<B>,
+    mode: usize,
+    subharmonic: usize,
+    omega: f64,
+) -> Result<Vec<f64>, Error> {
+    check_seed(problem, subharmonic, omega)?;
     let linear = open_mode(problem.system(), mode)?;
-    let shape = &linear.shapes[0];
+    seed_from_mode(problem, &linear, subharmonic, omega)
+}
+
+/// [`branch_seed`] from a linear mode already at hand (the one [`grazing_energy`] returns, for
+/// instance), without searching for it again.
+///
+/// # Errors
+/// As [`branch_seed`]; [`SettingsError::NoGrazing`] for a mode without shape.
+pub fn seed_from_mode<B: Basis>(
+    problem: &mut NonsmoothSystem<B>,
+    linear: &LinearMode,
+    subharmonic: usize,
+    omega: f64,
+) -> Result<Vec<f64>, Error> {
+    check_seed(problem, subharmonic, omega)?;
+    let Some(shape) = linear.shapes.first() else {
+        return Err(SettingsError::NoGrazing {
+            omega: linear.omega,
+        }
+        .into());
+    };
+    let expected = problem.system().unknowns_per_harmonic();
+    if shape.len() != expected {
+        return Err(SolveError::Dimension {
+            got: shape.len(),
+            expected,
+        }
+        .into());
+    }
     let laws: Vec<f64> = problem.system().laws().map(|l| l.gap().offset).collect();
     let rows = &problem.rows_at(omega)[subharmonic];
     let mut scale = f64::INFINITY;

@@ -16,4 +16,6 @@ pub use diagnostics::{
 };
 pub use energy::{energy, energy_at};
 pub use field::{FieldEvaluator, FieldValue};
-pub use linear::{branch_seed, grazing_energy, natural_frequencies, ContactState, LinearMode};
+pub use linear::{
+    branch_seed, grazing_energy, natural_frequencies, seed_from_mode, ContactState, LinearMode,
+};
