@@ -7,7 +7,7 @@ use crate::continuation::{
 };
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
-use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode, LinearMode};
+use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::cell::RefCell;
@@ -155,10 +155,8 @@ pub fn backbone_with<S: NonlinearSolver>(
         .into());
     }
     let values = linspace(grid.start, grid.end, grid.steps)?;
-    let (e_g, first_mode) = grazing_energy(system)?;
-    let start = seed(
+    let (e_g, start) = grazing_and_seed(
         &mut problem,
-        &first_mode,
         options.mode,
         options.subharmonic,
         2.0 * PI / grid.start,
@@ -202,20 +200,21 @@ pub fn backbone_with<S: NonlinearSolver>(
     Ok(e_g)
 }
 
-/// The seed of NSM `mode` sub `subharmonic`, reusing the first mode (found for `E_g`) when
-/// `mode == 1`.
-fn seed(
+/// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
+/// `subharmonic` at `omega`, reusing the first linear mode (found for `E_g`) when `mode == 1`.
+fn grazing_and_seed(
     problem: &mut NonsmoothSystem,
-    first_mode: &LinearMode,
     mode: usize,
     subharmonic: usize,
     omega: f64,
-) -> Result<Vec<f64>, Error> {
-    if mode == 1 {
-        seed_from_mode(problem, first_mode, subharmonic, omega)
+) -> Result<(f64, Vec<f64>), Error> {
+    let (e_g, first_mode) = grazing_energy(problem.system())?;
+    let seed = if mode == 1 {
+        seed_from_mode(problem, &first_mode, subharmonic, omega)?
     } else {
-        branch_seed(problem, mode, subharmonic, omega)
-    }
+        branch_seed(problem, mode, subharmonic, omega)?
+    };
+    Ok((e_g, seed))
 }
 
 /// [`backbone_with`] collecting every point.
@@ -294,14 +293,7 @@ pub fn arclength_backbone<S: NonlinearSolver>(
         .into());
     }
     let omega0 = 2.0 * PI / options.start_period;
-    let (e_g, first_mode) = grazing_energy(system)?;
-    let start = seed(
-        &mut problem,
-        &first_mode,
-        options.mode,
-        options.subharmonic,
-        omega0,
-    )?;
+    let (e_g, start) = grazing_and_seed(&mut problem, options.mode, options.subharmonic, omega0)?;
     let basis = problem.basis().clone();
     let arclength = ArclengthOptions {
         parameter_range: options.omega_range,
