@@ -51,7 +51,8 @@ impl NewtonOptions {
     /// `1e-4` or fifteen iterations to halve its residual is outside every solution's basin
     /// in practice; the default settings spend most of a backbone's time proving it
     /// (`docs/performance.md`). On the clamped bar's 181-step backbone they converge the same
-    /// steps as the defaults at `m = 20, 40, 80` in a half to a third of the time. Not for
+    /// steps as the defaults at `m = 20` and `40` and two fewer at `m = 80` (169 of 181), in a
+    /// half to a third of the time. Not for
     /// far starts (a seed, the jumps of [`crate::continuation::StallEscape`]): those can need
     /// a slow first phase before converging.
     pub fn fail_fast() -> Self {
@@ -173,8 +174,8 @@ impl NonlinearSolver for SemismoothNewton {
     }
 }
 
-/// The last `window + 1` residual norms, in a ring (no allocation for windows up to
-/// [`Stagnation::CAPACITY`]; larger windows fall back to the last that fits).
+/// The last `window + 1` residual norms, in a ring without allocation (windows are capped at
+/// [`Stagnation::CAPACITY`]` - 1`).
 struct Stagnation {
     window: usize,
     ratio: f64,
