@@ -49,6 +49,14 @@ impl DenseMatrix {
         self.data.resize(nrows * ncols, 0.0);
     }
 
+    /// Resizes to `nrows x ncols` keeping the storage, without clearing: the entries are left
+    /// over from earlier contents, for callers that overwrite every entry.
+    pub(crate) fn reshape(&mut self, nrows: usize, ncols: usize) {
+        self.nrows = nrows;
+        self.ncols = ncols;
+        self.data.resize(nrows * ncols, 0.0);
+    }
+
     /// Column `j` as a mutable slice.
     ///
     /// # Panics

@@ -760,7 +760,8 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let size = len * c;
         let mut red = std::mem::take(&mut self.reduced);
         let mut ws = std::mem::take(&mut self.ws);
-        red.matrix.reset(size, size);
+        // Every entry is written below (one column block per law and coefficient).
+        red.matrix.reshape(size, size);
         red.rhs.clear();
         red.rhs.resize(size, 0.0);
         red.gap_z.resize(len * c, 0.0);

@@ -323,6 +323,7 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
     det
 }
 
+#[inline]
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
