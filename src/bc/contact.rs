@@ -1,8 +1,8 @@
 //! Two bar ends facing each other.
 
 use super::{
-    smoothed_complementarity, BoundaryCondition, LawValue, LinearRows, Observable, Quantity, Term,
-    UnilateralLaw,
+    complementarity_samples, smoothed_complementarity, BoundaryCondition, LawSamples, LawValue,
+    LinearRows, Observable, Quantity, Term, UnilateralLaw,
 };
 use crate::bar::EndRef;
 use crate::error::{positive, ModelError};
@@ -80,5 +80,16 @@ impl UnilateralLaw for Contact {
     }
     fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
         smoothed_complementarity(gap, force, penalty, smoothing)
+    }
+
+    fn sample(
+        &self,
+        gaps: &[f64],
+        forces: &[f64],
+        penalty: f64,
+        smoothing: f64,
+        out: LawSamples<'_>,
+    ) {
+        complementarity_samples(gaps, forces, penalty, smoothing, out);
     }
 }

@@ -74,6 +74,51 @@ pub fn smoothed_complementarity(gap: f64, force: f64, penalty: f64, smoothing: f
     }
 }
 
+/// [`smoothed_complementarity`] at every sample `(gaps[k], forces[k])` into `out`: the
+/// [`UnilateralLaw::sample`] of Signorini and contact conditions. Without smoothing the loop
+/// is branch-free (selects), so the compiler vectorises it; values are those of
+/// [`complementarity`], bit for bit.
+///
+/// # Panics
+/// If the slices do not all have the same length.
+pub fn complementarity_samples(
+    gaps: &[f64],
+    forces: &[f64],
+    penalty: f64,
+    smoothing: f64,
+    out: LawSamples<'_>,
+) {
+    let n = gaps.len();
+    assert!(
+        forces.len() == n
+            && out.values.len() == n
+            && out.d_gap.len() == n
+            && out.d_force.len() == n,
+        "law samples of unequal lengths"
+    );
+    if smoothing > 0.0 {
+        for k in 0..n {
+            let v = smoothed_complementarity(gaps[k], forces[k], penalty, smoothing);
+            (out.values[k], out.d_gap[k], out.d_force[k]) = (v.value, v.d_gap, v.d_force);
+        }
+        return;
+    }
+    let samples = gaps.iter().zip(forces);
+    let outputs = out
+        .values
+        .iter_mut()
+        .zip(out.d_gap.iter_mut())
+        .zip(out.d_force.iter_mut());
+    for ((&g, &f), ((value, d_gap), d_force)) in samples.zip(outputs) {
+        // The branch of `complementarity`: the force branch where `lambda < a_c g`.
+        let b = penalty * g;
+        let force_branch = f < b;
+        *value = if force_branch { -f } else { -b };
+        *d_gap = if force_branch { 0.0 } else { -penalty };
+        *d_force = if force_branch { -1.0 } else { 0.0 };
+    }
+}
+
 /// A nonsmooth law between a gap and a force, enforced in time by harmonic balance.
 ///
 /// The system samples `gap` and `force` on the time grid, evaluates [`UnilateralLaw::residual`]
@@ -136,6 +181,31 @@ pub trait UnilateralLaw: Debug + Send + Sync {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sampled_law_equals_the_pointwise_law() {
+        // Both branches, the kink (force == a_c gap), negative gaps and forces.
+        let gaps = [0.3, 0.01, -0.2, 0.5, 0.25, 0.0, -1.0];
+        let forces = [0.1, 2.0, 0.5, -0.3, 1.0, 0.0, -4.0];
+        for smoothing in [0.0, 1e-3] {
+            let (mut v, mut dg, mut df) = ([f64::NAN; 7], [f64::NAN; 7], [f64::NAN; 7]);
+            complementarity_samples(
+                &gaps,
+                &forces,
+                4.0,
+                smoothing,
+                LawSamples {
+                    values: &mut v,
+                    d_gap: &mut dg,
+                    d_force: &mut df,
+                },
+            );
+            for k in 0..7 {
+                let want = smoothed_complementarity(gaps[k], forces[k], 4.0, smoothing);
+                assert_eq!((v[k], dg[k], df[k]), (want.value, want.d_gap, want.d_force));
+            }
+        }
+    }
 
     #[test]
     fn smoothing_tends_to_the_nonsmooth_law_with_consistent_derivatives() {

@@ -14,7 +14,8 @@ mod signorini;
 
 pub use contact::Contact;
 pub use law::{
-    complementarity, smoothed_complementarity, LawSamples, LawValue, Observable, UnilateralLaw,
+    complementarity, complementarity_samples, smoothed_complementarity, LawSamples, LawValue,
+    Observable, UnilateralLaw,
 };
 pub use linear::{Dirichlet, Neumann, Robin};
 pub use signorini::Signorini;

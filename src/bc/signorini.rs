@@ -1,8 +1,8 @@
 //! An end facing a rigid obstacle.
 
 use super::{
-    smoothed_complementarity, BoundaryCondition, LawValue, Observable, Quantity, Term,
-    UnilateralLaw,
+    complementarity_samples, smoothed_complementarity, BoundaryCondition, LawSamples, LawValue,
+    Observable, Quantity, Term, UnilateralLaw,
 };
 use crate::bar::EndRef;
 use crate::error::{positive, ModelError};
@@ -64,5 +64,16 @@ impl UnilateralLaw for Signorini {
     }
     fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
         smoothed_complementarity(gap, force, penalty, smoothing)
+    }
+
+    fn sample(
+        &self,
+        gaps: &[f64],
+        forces: &[f64],
+        penalty: f64,
+        smoothing: f64,
+        out: LawSamples<'_>,
+    ) {
+        complementarity_samples(gaps, forces, penalty, smoothing, out);
     }
 }
