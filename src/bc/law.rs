@@ -74,6 +74,37 @@ pub fn smoothed_complementarity(gap: f64, force: f64, penalty: f64, smoothing: f
     }
 }
 
+/// Panics unless the samples and the outputs all have the same length.
+fn check_lengths(gaps: &[f64], forces: &[f64], out: &LawSamples<'_>) {
+    let n = gaps.len();
+    assert!(
+        forces.len() == n
+            && out.values.len() == n
+            && out.d_gap.len() == n
+            && out.d_force.len() == n,
+        "law samples of unequal lengths"
+    );
+}
+
+/// `law` at every sample `(gaps[k], forces[k])` into `out`.
+fn sample_pointwise(
+    gaps: &[f64],
+    forces: &[f64],
+    out: LawSamples<'_>,
+    law: impl Fn(f64, f64) -> LawValue,
+) {
+    check_lengths(gaps, forces, &out);
+    let outputs = out
+        .values
+        .iter_mut()
+        .zip(out.d_gap.iter_mut())
+        .zip(out.d_force.iter_mut());
+    for ((&g, &f), ((value, d_gap), d_force)) in gaps.iter().zip(forces).zip(outputs) {
+        let v = law(g, f);
+        (*value, *d_gap, *d_force) = (v.value, v.d_gap, v.d_force);
+    }
+}
+
 /// [`smoothed_complementarity`] at every sample `(gaps[k], forces[k])` into `out`: the
 /// [`UnilateralLaw::sample`] of Signorini and contact conditions. Without smoothing the loop
 /// is branch-free (selects), so the compiler vectorises it; values are those of
@@ -88,21 +119,11 @@ pub fn complementarity_samples(
     smoothing: f64,
     out: LawSamples<'_>,
 ) {
-    let n = gaps.len();
-    assert!(
-        forces.len() == n
-            && out.values.len() == n
-            && out.d_gap.len() == n
-            && out.d_force.len() == n,
-        "law samples of unequal lengths"
-    );
     if smoothing > 0.0 {
-        for k in 0..n {
-            let v = smoothed_complementarity(gaps[k], forces[k], penalty, smoothing);
-            (out.values[k], out.d_gap[k], out.d_force[k]) = (v.value, v.d_gap, v.d_force);
-        }
-        return;
+        let law = |g, f| smoothed_complementarity(g, f, penalty, smoothing);
+        return sample_pointwise(gaps, forces, out, law);
     }
+    check_lengths(gaps, forces, &out);
     let samples = gaps.iter().zip(forces);
     let outputs = out
         .values
@@ -161,20 +182,8 @@ pub trait UnilateralLaw: Debug + Send + Sync {
         smoothing: f64,
         out: LawSamples<'_>,
     ) {
-        let n = gaps.len();
-        assert!(
-            forces.len() == n
-                && out.values.len() == n
-                && out.d_gap.len() == n
-                && out.d_force.len() == n,
-            "law samples of unequal lengths"
-        );
-        for k in 0..n {
-            let v = self.smoothed_residual(gaps[k], forces[k], penalty, smoothing);
-            out.values[k] = v.value;
-            out.d_gap[k] = v.d_gap;
-            out.d_force[k] = v.d_force;
-        }
+        let law = |g, f| self.smoothed_residual(g, f, penalty, smoothing);
+        sample_pointwise(gaps, forces, out, law);
     }
 }
 
