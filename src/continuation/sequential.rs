@@ -2,7 +2,7 @@
 
 use super::{AtParameter, ContinuationProblem, Point};
 use crate::error::{ContinuationError, SolveError};
-use crate::solve::{norm, NonlinearSolver};
+use crate::solve::{norm, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
 use std::ops::ControlFlow;
 
@@ -163,11 +163,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
 
     /// Solves at `lambda` from `x`; returns the solver's result and whether the acceptance
     /// test (if any) took the solution.
-    fn attempt(
-        &mut self,
-        lambda: f64,
-        x: &mut [f64],
-    ) -> (Result<crate::solve::SolveInfo, SolveError>, bool) {
+    fn attempt(&mut self, lambda: f64, x: &mut [f64]) -> (Result<SolveInfo, SolveError>, bool) {
         let mut frozen = AtParameter {
             problem: &mut self.problem,
             lambda,

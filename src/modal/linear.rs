@@ -301,7 +301,7 @@ pub fn branch_seed<B: Basis>(
 ) -> Result<Vec<f64>, Error> {
     check_seed(problem, subharmonic, omega)?;
     let linear = open_mode(problem.system(), mode)?;
-    seed_from_mode(problem, &linear, subharmonic, omega)
+    seed_checked(problem, &linear, subharmonic, omega)
 }
 
 /// [`branch_seed`] from a linear mode already at hand (the one [`grazing_energy`] returns, for
@@ -316,6 +316,16 @@ pub fn seed_from_mode<B: Basis>(
     omega: f64,
 ) -> Result<Vec<f64>, Error> {
     check_seed(problem, subharmonic, omega)?;
+    seed_checked(problem, linear, subharmonic, omega)
+}
+
+/// [`seed_from_mode`] once `subharmonic` and `omega` have passed [`check_seed`].
+fn seed_checked<B: Basis>(
+    problem: &mut NonsmoothSystem<B>,
+    linear: &LinearMode,
+    subharmonic: usize,
+    omega: f64,
+) -> Result<Vec<f64>, Error> {
     let Some(shape) = linear.shapes.first() else {
         return Err(SettingsError::NoGrazing {
             omega: linear.omega,

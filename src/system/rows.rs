@@ -287,14 +287,26 @@ const HADAMARD_SCREEN: f64 = 1e-12;
 /// dependent ones (Hadamard's inequality), by a Cholesky factorisation of the small Gram
 /// matrix. Returns 0 for a zero row or a failed factorisation.
 fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
+    // Up to eight rows (four bars) the Gram matrix and the norms live on the stack: the screen
+    // runs for every harmonic at every new frequency.
+    let mut stack = [0.0; 72];
+    let mut heap = Vec::new();
+    let buffer: &mut [f64] = if r * r + r <= stack.len() {
+        &mut stack[..r * r + r]
+    } else {
+        heap.resize(r * r + r, 0.0);
+        &mut heap
+    };
+    let (g, norms) = buffer.split_at_mut(r * r);
     let row = |i: usize| &rows[i * n..(i + 1) * n];
-    let norms: Vec<f64> = (0..r).map(|i| dot(row(i), row(i))).collect();
+    for (i, v) in norms.iter_mut().enumerate() {
+        *v = dot(row(i), row(i));
+    }
     // `v > 0` fails for zero and NaN alike.
     if !norms.iter().all(|&v| v > 0.0) {
         return 0.0;
     }
     // Gram matrix of the normalised rows, factorised in place (lower triangle).
-    let mut g = vec![0.0; r * r];
     for i in 0..r {
         for j in 0..=i {
             g[i * r + j] = dot(row(i), row(j)) / (norms[i] * norms[j]).sqrt();
