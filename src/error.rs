@@ -204,6 +204,17 @@ pub enum SolveError {
         /// The window.
         window: usize,
     },
+    /// The budget of residual evaluations ran out (see
+    /// [`NewtonOptions::max_evaluations`](crate::solve::NewtonOptions)).
+    #[error("evaluation budget of {evaluations} residuals spent at iteration {iteration}: residual norm {residual_norm:e}")]
+    EvaluationBudget {
+        /// Iteration at which it ran out.
+        iteration: usize,
+        /// Residual evaluations made.
+        evaluations: usize,
+        /// Residual norm at the start of that iteration's line search.
+        residual_norm: f64,
+    },
     /// The trust region shrank below its minimum radius.
     #[error("trust region collapsed at iteration {iteration}: radius {radius:e}, residual norm {residual_norm:e}")]
     TrustRegion {

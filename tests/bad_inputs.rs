@@ -472,6 +472,50 @@ fn iteration_budget() {
         other => panic!("expected Stagnated, got {other:?}"),
     }
     assert!(x.iter().all(|v| v.is_finite()));
+    // The same start with half the residual evaluations the generous solve needed: it stops
+    // in a line search once the budget is spent, with the count that shows it.
+    let budget = info.residual_evaluations / 2;
+    let mut x = start.clone();
+    let budgeted = SemismoothNewton::new(NewtonOptions {
+        max_evaluations: budget,
+        ..Default::default()
+    })
+    .unwrap();
+    match budgeted
+        .solve(&mut frozen(&mut problem), &mut x)
+        .unwrap_err()
+    {
+        SolveError::EvaluationBudget {
+            iteration,
+            evaluations,
+            residual_norm,
+        } => {
+            assert_eq!(evaluations, budget);
+            assert!(iteration < info.iterations);
+            assert!(residual_norm.is_finite() && residual_norm > tolerance);
+        }
+        other => panic!("expected EvaluationBudget, got {other:?}"),
+    }
+    assert!(x.iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn zero_evaluation_budget_is_refused() {
+    let e = SemismoothNewton::new(NewtonOptions {
+        max_evaluations: 0,
+        ..Default::default()
+    })
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SolveError::InvalidOption {
+                what: "max_evaluations",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
 }
 
 #[test]

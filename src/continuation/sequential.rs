@@ -243,6 +243,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                             | SolveError::SingularJacobian { iteration, .. }
                             | SolveError::TrustRegion { iteration, .. }
                             | SolveError::Stagnated { iteration, .. }
+                            | SolveError::EvaluationBudget { iteration, .. }
                             | SolveError::NonFinite { iteration, .. },
                         ),
                         _,

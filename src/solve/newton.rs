@@ -28,6 +28,13 @@ pub struct NewtonOptions {
     /// Least decrease factor over [`NewtonOptions::stall_window`] iterations (default 0.5,
     /// in `(0, 1]`).
     pub stall_ratio: f64,
+    /// Budget of residual evaluations per solve, line-search trials included (default
+    /// `usize::MAX`: none; 80 in [`NewtonOptions::fail_fast`]): give up with
+    /// [`SolveError::EvaluationBudget`] when a line search has spent it. A hopeless start
+    /// spends its time in long line searches at tiny steps; the solves that converge on the
+    /// clamped bar's backbones use at most 44 (`m = 40`) and 105 (`m = 80`) evaluations, the
+    /// failed ones 34 to 179 (`docs/performance.md`).
+    pub max_evaluations: usize,
 }
 
 impl Default for NewtonOptions {
@@ -39,6 +46,7 @@ impl Default for NewtonOptions {
             min_step: 1e-10,
             stall_window: 0,
             stall_ratio: 0.5,
+            max_evaluations: usize::MAX,
         }
     }
 }
@@ -49,7 +57,7 @@ impl NewtonOptions {
     /// step length `1e-4` (instead of `1e-10`) and the stagnation test is on
     /// (`stall_window = 15`, `stall_ratio = 0.5`). A start that needs steps shorter than
     /// `1e-4` or fifteen iterations to halve its residual is outside every solution's basin
-    /// in practice; the default settings spend most of a backbone's time proving it
+    /// in practice, and so is one that has spent 80 residual evaluations; the default settings spend most of a backbone's time proving it
     /// (`docs/performance.md`). On the clamped bar's 181-step backbone they converge the same
     /// steps as the defaults at `m = 20` and `40` and two fewer at `m = 80` (169 of 181), in a
     /// half to a third of the time. Not for
@@ -60,6 +68,7 @@ impl NewtonOptions {
             min_step: 1e-4,
             stall_window: 15,
             stall_ratio: 0.5,
+            max_evaluations: 80,
             ..Self::default()
         }
     }
@@ -83,12 +92,19 @@ impl SemismoothNewton {
     ///
     /// # Errors
     /// [`SolveError::InvalidOption`] for a non-positive or non-finite tolerance, Armijo
-    /// constant or minimum step, or a stagnation ratio outside `(0, 1]`.
+    /// constant or minimum step, a stagnation ratio outside `(0, 1]`, or a zero evaluation
+    /// budget.
     pub fn new(options: NewtonOptions) -> Result<Self, SolveError> {
         check_positive("tolerance", options.tolerance)?;
         check_positive("armijo", options.armijo)?;
         check_positive("min_step", options.min_step)?;
         check_positive("stall_ratio", options.stall_ratio)?;
+        if options.max_evaluations == 0 {
+            return Err(SolveError::InvalidOption {
+                what: "max_evaluations",
+                value: 0.0,
+            });
+        }
         if options.stall_ratio > 1.0 {
             return Err(SolveError::InvalidOption {
                 what: "stall_ratio (at most 1)",
@@ -158,6 +174,13 @@ impl NonlinearSolver for SemismoothNewton {
                         std::mem::swap(f, f_trial);
                         r = rt;
                         break;
+                    }
+                    if it.residuals >= o.max_evaluations {
+                        return Err(SolveError::EvaluationBudget {
+                            iteration,
+                            evaluations: it.residuals,
+                            residual_norm: r,
+                        });
                     }
                     t *= 0.5;
                     if t < o.min_step {

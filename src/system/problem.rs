@@ -120,6 +120,26 @@ impl Workspace {
     }
 }
 
+/// `(alpha, beta)` with `w_force[k] = alpha + beta w_gap[k]` at every sample (to a few
+/// roundings), if there are such: the Gram matrix is linear in the weight, so then
+/// `G(w_force) = alpha G(1) + beta G(w_gap)` and one transform is saved. Complementarity laws
+/// (Signorini, contact) always have it: `w_gap` is 0 or `a_c` and `w_force = 1 - w_gap / a_c`.
+fn affine_relation(w_gap: &[f64], w_force: &[f64]) -> Option<(f64, f64)> {
+    let (&g0, &f0) = (w_gap.first()?, w_force.first()?);
+    let (alpha, beta) = match w_gap.iter().position(|&g| g != g0) {
+        Some(k) => {
+            let beta = (w_force[k] - f0) / (w_gap[k] - g0);
+            (f0 - beta * g0, beta)
+        }
+        None => (f0, 0.0),
+    };
+    let fits = w_gap.iter().zip(w_force).all(|(&g, &f)| {
+        let model = alpha + beta * g;
+        (f - model).abs() <= 4.0 * f64::EPSILON * (f.abs() + alpha.abs() + (beta * g).abs())
+    });
+    (fits && alpha.is_finite() && beta.is_finite()).then_some((alpha, beta))
+}
+
 /// Sets a cache key to a copy of `v`, reusing its storage.
 fn set_key(key: &mut Option<Vec<f64>>, v: &[f64]) {
     let mut k = key.take().unwrap_or_default();
@@ -161,6 +181,8 @@ pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     condensed_state: Option<bool>,
     condense_scratch: CondenseScratch,
     reduced: Reduced,
+    /// `G(1)`, the Gram matrix of the unit weight (see [`affine_relation`]).
+    unit_gram: Vec<f64>,
     ws: Workspace,
 }
 
@@ -229,6 +251,8 @@ impl<B: Basis> NonsmoothSystem<B> {
             .collect();
         let n = basis.samples();
         let len = basis.len();
+        let mut unit_gram = vec![0.0; len * len];
+        basis.weighted_gram(&vec![1.0; n], &mut unit_gram);
         let ws = Workspace {
             coefficients: vec![0.0; len],
             gap: vec![0.0; laws * n],
@@ -267,6 +291,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             condensed_state: None,
             condense_scratch: CondenseScratch::default(),
             reduced: Reduced::default(),
+            unit_gram,
             ws,
         })
     }
@@ -457,13 +482,22 @@ impl<B: Basis> NonsmoothSystem<B> {
 
     /// The Gram matrices `G(w_gap)` and `G(w_force)` of law `l` (after [`Self::sample_laws`]),
     /// into the workspace: the two halves of the law's Jacobian block.
+    /// When the force weight is an affine function of the gap weight (complementarity laws),
+    /// `G(w_force)` is formed from `G(w_gap)` and `G(1)` instead of by a transform.
     fn law_grams(&self, ws: &mut Workspace, l: usize) {
         let n = self.basis.samples();
         let range = l * n..(l + 1) * n;
-        self.basis
-            .weighted_gram(&ws.w_gap[range.clone()], &mut ws.gram_gap);
-        self.basis
-            .weighted_gram(&ws.w_force[range], &mut ws.gram_force);
+        let (w_gap, w_force) = (&ws.w_gap[range.clone()], &ws.w_force[range]);
+        self.basis.weighted_gram(w_gap, &mut ws.gram_gap);
+        match affine_relation(w_gap, w_force) {
+            Some((alpha, beta)) => {
+                let terms = self.unit_gram.iter().zip(&ws.gram_gap);
+                for (g, (u, w)) in ws.gram_force.iter_mut().zip(terms) {
+                    *g = alpha * u + beta * w;
+                }
+            }
+            None => self.basis.weighted_gram(w_force, &mut ws.gram_force),
+        }
     }
 
     /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid).
@@ -760,7 +794,8 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let size = len * c;
         let mut red = std::mem::take(&mut self.reduced);
         let mut ws = std::mem::take(&mut self.ws);
-        // Every entry is written below (one column block per law and coefficient).
+        // Every entry of the transposed reduced matrix is written below (one column per law
+        // row).
         red.matrix.reshape(size, size);
         red.rhs.clear();
         red.rhs.resize(size, 0.0);
@@ -792,13 +827,25 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
                 );
                 red.rhs[row] = -f[base + row] - dot(gg, &red.gap_p) - dot(gf, &red.force_p);
             }
-            // Column by column (the matrix is column-major): contiguous writes.
-            for col in 0..len * c {
-                let (gz, fz) = (red.gap_z[col], red.force_z[col]);
-                let i = col / c;
-                let column = &mut red.matrix.column_mut(col)[l * len..(l + 1) * len];
-                for (j, m) in column.iter_mut().enumerate() {
-                    *m = ws.gram_gap[j * len + i] * gz + ws.gram_force[j * len + i] * fz;
+            // The transpose is stored (column `l len + j` of the column-major storage is
+            // row `j` of the law's block): reads of the row-major Gram matrices and writes
+            // are both contiguous.
+            for j in 0..len {
+                let (gg, gf) = (
+                    &ws.gram_gap[j * len..(j + 1) * len],
+                    &ws.gram_force[j * len..(j + 1) * len],
+                );
+                let out = red.matrix.column_mut(l * len + j);
+                let zs = red.gap_z.iter().zip(&red.force_z);
+                if c == 1 {
+                    // One bar end per law (the common case): a plain vectorisable loop.
+                    for ((m, (gz, fz)), (g, f)) in out.iter_mut().zip(zs).zip(gg.iter().zip(gf)) {
+                        *m = g * gz + f * fz;
+                    }
+                } else {
+                    for (col, (m, (gz, fz))) in out.iter_mut().zip(zs).enumerate() {
+                        *m = gg[col / c] * gz + gf[col / c] * fz;
+                    }
                 }
             }
         }
@@ -810,7 +857,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
                 ratio: p.ratio,
             }));
         }
-        red.lu.solve_in_place(&mut red.rhs);
+        red.lu.solve_transpose_in_place(&mut red.rhs);
         for i in 0..len {
             let cd = &self.condensed[self.basis.harmonic(i)];
             let dxi = &mut dx[i * un..(i + 1) * un];
@@ -831,5 +878,51 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             .map(|o| o.0.abs())
             .fold(0.0, f64::max)
             .max(f64::MIN_POSITIVE)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::affine_relation;
+    use crate::fourier::{Basis, CosineBasis};
+
+    #[test]
+    fn complementarity_weights_are_affinely_related() {
+        // Signorini with a_c = 4: contact samples (4, 0), free samples (0, 1).
+        let (w_gap, w_force) = ([4.0, 0.0, 0.0, 4.0], [0.0, 1.0, 1.0, 0.0]);
+        let (alpha, beta) = affine_relation(&w_gap, &w_force).unwrap();
+        assert!((alpha - 1.0).abs() < 1e-15 && (beta + 0.25).abs() < 1e-15);
+        // One branch everywhere: the force weight is a constant.
+        assert_eq!(affine_relation(&[0.0; 3], &[1.0; 3]), Some((1.0, 0.0)));
+        // Not affine: three distinct pairs off one line.
+        assert_eq!(affine_relation(&[0.0, 1.0, 2.0], &[1.0, 0.0, 1.0]), None);
+        assert_eq!(affine_relation(&[0.0, 0.0], &[1.0, 0.5]), None);
+    }
+
+    #[test]
+    fn the_gram_matrix_is_linear_in_the_weight() {
+        // What the shortcut relies on: G(alpha + beta w) = alpha G(1) + beta G(w).
+        let basis = CosineBasis::new(9, 5).unwrap();
+        let (n, len) = (basis.samples(), basis.len());
+        let w: Vec<f64> = (0..n)
+            .map(|k| ((k * 37) % 13) as f64 / 13.0 - 0.3)
+            .collect();
+        let (alpha, beta) = (0.7, -1.9);
+        let combined: Vec<f64> = w.iter().map(|v| alpha + beta * v).collect();
+        let (mut g, mut g1, mut gw) = (
+            vec![0.0; len * len],
+            vec![0.0; len * len],
+            vec![0.0; len * len],
+        );
+        basis.weighted_gram(&combined, &mut g);
+        basis.weighted_gram(&vec![1.0; n], &mut g1);
+        basis.weighted_gram(&w, &mut gw);
+        for ((a, u), b) in g.iter().zip(&g1).zip(&gw) {
+            assert!(
+                (a - (alpha * u + beta * b)).abs() < 1e-13,
+                "{a} vs {}",
+                alpha * u + beta * b
+            );
+        }
     }
 }
