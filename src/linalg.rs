@@ -49,14 +49,6 @@ impl DenseMatrix {
         self.data.resize(nrows * ncols, 0.0);
     }
 
-    /// Resizes to `nrows x ncols` keeping the storage, without clearing: the entries are left
-    /// over from earlier contents, for callers that overwrite every entry.
-    pub(crate) fn reshape(&mut self, nrows: usize, ncols: usize) {
-        self.nrows = nrows;
-        self.ncols = ncols;
-        self.data.resize(nrows * ncols, 0.0);
-    }
-
     /// Column `j` as a mutable slice.
     ///
     /// # Panics
@@ -174,10 +166,26 @@ impl Lu {
     /// If `a` is not square.
     pub fn refactor(&mut self, a: &DenseMatrix, tol: f64) -> Result<(), SmallPivot> {
         assert_eq!(a.nrows, a.ncols, "LU of a non-square matrix");
-        let n = a.nrows;
-        self.n = n;
+        self.n = a.nrows;
         self.factors.clear();
         self.factors.extend_from_slice(&a.data);
+        self.factor_stored(tol)
+    }
+
+    /// The column-major storage of an `n x n` matrix to be factorised by
+    /// [`Lu::factor_stored`]: a caller that assembles its matrix here saves the copy of
+    /// [`Lu::refactor`]. The contents are unspecified until written.
+    pub(crate) fn storage(&mut self, n: usize) -> &mut [f64] {
+        self.n = n;
+        self.factors.resize(n * n, 0.0);
+        &mut self.factors
+    }
+
+    /// Factorises in place the matrix written into [`Lu::storage`]; fails like
+    /// [`Lu::refactor`].
+    pub(crate) fn factor_stored(&mut self, tol: f64) -> Result<(), SmallPivot> {
+        let n = self.n;
+        assert_eq!(self.factors.len(), n * n, "storage of an n x n matrix");
         self.perm.resize(n, 0);
         self.perm_inv.resize(n, 0);
         if self.scratch.is_none() || self.scratch_n < n {

@@ -189,7 +189,7 @@ pub struct NonsmoothSystem<B: Basis = CosineBasis> {
 /// Scratch of the structured Newton step: the reduced matrix, its LU and vectors.
 #[derive(Default)]
 struct Reduced {
-    matrix: DenseMatrix,
+    /// LU of the transposed reduced matrix, assembled in its storage.
     lu: Lu,
     rhs: Vec<f64>,
     gap_z: Vec<f64>,
@@ -208,7 +208,7 @@ impl Clone for Reduced {
 impl std::fmt::Debug for Reduced {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Reduced")
-            .field("size", &self.matrix.nrows())
+            .field("size", &self.rhs.len())
             .finish_non_exhaustive()
     }
 }
@@ -596,8 +596,10 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         if !(same(&ws.along.start, x) && same(&ws.along.direction, dx)) {
             let along = &mut ws.along;
             if same(&ws.sampled, x) {
-                along.gap.clone_from(&ws.gap);
-                along.force.clone_from(&ws.force);
+                // The samples of x move to the line search: the trials overwrite `ws` next.
+                std::mem::swap(&mut along.gap, &mut ws.gap);
+                std::mem::swap(&mut along.force, &mut ws.force);
+                ws.sampled = None;
             } else {
                 self.synthesize_observables(
                     x,
@@ -794,9 +796,9 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let size = len * c;
         let mut red = std::mem::take(&mut self.reduced);
         let mut ws = std::mem::take(&mut self.ws);
-        // Every entry of the transposed reduced matrix is written below (one column per law
-        // row).
-        red.matrix.reshape(size, size);
+        // Every entry of the transposed reduced matrix is written below, straight into the
+        // LU's storage (one column per law row).
+        red.lu.storage(size);
         red.rhs.clear();
         red.rhs.resize(size, 0.0);
         red.gap_z.resize(len * c, 0.0);
@@ -835,7 +837,8 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
                     &ws.gram_gap[j * len..(j + 1) * len],
                     &ws.gram_force[j * len..(j + 1) * len],
                 );
-                let out = red.matrix.column_mut(l * len + j);
+                let column = (l * len + j) * size;
+                let out = &mut red.lu.storage(size)[column..column + size];
                 let zs = red.gap_z.iter().zip(&red.force_z);
                 if c == 1 {
                     // One bar end per law (the common case): a plain vectorisable loop.
@@ -850,7 +853,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             }
         }
         self.ws = ws;
-        if let Err(p) = red.lu.refactor(&red.matrix, REDUCED_PIVOT_TOLERANCE) {
+        if let Err(p) = red.lu.factor_stored(REDUCED_PIVOT_TOLERANCE) {
             self.reduced = red;
             return Some(Err(SingularStep {
                 pivot: p.pivot,
