@@ -123,7 +123,8 @@ impl Workspace {
 /// `(alpha, beta)` with `w_force[k] = alpha + beta w_gap[k]` at every sample (to a few
 /// roundings), if there are such: the Gram matrix is linear in the weight, so then
 /// `G(w_force) = alpha G(1) + beta G(w_gap)` and one transform is saved. Complementarity laws
-/// (Signorini, contact) always have it: `w_gap` is 0 or `a_c` and `w_force = 1 - w_gap / a_c`.
+/// (Signorini, contact) always have it: for `r = -min(lambda, a_c g)`, `w_gap` is 0 or `-a_c`
+/// and `w_force = -1 - w_gap / a_c`.
 fn affine_relation(w_gap: &[f64], w_force: &[f64]) -> Option<(f64, f64)> {
     let (&g0, &f0) = (w_gap.first()?, w_force.first()?);
     let (alpha, beta) = match w_gap.iter().position(|&g| g != g0) {
@@ -891,10 +892,11 @@ mod tests {
 
     #[test]
     fn complementarity_weights_are_affinely_related() {
-        // Signorini with a_c = 4: contact samples (4, 0), free samples (0, 1).
-        let (w_gap, w_force) = ([4.0, 0.0, 0.0, 4.0], [0.0, 1.0, 1.0, 0.0]);
+        // Signorini with a_c = 4 (`r = -min(lambda, a_c g)`): gap-branch samples (-4, 0),
+        // force-branch samples (0, -1).
+        let (w_gap, w_force) = ([-4.0, 0.0, 0.0, -4.0], [0.0, -1.0, -1.0, 0.0]);
         let (alpha, beta) = affine_relation(&w_gap, &w_force).unwrap();
-        assert!((alpha - 1.0).abs() < 1e-15 && (beta + 0.25).abs() < 1e-15);
+        assert!((alpha + 1.0).abs() < 1e-15 && (beta + 0.25).abs() < 1e-15);
         // One branch everywhere: the force weight is a constant.
         assert_eq!(affine_relation(&[0.0; 3], &[1.0; 3]), Some((1.0, 0.0)));
         // Not affine: three distinct pairs off one line.
