@@ -57,8 +57,9 @@ impl NewtonOptions {
     /// step length `1e-4` (instead of `1e-10`) and the stagnation test is on
     /// (`stall_window = 15`, `stall_ratio = 0.5`). A start that needs steps shorter than
     /// `1e-4` or fifteen iterations to halve its residual is outside every solution's basin
-    /// in practice, and so is one that has spent 80 residual evaluations; the default settings spend most of a backbone's time proving it
-    /// (`docs/performance.md`). On the clamped bar's 181-step backbone they converge the same
+    /// in practice, and so is one that has spent 80 residual evaluations
+    /// ([`NewtonOptions::max_evaluations`]); the default settings spend most of a backbone's
+    /// time proving it (`docs/performance.md`). On the clamped bar's 181-step backbone they converge the same
     /// steps as the defaults at `m = 20` and `40` and two fewer at `m = 80` (169 of 181), in a
     /// half to a third of the time. Not for
     /// far starts (a seed, the jumps of [`crate::continuation::StallEscape`]): those can need

@@ -483,6 +483,7 @@ impl<B: Basis> NonsmoothSystem<B> {
 
     /// The Gram matrices `G(w_gap)` and `G(w_force)` of law `l` (after [`Self::sample_laws`]),
     /// into the workspace: the two halves of the law's Jacobian block.
+    ///
     /// When the force weight is an affine function of the gap weight (complementarity laws),
     /// `G(w_force)` is formed from `G(w_gap)` and `G(1)` instead of by a transform.
     fn law_grams(&self, ws: &mut Workspace, l: usize) {
@@ -799,7 +800,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         let mut ws = std::mem::take(&mut self.ws);
         // Every entry of the transposed reduced matrix is written below, straight into the
         // LU's storage (one column per law row).
-        red.lu.storage(size);
+        let matrix = red.lu.storage(size);
         red.rhs.clear();
         red.rhs.resize(size, 0.0);
         red.gap_z.resize(len * c, 0.0);
@@ -839,7 +840,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
                     &ws.gram_force[j * len..(j + 1) * len],
                 );
                 let column = (l * len + j) * size;
-                let out = &mut red.lu.storage(size)[column..column + size];
+                let out = &mut matrix[column..column + size];
                 let zs = red.gap_z.iter().zip(&red.force_z);
                 if c == 1 {
                     // One bar end per law (the common case): a plain vectorisable loop.
