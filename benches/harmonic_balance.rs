@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the harmonic-balance hot path on the clamped bar with an obstacle
 //! (gap `1e-3`, `n_h = 30`): residual, generalised Jacobian, one continuation step's solve,
-//! whole 181-step backbones at `m = 20, 40, 80`, and a sweep of backbones (parallel with
-//! `--features parallel`).
+//! whole 181-step backbones at `m = 20, 40, 80`, a sweep of backbones (parallel with
+//! `--features parallel`), and the closed-form energy of a point.
 //!
 //! ```text
 //! cargo bench --bench harmonic_balance                       # everything
@@ -11,8 +11,11 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nonsmooth_modes::continuation::{AtParameter, ContinuationProblem};
+use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::modal::{
+    backbone, energy, energy_at, BackboneOptions, BackbonePoint, PeriodGrid,
+};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
@@ -166,11 +169,30 @@ fn sweep(c: &mut Criterion) {
     group.finish();
 }
 
+/// The closed-form energy of a point near the branch (computed once per continuation point):
+/// at `theta = 0` (strain only, the common call) and at `theta = 0.3` (kinetic part too).
+fn energy_of_point(c: &mut Criterion) {
+    let system = clamped_bar_with_obstacle(GAP).unwrap();
+    let mut group = c.benchmark_group("energy");
+    for m in [40, 160] {
+        let (_, p) = two_points(&system, m);
+        let basis = CosineBasis::new(m, settings(m).samples_per_harmonic).unwrap();
+        group.bench_with_input(BenchmarkId::new("theta_0", m), &p, |b, p| {
+            b.iter(|| energy(&system, &basis, black_box(&p.x), p.omega));
+        });
+        group.bench_with_input(BenchmarkId::new("theta_0.3", m), &p, |b, p| {
+            b.iter(|| energy_at(&system, &basis, black_box(&p.x), p.omega, 0.3));
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     residual_and_jacobian,
     one_solve,
     whole_backbone,
-    sweep
+    sweep,
+    energy_of_point
 );
 criterion_main!(benches);

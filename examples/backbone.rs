@@ -5,7 +5,7 @@
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
-//!     [--newton fail-fast|full] [--retry-depth K] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--newton fail-fast|full] [--retry-depth K] [--serial] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
@@ -30,14 +30,16 @@
 //! `--newton full` (`NewtonOptions::default`, the default of arclength runs, whose stall
 //! escapes solve from far starts). A failed sequential step is retried from up to
 //! `--retry-depth` earlier converged points (`SequentialOptions::retry_depth`, default 1; 0
-//! switches the retry off).
+//! switches the retry off). Where the machine has more than one core, the first retry runs on
+//! a second thread beside the first attempt (`backbone_speculative_with`; the same points, bit
+//! for bit); `--serial` keeps everything on one thread.
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
     linspace, Arclength, ArclengthOptions, ArclengthOutcome, Event, Point, Sequential,
-    SequentialOptions, StallEscape,
+    SequentialOptions, Speculation, StallEscape,
 };
-use nonsmooth_modes::modal::backbone::backbone_with;
+use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, energy, grazing_energy, ArclengthBackboneOptions,
     BackboneOptions, BackbonePoint, PeriodGrid,
@@ -45,10 +47,12 @@ use nonsmooth_modes::modal::{
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{Dogleg, NewtonOptions, NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{
+    Dogleg, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton, SolveInfo,
+};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
-use nonsmooth_modes::ModelError;
+use nonsmooth_modes::{ModelError, SolveError};
 use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -57,7 +61,7 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
   [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--out FILE]
+  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--serial] [--out FILE]
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
@@ -98,6 +102,8 @@ struct Args {
     /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
     fail_fast: Option<bool>,
     retry_depth: usize,
+    /// No speculative retry on a second thread.
+    serial: bool,
     out: Option<String>,
     arclength: bool,
     driver: ArclengthOptions,
@@ -149,6 +155,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         dogleg: false,
         fail_fast: None,
         retry_depth: 1,
+        serial: false,
         out: None,
         arclength: false,
         driver: ArclengthOptions {
@@ -202,6 +209,7 @@ fn parse() -> Result<Args, lexopt::Error> {
                 }
             }
             Long("retry-depth") => a.retry_depth = parser.value()?.parse()?,
+            Long("serial") => a.serial = true,
             Long("out") => a.out = Some(parser.value()?.string()?),
             Long("method") => {
                 a.arclength = match parser.value()?.string()?.as_str() {
@@ -352,6 +360,29 @@ impl Sink<'_> {
     }
 }
 
+/// The solver of the command line (a plain enum, so that it can be cloned onto the thread of
+/// speculative retries).
+#[derive(Debug, Clone, Copy)]
+enum Solver {
+    Newton(SemismoothNewton),
+    Dogleg(Dogleg),
+}
+
+impl NonlinearSolver for Solver {
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+        match self {
+            Solver::Newton(s) => s.solve(problem, x),
+            Solver::Dogleg(s) => s.solve(problem, x),
+        }
+    }
+    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+        match self {
+            Solver::Newton(s) => s.tolerance(problem),
+            Solver::Dogleg(s) => s.tolerance(problem),
+        }
+    }
+}
+
 fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::error::Error>> {
     let system = build_system(a, Parameter::Omega, f64::NAN)?;
     let (t0, t1) = default_periods(a.system);
@@ -375,14 +406,14 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
         error: None,
         progress: a.progress,
     };
-    let solver: Box<dyn NonlinearSolver> = if a.dogleg {
-        Box::new(Dogleg::default())
+    let solver = if a.dogleg {
+        Solver::Dogleg(Dogleg::default())
     } else if a.fail_fast.unwrap_or(!a.arclength) {
         // Sequential steps start from a converged neighbour: give up early.
-        Box::new(SemismoothNewton::new(NewtonOptions::fail_fast())?)
+        Solver::Newton(SemismoothNewton::new(NewtonOptions::fail_fast())?)
     } else {
         // Arclength's stall escapes solve from far starts: the full budget.
-        Box::new(SemismoothNewton::default())
+        Solver::Newton(SemismoothNewton::default())
     };
     if a.parameter != Parameter::Omega {
         run_parameter(a, t0, solver, &mut sink)?;
@@ -418,9 +449,14 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             retry_depth: a.retry_depth,
             ..Default::default()
         };
-        backbone_with(&system, a.settings, &options, solver, |p| {
-            sink.row(&system, p, f64::NAN)
-        })?;
+        let see = |p: &BackbonePoint| sink.row(&system, p, f64::NAN);
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        if a.serial || cores < 2 {
+            backbone_with(&system, a.settings, &options, solver, see)?;
+        } else {
+            let speculation = Speculation::default();
+            backbone_speculative_with(&system, a.settings, &options, speculation, solver, see)?;
+        }
     }
     if let Some(e) = sink.error {
         return Err(e.into());
@@ -432,7 +468,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
 fn run_parameter(
     a: &Args,
     period: f64,
-    solver: Box<dyn NonlinearSolver>,
+    solver: Solver,
     sink: &mut Sink<'_>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let parameter = a.parameter;

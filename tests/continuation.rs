@@ -212,6 +212,7 @@ fn iterator_restart_and_reverse_direction() {
 
 /// `F(x, lambda) = x - s(lambda)` with a spike `s(0.2) = 0.55` between `s(0.1) = 0.1` and
 /// `s(0.3) = 0`.
+#[derive(Clone)]
 struct Spiky;
 
 impl ContinuationProblem for Spiky {
@@ -238,8 +239,11 @@ impl ContinuationProblem for Spiky {
 }
 
 /// A local solver: one exact Newton step when the start is within 0.5 of the solution,
-/// otherwise a failure.
-struct Local;
+/// otherwise a failure (after `patience`, to let a speculative retry start beside it).
+#[derive(Clone, Copy, Default)]
+struct Local {
+    patience: std::time::Duration,
+}
 
 impl nonsmooth_modes::solve::NonlinearSolver for Local {
     fn solve(
@@ -250,6 +254,7 @@ impl nonsmooth_modes::solve::NonlinearSolver for Local {
         let mut f = [0.0];
         problem.residual(x, &mut f);
         if f[0].abs() > 0.5 {
+            std::thread::sleep(self.patience);
             return Err(nonsmooth_modes::SolveError::MaxIterations {
                 iterations: 0,
                 residual_norm: f[0].abs(),
@@ -280,7 +285,7 @@ fn sequential_retry_steps_back_over_a_spike() {
             retry_depth,
             ..Default::default()
         };
-        Sequential::new(Spiky, Local, vec![0.0], values.clone(), options)
+        Sequential::new(Spiky, Local::default(), vec![0.0], values.clone(), options)
             .unwrap()
             .map(|p| (p.converged, p.x[0]))
             .collect::<Vec<_>>()
@@ -302,4 +307,97 @@ fn sequential_retry_steps_back_over_a_spike() {
     assert!(!without[3].0);
     assert_eq!(without[4], (true, 0.4));
     assert_eq!(SequentialOptions::default().retry_depth, 1);
+}
+
+/// The speculative driver gives the serial points, whether the worker solves the retry (the
+/// first attempt fails slowly) or the driver takes it back (it fails at once), and every
+/// handed-over retry is accounted for.
+#[test]
+fn speculative_retries_give_the_serial_points() {
+    use nonsmooth_modes::continuation::{Sequential, SequentialOptions, Speculation};
+    let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
+    let driver = |patience| {
+        let solver = Local { patience };
+        Sequential::new(
+            Spiky,
+            solver,
+            vec![0.0],
+            values.clone(),
+            SequentialOptions::default(),
+        )
+        .unwrap()
+    };
+    let serial: Vec<_> = driver(Default::default()).collect();
+    assert!(!serial.is_empty() && serial.iter().all(|p| p.converged));
+    let every_step = Speculation {
+        after_evaluations: 0,
+    };
+    for patience_ms in [0, 300] {
+        let mut speculative = driver(std::time::Duration::from_millis(patience_ms));
+        let mut points = Vec::new();
+        speculative
+            .run_speculative(every_step, |p| {
+                points.push(p.clone());
+                ControlFlow::Continue(())
+            })
+            .unwrap();
+        assert_eq!(points, serial);
+        let stats = speculative.speculation_stats();
+        // One job per step with a history (steps 1 to 4); only lambda = 0.3 fails first.
+        assert_eq!(stats.launched, 4);
+        assert_eq!(stats.cancelled, 3);
+        assert_eq!(stats.used + stats.taken_back, 1);
+        if patience_ms > 0 {
+            // The first attempt failed 0.3 s after handing the retry over.
+            assert_eq!(stats.used, 1);
+        }
+    }
+    // A retry never handed over: no job, the serial path.
+    let mut never = driver(Default::default());
+    let late = Speculation {
+        after_evaluations: usize::MAX,
+    };
+    let points: Vec<_> = std::iter::from_fn(|| match never.step_speculative(late) {
+        nonsmooth_modes::continuation::StepOutcome::Converged(p)
+        | nonsmooth_modes::continuation::StepOutcome::Failed(p) => Some(p),
+        _ => None,
+    })
+    .collect();
+    assert_eq!(points, serial);
+    assert_eq!(never.speculation_stats(), Default::default());
+}
+
+/// On the clamped bar at m = 40 (16 first attempts fail, 5 retries converge) the speculative
+/// backbone is the serial one, bit for bit.
+#[test]
+fn speculative_backbone_is_the_serial_backbone() {
+    use nonsmooth_modes::continuation::Speculation;
+    use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
+    use nonsmooth_modes::solve::NewtonOptions;
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let settings = HarmonicBalance {
+        harmonics: 40,
+        ..Default::default()
+    };
+    let options = BackboneOptions::default();
+    let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
+    let collect = |speculation: Option<Speculation>| {
+        let mut points = Vec::new();
+        let see = |p: &BackbonePoint| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        };
+        match speculation {
+            None => backbone_with(&system, settings, &options, solver, see),
+            Some(s) => backbone_speculative_with(&system, settings, &options, s, solver, see),
+        }
+        .unwrap();
+        points
+    };
+    let serial = collect(None);
+    assert_eq!(serial.len(), 181);
+    assert!(serial.iter().filter(|p| !p.converged).count() > 0);
+    for after_evaluations in [0, 10] {
+        assert_eq!(collect(Some(Speculation { after_evaluations })), serial);
+    }
 }

@@ -12,6 +12,7 @@
 mod arclength;
 mod progress;
 mod sequential;
+mod speculative;
 
 pub use arclength::{
     Arclength, ArclengthOptions, ArclengthOutcome, ArclengthScale, Branch, EndReason, RejectReason,
@@ -19,6 +20,7 @@ pub use arclength::{
 };
 pub use progress::{quiet, Progress};
 pub use sequential::{linspace, Predictor, Sequential, SequentialOptions, StepOutcome};
+pub use speculative::{Speculation, SpeculationStats};
 
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;

@@ -61,8 +61,13 @@ pub enum StepOutcome {
 /// [`SequentialOptions::retry_depth`] allows, from earlier converged points). Failed steps are reported and skipped; the next step starts again from the last
 /// converged solution.
 pub struct Sequential<P, S> {
-    problem: P,
-    solver: S,
+    pub(super) problem: P,
+    pub(super) solver: S,
+    /// The thread of speculative retries (started on first use by
+    /// [`Sequential::step_speculative`]).
+    pub(super) worker: Option<super::speculative::Worker>,
+    /// Counts of [`Sequential::step_speculative`]'s retries.
+    pub(super) speculation: super::SpeculationStats,
     values: Vec<f64>,
     options: SequentialOptions,
     next: usize,
@@ -72,11 +77,43 @@ pub struct Sequential<P, S> {
     history: VecDeque<(Vec<f64>, f64)>,
     failures: usize,
     stalled: bool,
-    accept: Option<Acceptance>,
+    pub(super) accept: Option<Acceptance>,
+}
+
+/// One solve of a step: where it ended, how, and from which start.
+pub(super) struct Attempt {
+    pub x: Vec<f64>,
+    pub result: Result<SolveInfo, SolveError>,
+    /// Whether the acceptance test took the solution.
+    pub accepted: bool,
+    /// `None` for the prediction, `Some(d)` for the start `history[d]`.
+    pub from_history: Option<usize>,
+}
+
+impl Attempt {
+    /// Whether the solve converged to a solution the driver accepts.
+    pub fn joins(&self) -> bool {
+        self.result.is_ok() && self.accepted
+    }
 }
 
 /// A test that a converged solution `(x, lambda)` belongs to the branch.
-type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
+pub(super) type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
+
+/// Whether a solve's outcome joins the branch: it converged and the acceptance test (if any)
+/// takes the solution.
+pub(super) fn accepts(
+    accept: &mut Option<Acceptance>,
+    result: &Result<SolveInfo, SolveError>,
+    x: &[f64],
+    lambda: f64,
+) -> bool {
+    match (result, accept.as_mut()) {
+        (Ok(_), Some(accept)) => accept(x, lambda),
+        (Ok(_), None) => true,
+        (Err(_), _) => false,
+    }
+}
 
 impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     /// A driver visiting `values` in order from the guess `start`.
@@ -113,6 +150,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             last_lambda: values[0],
             problem,
             solver,
+            worker: None,
+            speculation: Default::default(),
             values,
             options,
             next: 0,
@@ -142,7 +181,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         (&self.last, self.last_lambda)
     }
 
-    fn predict(&self, lambda: f64) -> Vec<f64> {
+    pub(super) fn predict(&self, lambda: f64) -> Vec<f64> {
         match (self.options.predictor, self.history.front()) {
             (Predictor::Secant, Some((prev, prev_lambda))) if *prev_lambda != self.last_lambda => {
                 let s = (lambda - self.last_lambda) / (self.last_lambda - prev_lambda);
@@ -161,46 +200,90 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         self.values[step.saturating_sub(1)]
     }
 
-    /// Solves at `lambda` from `x`; returns the solver's result and whether the acceptance
-    /// test (if any) took the solution.
-    fn attempt(&mut self, lambda: f64, x: &mut [f64]) -> (Result<SolveInfo, SolveError>, bool) {
+    /// Solves at `lambda` from `x` with the driver's own problem; returns the solver's result
+    /// and whether the acceptance test (if any) took the solution.
+    pub(super) fn attempt(
+        &mut self,
+        lambda: f64,
+        x: &mut [f64],
+    ) -> (Result<SolveInfo, SolveError>, bool) {
         let mut frozen = AtParameter {
             problem: &mut self.problem,
             lambda,
         };
         let result = self.solver.solve(&mut frozen, x);
-        let accepted = match (&result, self.accept.as_mut()) {
-            (Ok(_), Some(accept)) => accept(x, lambda),
-            _ => true,
-        };
+        let accepted = accepts(&mut self.accept, &result, x, lambda);
         (result, accepted)
+    }
+
+    /// The index and value of the next parameter, advancing the driver; `None` when the
+    /// values are exhausted or the run stalled.
+    pub(super) fn next_value(&mut self) -> Option<(usize, f64)> {
+        if self.stalled {
+            return None;
+        }
+        let lambda = *self.values.get(self.next)?;
+        self.next += 1;
+        Some((self.next - 1, lambda))
+    }
+
+    /// The number of earlier converged points a failed step may be retried from.
+    pub(super) fn retry_count(&self) -> usize {
+        self.options.retry_depth.min(self.history.len())
+    }
+
+    /// The start of retry `d`: the converged point `d + 1` places before the last.
+    pub(super) fn retry_start(&self, d: usize) -> Vec<f64> {
+        self.history[d].0.clone()
+    }
+
+    /// Retries from `history[from..]` while `attempt` has not joined the branch.
+    pub(super) fn retry_from(&mut self, lambda: f64, from: usize, attempt: Attempt) -> Attempt {
+        let mut attempt = attempt;
+        for d in from..self.retry_count() {
+            if attempt.joins() {
+                break;
+            }
+            let mut y = self.retry_start(d);
+            let (result, accepted) = self.attempt(lambda, &mut y);
+            if result.is_ok() && accepted {
+                attempt = Attempt {
+                    x: y,
+                    result,
+                    accepted,
+                    from_history: Some(d),
+                };
+            }
+        }
+        attempt
     }
 
     /// Solves at the next parameter value.
     pub fn step(&mut self) -> StepOutcome {
-        if self.stalled {
-            return StepOutcome::Finished;
-        }
-        let Some(&lambda) = self.values.get(self.next) else {
+        let Some((step, lambda)) = self.next_value() else {
             return StepOutcome::Finished;
         };
-        let step = self.next;
-        self.next += 1;
         let mut x = self.predict(lambda);
-        let (mut result, mut accepted) = self.attempt(lambda, &mut x);
-        // Which start converged: `None` for the prediction, `Some(d)` for `history[d]`.
-        let mut from_history = None;
-        if !(result.is_ok() && accepted) {
-            let depth = self.options.retry_depth.min(self.history.len());
-            for d in 0..depth {
-                let mut y = self.history[d].0.clone();
-                let (again, again_accepted) = self.attempt(lambda, &mut y);
-                if again.is_ok() && again_accepted {
-                    (x, result, accepted, from_history) = (y, again, true, Some(d));
-                    break;
-                }
-            }
-        }
+        let (result, accepted) = self.attempt(lambda, &mut x);
+        let first = Attempt {
+            x,
+            result,
+            accepted,
+            from_history: None,
+        };
+        let chosen = self.retry_from(lambda, 0, first);
+        self.conclude(step, lambda, chosen)
+    }
+
+    /// Records the outcome of the step at `lambda`: on success the point joins the branch
+    /// (and the history), on failure the failure count grows.
+    pub(super) fn conclude(&mut self, step: usize, lambda: f64, chosen: Attempt) -> StepOutcome {
+        let Attempt {
+            x,
+            result,
+            accepted,
+            from_history,
+        } = chosen;
         match result {
             Ok(info) if accepted => {
                 self.failures = 0;
@@ -280,19 +363,29 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     /// [`ContinuationError::Stalled`] if too many consecutive steps failed.
     pub fn run(
         &mut self,
-        mut observer: impl FnMut(&Point) -> ControlFlow<()>,
+        observer: impl FnMut(&Point) -> ControlFlow<()>,
     ) -> Result<usize, ContinuationError> {
-        let mut taken = 0;
-        loop {
-            let point = match self.step() {
-                StepOutcome::Converged(p) | StepOutcome::Failed(p) => p,
-                StepOutcome::Finished => return Ok(taken),
-                StepOutcome::Stalled(e) => return Err(e),
-            };
-            taken += 1;
-            if observer(&point).is_break() {
-                return Ok(taken);
-            }
+        run_with(self, Self::step, observer)
+    }
+}
+
+/// Steps `driver` with `step` until the values run out, the run stalls or `observer` stops
+/// it; returns the number of steps taken.
+pub(super) fn run_with<D>(
+    driver: &mut D,
+    mut step: impl FnMut(&mut D) -> StepOutcome,
+    mut observer: impl FnMut(&Point) -> ControlFlow<()>,
+) -> Result<usize, ContinuationError> {
+    let mut taken = 0;
+    loop {
+        let point = match step(driver) {
+            StepOutcome::Converged(p) | StepOutcome::Failed(p) => p,
+            StepOutcome::Finished => return Ok(taken),
+            StepOutcome::Stalled(e) => return Err(e),
+        };
+        taken += 1;
+        if observer(&point).is_break() {
+            return Ok(taken);
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::continuation::{
     linspace, Arclength, ArclengthOptions, ArclengthOutcome, Branch, Event, PeriodParametrised,
-    Point, Predictor, Sequential, SequentialOptions, StallEscape,
+    Point, Predictor, Sequential, SequentialOptions, Speculation, StallEscape,
 };
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
@@ -134,6 +134,47 @@ pub fn backbone_with<S: NonlinearSolver>(
     settings: HarmonicBalance,
     options: &BackboneOptions,
     solver: S,
+    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+) -> Result<f64, Error> {
+    let run = |driver: &mut Sequential<_, S>, see: &mut dyn FnMut(&Point) -> ControlFlow<()>| {
+        driver.run(see)
+    };
+    drive_backbone(system, settings, options, solver, run, observer)
+}
+
+/// [`backbone_with`] with the first retry of each failing step run on a second thread beside
+/// the first attempt ([`Sequential::step_speculative`]): the same points, bit for bit, in
+/// less wall time when steps fail and a second core is free. The retries run on a worker
+/// thread with clones of the problem and the solver, so the solver must be `Clone + Send +
+/// 'static` (the crate's solvers are).
+///
+/// # Errors
+/// See [`backbone_with`].
+pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
+    system: &BarSystem,
+    settings: HarmonicBalance,
+    options: &BackboneOptions,
+    speculation: Speculation,
+    solver: S,
+    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+) -> Result<f64, Error> {
+    let run = |driver: &mut Sequential<_, S>, see: &mut dyn FnMut(&Point) -> ControlFlow<()>| {
+        driver.run_speculative(speculation, see)
+    };
+    drive_backbone(system, settings, options, solver, run, observer)
+}
+
+/// The driver of a sequential backbone (seed, grid, acceptance test, energies) with the loop
+/// itself left to `run`.
+fn drive_backbone<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalance,
+    options: &BackboneOptions,
+    solver: S,
+    run: impl FnOnce(
+        &mut Sequential<PeriodParametrised<NonsmoothSystem>, S>,
+        &mut dyn FnMut(&Point) -> ControlFlow<()>,
+    ) -> Result<usize, ContinuationError>,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
@@ -188,7 +229,7 @@ pub fn backbone_with<S: NonlinearSolver>(
         (last.1, last.2) = (period, e);
         e > floor
     });
-    driver.run(|p: &Point| {
+    run(&mut driver, &mut |p: &Point| {
         let omega = 2.0 * PI / p.lambda;
         let known = {
             let last = last_energy.borrow();

@@ -12,6 +12,16 @@
 //!
 //! and the diagonal terms (`k_i = k_j`) have elementary closed forms. The energy of a motion is
 //! then a quadratic form in the harmonics: `O(m^2)` flops per bar, no quadrature.
+//!
+//! The pair sum is the hot part (it runs once per continuation point), so its data is laid
+//! out for SIMD: the harmonics of a bar are stored `LANES` at a time, field by field
+//! (`Block`), and each row `sum_{j<i}` runs over whole blocks with one independent
+//! accumulator per lane, with no branch and no bounds check. Green's identity does not apply
+//! to equal wavenumbers, so the row loop ignores them: the diagonal `j = i` is added from its
+//! closed form, and a row that meets a duplicate `k_j = k_i` (`j < i`; never with the cosine
+//! basis at `omega != 0`, but e.g. at `omega = 0` or with a basis holding both the cosine and
+//! the sine of one harmonic) divides by zero, comes out infinite or NaN, and is redone pair by
+//! pair with the diagonal closed form for the duplicates.
 
 use crate::bar::{Bar, End, EndRef};
 use crate::bem::sinc;
@@ -38,46 +48,39 @@ pub fn energy_at<B: Basis>(
 ) -> f64 {
     let len = basis.len();
     let nb = system.bars().len();
-    let mut phi = vec![0.0; len];
-    let mut dphi = vec![0.0; len];
-    basis.functions_at(theta, &mut phi);
-    basis.derivatives_at(theta, &mut dphi);
-    let mut total = 0.0;
-    let mut end_u = vec![[0.0; 2]; nb];
-    let mut harmonics = Vec::with_capacity(len);
-    for (b, bar) in system.bars().iter().enumerate() {
-        harmonics.clear();
-        harmonics.extend((0..len).map(|i| {
-            let j = (i * nb + b) * 2;
-            Harmonic::new(bar, basis.harmonic(i) as f64 * omega, x[j], x[j + 1])
-        }));
-        let c2 = bar.wave_speed() * bar.wave_speed();
-        let (mut strain, mut kinetic) = (0.0, 0.0);
-        for i in 0..len {
-            let (wi, vi) = (phi[i], omega * dphi[i]);
-            if wi == 0.0 && vi == 0.0 {
-                continue;
-            }
-            for j in 0..=i {
-                let (wj, vj) = (phi[j], omega * dphi[j]);
-                if wi * wj == 0.0 && vi * vj == 0.0 {
-                    continue;
-                }
-                let (int_uu, int_dd) = pair_integrals(&harmonics[i], &harmonics[j], bar.length());
-                let twice = if i == j { 1.0 } else { 2.0 };
-                strain += twice * wi * wj * int_dd;
-                kinetic += twice * vi * vj * int_uu;
-            }
-        }
-        total += 0.5 * bar.stiffness() * (strain + kinetic / c2);
-        end_u[b] = [
-            harmonics.iter().zip(&phi).map(|(h, w)| w * h.u0).sum(),
-            harmonics.iter().zip(&phi).map(|(h, w)| w * h.ul).sum(),
-        ];
+    // Two allocations per call: the time weights `w_i = phi_i(theta)`,
+    // `v_i = omega phi_i'(theta)` with the end displacements `u_b(0), u_b(l_b)` that the
+    // conditions read, and the harmonics of one bar, refilled bar after bar.
+    let mut buffer = vec![0.0; 2 * len + 2 * nb];
+    let (weights, end_u) = buffer.split_at_mut(2 * len);
+    let (w, v) = weights.split_at_mut(len);
+    basis.functions_at(theta, w);
+    basis.derivatives_at(theta, v);
+    for v in v.iter_mut() {
+        *v *= omega;
     }
+    // With the cosine basis at theta = 0 (the common call) every velocity weight vanishes:
+    // skip the kinetic sums altogether.
+    let moving = v.iter().any(|&v| v != 0.0);
+    let mut harmonics = Harmonics::new(len);
+    let mut total = 0.0;
+    for (b, bar) in system.bars().iter().enumerate() {
+        harmonics.fill(bar, basis, x, (b, nb), omega, (w, v));
+        let (strain, kinetic) = if moving {
+            harmonics.quadratic_forms::<true>()
+        } else {
+            harmonics.quadratic_forms::<false>()
+        };
+        let c2 = bar.wave_speed() * bar.wave_speed();
+        total += 0.5 * bar.stiffness() * (strain + kinetic / c2);
+        let each = || (0..len).map(|i| harmonics.get(i));
+        end_u[2 * b] = each().map(|h| h.w * h.a).sum();
+        end_u[2 * b + 1] = each().map(|h| h.w * h.ul).sum();
+    }
+    let end_u = &*end_u;
     let displacement = |e: EndRef| match e.end {
-        End::Left => end_u[e.bar.index()][0],
-        End::Right => end_u[e.bar.index()][1],
+        End::Left => end_u[2 * e.bar.index()],
+        End::Right => end_u[2 * e.bar.index() + 1],
     };
     total
         + system
@@ -86,32 +89,244 @@ pub fn energy_at<B: Basis>(
             .sum::<f64>()
 }
 
-/// One harmonic of one bar with its boundary values.
+/// Harmonics per [`Block`]: the SIMD lanes (and independent accumulators, which hide the
+/// latency of the divisions and additions) of the pair sums.
+const LANES: usize = 4;
+
+/// One harmonic of one bar, `u = a cos(kx) + b sin(kx)/k` on `[0, l]`, with its boundary
+/// values `u(0) = a`, `u'(0) = b`, `u(l)`, `u'(l)` and its time weights `w = phi(theta)`,
+/// `v = omega phi'(theta)`.
+#[derive(Clone, Copy)]
 struct Harmonic {
     k: f64,
+    k2: f64,
     a: f64,
     b: f64,
-    /// `u(0), u'(0), u(l), u'(l)`.
-    u0: f64,
-    d0: f64,
     ul: f64,
     dl: f64,
+    w: f64,
+    v: f64,
+    /// `sinc(k l)`, shared by `u(l)` and the diagonal closed form.
+    sinc_kl: f64,
 }
 
-impl Harmonic {
-    fn new(bar: &Bar, omega: f64, a: f64, b: f64) -> Self {
-        let k = bar.wavenumber(omega);
+/// [`LANES`] consecutive harmonics of one bar, field by field (the fields of [`Harmonic`]).
+#[derive(Clone, Copy, Default)]
+struct Block {
+    k: [f64; LANES],
+    k2: [f64; LANES],
+    a: [f64; LANES],
+    b: [f64; LANES],
+    ul: [f64; LANES],
+    dl: [f64; LANES],
+    w: [f64; LANES],
+    v: [f64; LANES],
+    sinc_kl: [f64; LANES],
+}
+
+/// The harmonics of one bar of length `l`, `len` of them in blocks (the last one padded).
+struct Harmonics {
+    l: f64,
+    len: usize,
+    blocks: Vec<Block>,
+}
+
+impl Harmonics {
+    fn new(len: usize) -> Self {
+        Self {
+            l: 0.0,
+            len,
+            blocks: vec![Block::default(); len.div_ceil(LANES)],
+        }
+    }
+
+    /// Fills in bar `b` of `nb` of the solution `x` at fundamental frequency `omega`, with
+    /// the time weights `(w, v)`.
+    fn fill<B: Basis>(
+        &mut self,
+        bar: &Bar,
+        basis: &B,
+        x: &[f64],
+        (b, nb): (usize, usize),
+        omega: f64,
+        (w, v): (&[f64], &[f64]),
+    ) {
         let l = bar.length();
-        let (s, c) = (k * l).sin_cos();
+        self.l = l;
+        for i in 0..self.len {
+            let j = (i * nb + b) * 2;
+            let (a, bi) = (x[j], x[j + 1]);
+            let k = bar.wavenumber(basis.harmonic(i) as f64 * omega);
+            let z = k * l;
+            let (s, c) = z.sin_cos();
+            let sinc_kl = sinc_from_sin(z, s);
+            let (block, lane) = (&mut self.blocks[i / LANES], i % LANES);
+            block.k[lane] = k;
+            block.k2[lane] = k * k;
+            block.a[lane] = a;
+            block.b[lane] = bi;
+            block.ul[lane] = a * c + bi * l * sinc_kl;
+            block.dl[lane] = -a * k * s + bi * c;
+            block.w[lane] = w[i];
+            block.v[lane] = v[i];
+            block.sinc_kl[lane] = sinc_kl;
+        }
+    }
+
+    /// Harmonic `i`.
+    fn get(&self, i: usize) -> Harmonic {
+        let (block, lane) = (&self.blocks[i / LANES], i % LANES);
+        Harmonic {
+            k: block.k[lane],
+            k2: block.k2[lane],
+            a: block.a[lane],
+            b: block.b[lane],
+            ul: block.ul[lane],
+            dl: block.dl[lane],
+            w: block.w[lane],
+            v: block.v[lane],
+            sinc_kl: block.sinc_kl[lane],
+        }
+    }
+
+    /// `(sum_ij w_i w_j int u_i' u_j' dx, sum_ij v_i v_j int u_i u_j dx)`; the second is 0
+    /// unless `KINETIC`. Rows with `w_i = v_i = 0` contribute nothing and are skipped.
+    fn quadratic_forms<const KINETIC: bool>(&self) -> (f64, f64) {
+        let (mut strain, mut kinetic) = (0.0, 0.0);
+        for i in 0..self.len {
+            let hi = self.get(i);
+            let vi = if KINETIC { hi.v } else { 0.0 };
+            if hi.w == 0.0 && vi == 0.0 {
+                continue;
+            }
+            let diagonal = Diagonal::new(hi.k, self.l, hi.sinc_kl);
+            let (mut row_strain, mut row_kinetic) = self.row::<KINETIC>(i, &hi);
+            if !(row_strain.is_finite() && row_kinetic.is_finite()) {
+                (row_strain, row_kinetic) = self.row_pairwise::<KINETIC>(i, &hi, &diagonal);
+            }
+            let (int_uu, int_dd) = diagonal.integrals(&hi, &hi);
+            strain += hi.w * (hi.w * int_dd + 2.0 * row_strain);
+            if KINETIC {
+                kinetic += vi * (vi * int_uu + 2.0 * row_kinetic);
+            }
+        }
+        (strain, kinetic)
+    }
+
+    /// `(sum_{j<i} w_j int u_i' u_j' dx, sum_{j<i} v_j int u_i u_j dx)` by Green's identity,
+    /// block by block: infinite or NaN if some `k_j = k_i`. On baseline x86-64 (SSE2) the
+    /// compiler turns the strain-only loop into packed divisions; with the kinetic sum too, its
+    /// cost model keeps the `LANES` lanes scalar, which still overlap their divisions.
+    fn row<const KINETIC: bool>(&self, i: usize, hi: &Harmonic) -> (f64, f64) {
+        let mut strain = [0.0; LANES];
+        let mut kinetic = [0.0; LANES];
+        let (full, rest) = (i / LANES, i % LANES);
+        for block in &self.blocks[..full] {
+            for lane in 0..LANES {
+                let (int_uu, int_dd) = green(hi, block, lane);
+                strain[lane] += block.w[lane] * int_dd;
+                if KINETIC {
+                    kinetic[lane] += block.v[lane] * int_uu;
+                }
+            }
+        }
+        if rest > 0 {
+            // The first `rest` lanes of the block of `i` itself.
+            let block = &self.blocks[full];
+            for lane in 0..rest {
+                let (int_uu, int_dd) = green(hi, block, lane);
+                strain[lane] += block.w[lane] * int_dd;
+                if KINETIC {
+                    kinetic[lane] += block.v[lane] * int_uu;
+                }
+            }
+        }
+        (strain.iter().sum(), kinetic.iter().sum())
+    }
+
+    /// [`Self::row`] pair by pair, with the closed form `diagonal` of `k_i` for the pairs
+    /// with `k_j = k_i`.
+    #[cold]
+    fn row_pairwise<const KINETIC: bool>(
+        &self,
+        i: usize,
+        hi: &Harmonic,
+        diagonal: &Diagonal,
+    ) -> (f64, f64) {
+        let (mut strain, mut kinetic) = (0.0, 0.0);
+        for j in 0..i {
+            let hj = self.get(j);
+            let (int_uu, int_dd) = if hj.k == hi.k {
+                diagonal.integrals(hi, &hj)
+            } else {
+                green(hi, &self.blocks[j / LANES], j % LANES)
+            };
+            strain += hj.w * int_dd;
+            if KINETIC {
+                kinetic += hj.v * int_uu;
+            }
+        }
+        (strain, kinetic)
+    }
+}
+
+/// `(int u_i u_j dx, int u_i' u_j' dx)` over `[0, l]` for `k_i != k_j` by Green's identity,
+/// `u_j` being lane `lane` of `block`.
+#[inline(always)]
+fn green(hi: &Harmonic, block: &Block, lane: usize) -> (f64, f64) {
+    let bracket_ij = hi.ul * block.dl[lane] - hi.a * block.b[lane];
+    let bracket_ji = block.ul[lane] * hi.dl - block.a[lane] * hi.b;
+    let int_uu = (bracket_ij - bracket_ji) / (hi.k2 - block.k2[lane]);
+    (int_uu, bracket_ij + block.k2[lane] * int_uu)
+}
+
+/// The integrals of `cos^2, sin^2, sin cos` products at one wavenumber `k` over `[0, l]`,
+/// for the pairs with `k_i = k_j = k`.
+struct Diagonal {
+    k: f64,
+    /// `int sin^2(kx) dx / k^2`.
+    sin2_over_k2: f64,
+    /// `int cos^2(kx) dx`.
+    cos2: f64,
+    /// `int sin(kx) cos(kx) dx / k`.
+    sc_over_k: f64,
+}
+
+impl Diagonal {
+    fn new(k: f64, l: f64, sinc_kl: f64) -> Self {
+        // int sin^2(kx) = l/2 - sin(2kl)/(4k) = k^2 l^3 g(2kl) * 2, int cos^2 = l - that,
+        // int sin cos = sin^2(kl)/(2k), with g(z) = (1 - sinc z)/z^2.
+        let sin2_over_k2 = 2.0 * l * l * l * one_minus_sinc_over_z2(2.0 * k * l);
         Self {
             k,
-            a,
-            b,
-            u0: a,
-            d0: b,
-            ul: a * c + b * l * sinc(k * l),
-            dl: -a * k * s + b * c,
+            sin2_over_k2,
+            cos2: l - k * k * sin2_over_k2,
+            sc_over_k: 0.5 * (l * sinc_kl).powi(2),
         }
+    }
+
+    /// `(int u_1 u_2 dx, int u_1' u_2' dx)` of two harmonics at this wavenumber.
+    fn integrals(&self, h1: &Harmonic, h2: &Harmonic) -> (f64, f64) {
+        let Self {
+            k,
+            sin2_over_k2,
+            cos2,
+            sc_over_k,
+        } = *self;
+        let (a1, b1, a2, b2) = (h1.a, h1.b, h2.a, h2.b);
+        let int_uu = a1 * a2 * cos2 + b1 * b2 * sin2_over_k2 + (a1 * b2 + a2 * b1) * sc_over_k;
+        let int_dd = a1 * a2 * k.powi(4) * sin2_over_k2 + b1 * b2 * cos2
+            - (a1 * b2 + a2 * b1) * k * k * sc_over_k;
+        (int_uu, int_dd)
+    }
+}
+
+/// [`sinc`]`(z)` given `s = sin z`, bit for bit: saves a `sin` per harmonic.
+fn sinc_from_sin(z: f64, s: f64) -> f64 {
+    if z.abs() < 1e-2 {
+        sinc(z)
+    } else {
+        s / z
     }
 }
 
@@ -125,28 +340,6 @@ fn one_minus_sinc_over_z2(z: f64) -> f64 {
     }
 }
 
-/// `(int u_i u_j dx, int u_i' u_j' dx)` over `[0, l]`.
-fn pair_integrals(hi: &Harmonic, hj: &Harmonic, l: f64) -> (f64, f64) {
-    if hi.k == hj.k {
-        // int sin^2(kx) = l/2 - sin(2kl)/(4k) = k^2 l^3 g(2kl) * 2, int cos^2 = l - that,
-        // int sin cos = sin^2(kl)/(2k), with g(z) = (1 - sinc z)/z^2.
-        let k = hi.k;
-        let sin2_over_k2 = 2.0 * l * l * l * one_minus_sinc_over_z2(2.0 * k * l);
-        let cos2 = l - k * k * sin2_over_k2;
-        let sc_over_k = 0.5 * (l * sinc(k * l)).powi(2);
-        let (a1, b1, a2, b2) = (hi.a, hi.b, hj.a, hj.b);
-        let int_uu = a1 * a2 * cos2 + b1 * b2 * sin2_over_k2 + (a1 * b2 + a2 * b1) * sc_over_k;
-        let int_dd = a1 * a2 * k.powi(4) * sin2_over_k2 + b1 * b2 * cos2
-            - (a1 * b2 + a2 * b1) * k * k * sc_over_k;
-        (int_uu, int_dd)
-    } else {
-        let bracket_ij = hi.ul * hj.dl - hi.u0 * hj.d0;
-        let bracket_ji = hj.ul * hi.dl - hj.u0 * hi.d0;
-        let int_uu = (bracket_ij - bracket_ji) / (hi.k * hi.k - hj.k * hj.k);
-        (int_uu, bracket_ij + hj.k * hj.k * int_uu)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -154,6 +347,284 @@ mod tests {
     use crate::fourier::CosineBasis;
     use crate::modal::field::FieldEvaluator;
     use crate::system::AssemblyBuilder;
+
+    // The straightforward implementation, one struct and one branch per pair: the oracle of
+    // the SIMD-friendly row sums.
+
+    /// [`energy_at`] pair by pair.
+    fn pairwise_energy_at<B: Basis>(
+        system: &BarSystem,
+        basis: &B,
+        x: &[f64],
+        omega: f64,
+        theta: f64,
+    ) -> f64 {
+        let len = basis.len();
+        let nb = system.bars().len();
+        let mut phi = vec![0.0; len];
+        let mut dphi = vec![0.0; len];
+        basis.functions_at(theta, &mut phi);
+        basis.derivatives_at(theta, &mut dphi);
+        let mut total = 0.0;
+        let mut end_u = vec![[0.0; 2]; nb];
+        let mut harmonics = Vec::with_capacity(len);
+        for (b, bar) in system.bars().iter().enumerate() {
+            harmonics.clear();
+            harmonics.extend((0..len).map(|i| {
+                let j = (i * nb + b) * 2;
+                OracleHarmonic::new(bar, basis.harmonic(i) as f64 * omega, x[j], x[j + 1])
+            }));
+            let c2 = bar.wave_speed() * bar.wave_speed();
+            let (mut strain, mut kinetic) = (0.0, 0.0);
+            for i in 0..len {
+                let (wi, vi) = (phi[i], omega * dphi[i]);
+                if wi == 0.0 && vi == 0.0 {
+                    continue;
+                }
+                for j in 0..=i {
+                    let (wj, vj) = (phi[j], omega * dphi[j]);
+                    if wi * wj == 0.0 && vi * vj == 0.0 {
+                        continue;
+                    }
+                    let (int_uu, int_dd) =
+                        pair_integrals(&harmonics[i], &harmonics[j], bar.length());
+                    let twice = if i == j { 1.0 } else { 2.0 };
+                    strain += twice * wi * wj * int_dd;
+                    kinetic += twice * vi * vj * int_uu;
+                }
+            }
+            total += 0.5 * bar.stiffness() * (strain + kinetic / c2);
+            end_u[b] = [
+                harmonics.iter().zip(&phi).map(|(h, w)| w * h.u0).sum(),
+                harmonics.iter().zip(&phi).map(|(h, w)| w * h.ul).sum(),
+            ];
+        }
+        let displacement = |e: EndRef| match e.end {
+            End::Left => end_u[e.bar.index()][0],
+            End::Right => end_u[e.bar.index()][1],
+        };
+        total
+            + system
+                .conditions()
+                .map(|c| c.stored_energy(&displacement))
+                .sum::<f64>()
+    }
+
+    /// One harmonic of one bar with its boundary values.
+    struct OracleHarmonic {
+        k: f64,
+        a: f64,
+        b: f64,
+        /// `u(0), u'(0), u(l), u'(l)`.
+        u0: f64,
+        d0: f64,
+        ul: f64,
+        dl: f64,
+    }
+
+    impl OracleHarmonic {
+        fn new(bar: &Bar, omega: f64, a: f64, b: f64) -> Self {
+            let k = bar.wavenumber(omega);
+            let l = bar.length();
+            let (s, c) = (k * l).sin_cos();
+            Self {
+                k,
+                a,
+                b,
+                u0: a,
+                d0: b,
+                ul: a * c + b * l * sinc(k * l),
+                dl: -a * k * s + b * c,
+            }
+        }
+    }
+
+    /// `(int u_i u_j dx, int u_i' u_j' dx)` over `[0, l]`.
+    fn pair_integrals(hi: &OracleHarmonic, hj: &OracleHarmonic, l: f64) -> (f64, f64) {
+        if hi.k == hj.k {
+            // int sin^2(kx) = l/2 - sin(2kl)/(4k) = k^2 l^3 g(2kl) * 2, int cos^2 = l - that,
+            // int sin cos = sin^2(kl)/(2k), with g(z) = (1 - sinc z)/z^2.
+            let k = hi.k;
+            let sin2_over_k2 = 2.0 * l * l * l * one_minus_sinc_over_z2(2.0 * k * l);
+            let cos2 = l - k * k * sin2_over_k2;
+            let sc_over_k = 0.5 * (l * sinc(k * l)).powi(2);
+            let (a1, b1, a2, b2) = (hi.a, hi.b, hj.a, hj.b);
+            let int_uu = a1 * a2 * cos2 + b1 * b2 * sin2_over_k2 + (a1 * b2 + a2 * b1) * sc_over_k;
+            let int_dd = a1 * a2 * k.powi(4) * sin2_over_k2 + b1 * b2 * cos2
+                - (a1 * b2 + a2 * b1) * k * k * sc_over_k;
+            (int_uu, int_dd)
+        } else {
+            let bracket_ij = hi.ul * hj.dl - hi.u0 * hj.d0;
+            let bracket_ji = hj.ul * hi.dl - hj.u0 * hi.d0;
+            let int_uu = (bracket_ij - bracket_ji) / (hi.k * hi.k - hj.k * hj.k);
+            (int_uu, bracket_ij + hj.k * hj.k * int_uu)
+        }
+    }
+
+    /// A deterministic spread of coefficients in `[-1, 1] * scale`, decaying with the index.
+    fn coefficients(n: usize, seed: u64, scale: f64) -> Vec<f64> {
+        let mut state = seed;
+        (0..n)
+            .map(|i| {
+                state = state
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                let r = (state >> 11) as f64 / (1u64 << 53) as f64;
+                scale * (2.0 * r - 1.0) / (1.0 + 0.1 * i as f64)
+            })
+            .collect()
+    }
+
+    fn two_bar_system() -> BarSystem {
+        crate::reference::two_bars_in_contact(Bar::new(0.7, 1.9, 2.5).unwrap(), 1e-3).unwrap()
+    }
+
+    fn assert_close(fast: f64, slow: f64, what: &str) {
+        let scale = slow.abs().max(f64::MIN_POSITIVE);
+        assert!(
+            (fast - slow).abs() <= 1e-12 * scale,
+            "{what}: {fast} vs {slow} (relative {:e})",
+            (fast - slow).abs() / scale
+        );
+    }
+
+    #[test]
+    fn row_sums_match_pairwise_formula() {
+        let systems = [
+            (
+                "clamped",
+                crate::reference::clamped_bar_with_obstacle(1e-3).unwrap(),
+            ),
+            (
+                "robin",
+                crate::reference::robin_bar_with_obstacle(0.5, 1e-3).unwrap(),
+            ),
+            ("two bars", two_bar_system()),
+        ];
+        for (name, system) in &systems {
+            let nb = system.bars().len();
+            for m in [1, 2, 3, 4, 5, 9, 40, 81] {
+                let basis = CosineBasis::new(m, 3).unwrap();
+                for (seed, (omega, theta)) in [
+                    (1.3, 0.0),
+                    (0.4, 0.9),
+                    (2.7, 2.0),
+                    (1.6, -0.3),
+                    (1e-4, 1.1),
+                    (0.0, 0.7),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let x = coefficients(2 * nb * basis.len(), seed as u64 + 7, 1e-3);
+                    let fast = energy_at(system, &basis, &x, omega, theta);
+                    let slow = pairwise_energy_at(system, &basis, &x, omega, theta);
+                    assert_close(
+                        fast,
+                        slow,
+                        &format!("{name} m={m} omega={omega} theta={theta}"),
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn exact_clamped_mode_matches_pairwise_formula() {
+        let system = crate::reference::clamped_bar_with_obstacle(1e-3).unwrap();
+        for m in [10, 40, 160] {
+            let basis = CosineBasis::new(m, 3).unwrap();
+            for period in [3.1, 3.5, 3.95] {
+                let mode = crate::reference::ClampedFirstMode::new(1e-3, period);
+                let x = mode.unknowns(m);
+                let omega = 2.0 * std::f64::consts::PI / period;
+                for theta in [0.0, 0.3] {
+                    let fast = energy_at(&system, &basis, &x, omega, theta);
+                    let slow = pairwise_energy_at(&system, &basis, &x, omega, theta);
+                    assert_close(fast, slow, &format!("m={m} T={period} theta={theta}"));
+                }
+            }
+        }
+    }
+
+    /// Constant + cosine + sine: every harmonic `n >= 1` appears twice, so each row has a pair
+    /// with equal wavenumbers off the diagonal. Only what `energy_at` reads is implemented.
+    #[derive(Debug, Clone)]
+    struct SineCosine(usize);
+
+    impl Basis for SineCosine {
+        fn len(&self) -> usize {
+            2 * self.0 + 1
+        }
+        fn harmonics(&self) -> usize {
+            self.0
+        }
+        fn harmonic(&self, i: usize) -> usize {
+            i.div_ceil(2)
+        }
+        fn samples(&self) -> usize {
+            3 * self.0
+        }
+        fn functions_at(&self, theta: f64, out: &mut [f64]) {
+            for (i, o) in out.iter_mut().enumerate() {
+                let n = self.harmonic(i) as f64;
+                *o = match i {
+                    0 => 0.5,
+                    _ if i % 2 == 1 => (n * theta).cos(),
+                    _ => (n * theta).sin(),
+                };
+            }
+        }
+        fn derivatives_at(&self, theta: f64, out: &mut [f64]) {
+            for (i, o) in out.iter_mut().enumerate() {
+                let n = self.harmonic(i) as f64;
+                *o = match i {
+                    0 => 0.0,
+                    _ if i % 2 == 1 => -n * (n * theta).sin(),
+                    _ => n * (n * theta).cos(),
+                };
+            }
+        }
+        fn synthesize(&self, _: &[f64], _: &mut [f64]) {
+            unimplemented!()
+        }
+        fn project(&self, _: &[f64], _: &mut [f64]) {
+            unimplemented!()
+        }
+        fn weighted_gram(&self, _: &[f64], _: &mut [f64]) {
+            unimplemented!()
+        }
+    }
+
+    #[test]
+    fn equal_wavenumbers_off_the_diagonal_match_pairwise_formula() {
+        let system = two_bar_system();
+        for m in [1, 3, 8, 20] {
+            let basis = SineCosine(m);
+            for (seed, (omega, theta)) in [(1.3, 0.0), (0.9, 0.4), (2.2, 1.7), (0.0, 0.5)]
+                .into_iter()
+                .enumerate()
+            {
+                let x = coefficients(4 * basis.len(), seed as u64 + 99, 1e-2);
+                let fast = energy_at(&system, &basis, &x, omega, theta);
+                let slow = pairwise_energy_at(&system, &basis, &x, omega, theta);
+                assert_close(fast, slow, &format!("m={m} omega={omega} theta={theta}"));
+            }
+        }
+    }
+
+    #[test]
+    fn sinc_from_sin_is_sinc() {
+        for z in [
+            0.0, 1e-3, -0.0099, 0.01, -0.0100001, 0.3, 1.0, -2.5, 40.0, 1e3,
+        ] {
+            assert_eq!(
+                sinc_from_sin(z, z.sin()).to_bits(),
+                sinc(z).to_bits(),
+                "z = {z}"
+            );
+        }
+    }
 
     /// Composite Gauss–Legendre quadrature of the energy density: the oracle.
     fn quadrature_energy(

@@ -134,9 +134,11 @@ fn affine_relation(w_gap: &[f64], w_force: &[f64]) -> Option<(f64, f64)> {
         }
         None => (f0, 0.0),
     };
-    let fits = w_gap.iter().zip(w_force).all(|(&g, &f)| {
+    // Branch-free, so that the scan vectorises (it runs once per Newton step).
+    let fits = w_gap.iter().zip(w_force).fold(true, |fits, (&g, &f)| {
         let model = alpha + beta * g;
-        (f - model).abs() <= 4.0 * f64::EPSILON * (f.abs() + alpha.abs() + (beta * g).abs())
+        fits & ((f - model).abs()
+            <= 4.0 * f64::EPSILON * (f.abs() + alpha.abs() + (beta * g).abs()))
     });
     (fits && alpha.is_finite() && beta.is_finite()).then_some((alpha, beta))
 }

@@ -1,0 +1,417 @@
+//! Speculative retries: the first retry of a sequential step runs on a second thread beside
+//! the first attempt, so that a failed step costs the wall time of one solve instead of two.
+//!
+//! The result is the serial one, bit for bit: the first attempt decides as before, the retry
+//! solves the same system from the same start with a clone of the problem, and its outcome is
+//! used only if the first attempt fails. What changes is when the retry runs: it is launched
+//! once the first attempt has spent [`Speculation::after_evaluations`] residual evaluations
+//! (a step that converges quickly never starts a thread), and it is cancelled as soon as the
+//! first attempt joins the branch.
+
+use super::sequential::{accepts, run_with, Attempt};
+use super::{AtParameter, ContinuationProblem, Sequential, StepOutcome};
+use crate::error::{ContinuationError, SolveError};
+use crate::linalg::DenseMatrix;
+use crate::solve::{NonlinearSolver, Problem, SingularStep, SolveInfo};
+use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::{mpsc, Arc};
+
+/// When [`Sequential::step_speculative`] starts the retry on a second thread.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Speculation {
+    /// Residual evaluations (line-search trials included) the first attempt spends before the
+    /// retry is launched beside it (default 10). On the clamped bar's backbones a solve that
+    /// converges from the prediction typically needs 3 to 6 evaluations and a failing one 34
+    /// or more (`docs/performance.md`): a small value launches the retry early in hopeless
+    /// steps while leaving quick steps alone; 0 launches it at every step.
+    pub after_evaluations: usize,
+}
+
+impl Default for Speculation {
+    fn default() -> Self {
+        Self {
+            after_evaluations: 10,
+        }
+    }
+}
+
+/// What the speculative retries of a run did ([`Sequential::speculation_stats`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SpeculationStats {
+    /// Retries handed to the worker (first attempts that reached
+    /// [`Speculation::after_evaluations`]).
+    pub launched: usize,
+    /// Handed-over retries whose first attempt joined the branch: cancelled, never used.
+    pub cancelled: usize,
+    /// Retries the worker solved and the driver used (the first attempt failed).
+    pub used: usize,
+    /// Retries the driver took back and solved itself, because the first attempt failed
+    /// before the worker had started them.
+    pub taken_back: usize,
+}
+
+/// A problem seen by a solver through a counter of residual evaluations (with a hook fired
+/// at a given count) and a cancellation flag (a cancelled solve meets a singular step and
+/// non-finite residuals, and stops at once).
+struct Monitored<'a, Q> {
+    inner: Q,
+    evaluations: usize,
+    hook: Option<(usize, &'a mut dyn FnMut())>,
+    cancel: Option<&'a AtomicU8>,
+}
+
+impl<Q: Problem> Monitored<'_, Q> {
+    fn cancelled(&self) -> bool {
+        self.cancel
+            .is_some_and(|c| c.load(Ordering::Acquire) == CANCELLED)
+    }
+
+    /// Counts an evaluation and fires the hook when its count is reached; returns whether the
+    /// evaluation should go ahead.
+    fn count(&mut self) -> bool {
+        self.evaluations += 1;
+        if let Some((at, hook)) = self.hook.as_mut() {
+            if self.evaluations >= *at {
+                hook();
+                self.hook = None;
+            }
+        }
+        !self.cancelled()
+    }
+}
+
+impl<Q: Problem> Problem for Monitored<'_, Q> {
+    fn dimension(&self) -> usize {
+        self.inner.dimension()
+    }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        if self.count() {
+            self.inner.residual(x, f);
+        } else {
+            f.fill(f64::NAN);
+        }
+    }
+    fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
+        if self.count() {
+            self.inner.residual_along(x, dx, t, trial, f);
+        } else {
+            trial.copy_from_slice(x);
+            f.fill(f64::NAN);
+        }
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        self.inner.jacobian(x, jac);
+    }
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.inner.set_smoothing(smoothing)
+    }
+    fn newton_step(
+        &mut self,
+        x: &[f64],
+        f: &[f64],
+        dx: &mut [f64],
+    ) -> Option<Result<(), SingularStep>> {
+        if self.cancelled() {
+            return Some(Err(SingularStep {
+                pivot: 0,
+                ratio: 0.0,
+            }));
+        }
+        self.inner.newton_step(x, f, dx)
+    }
+    fn residual_scale(&self) -> f64 {
+        self.inner.residual_scale()
+    }
+}
+
+/// Life of a speculative retry, shared by the driver and the worker thread.
+const PENDING: u8 = 0;
+const RUNNING: u8 = 1;
+/// The first attempt joined the branch: the retry is not needed.
+const CANCELLED: u8 = 2;
+/// The first attempt failed before the worker picked the retry up: the driver runs it.
+const TAKEN: u8 = 3;
+
+/// A retry handed to the worker: solve at `lambda` from `start`.
+struct Job {
+    step: usize,
+    lambda: f64,
+    start: Vec<f64>,
+    state: Arc<AtomicU8>,
+}
+
+/// What the worker sends back: the step, where the solve ended, and how.
+type Finished = (usize, Vec<f64>, Result<SolveInfo, SolveError>);
+
+/// A thread that solves retries with its own clone of the problem and of the solver. It
+/// lives as long as the driver; dropping it closes its queue and joins it.
+pub(super) struct Worker {
+    jobs: Option<mpsc::Sender<Job>>,
+    results: mpsc::Receiver<Finished>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Worker {
+    /// Starts the thread; `None` if the system refuses one (the driver then retries serially).
+    fn spawn<P, S>(mut problem: P, solver: S) -> Option<Self>
+    where
+        P: ContinuationProblem + Send + 'static,
+        S: NonlinearSolver + Send + 'static,
+    {
+        let (jobs, queue) = mpsc::channel::<Job>();
+        let (done, results) = mpsc::channel();
+        let thread = std::thread::Builder::new()
+            .name("nonsmooth-modes-retry".into())
+            .spawn(move || {
+                for job in queue {
+                    let claimed = job
+                        .state
+                        .compare_exchange(PENDING, RUNNING, Ordering::AcqRel, Ordering::Acquire)
+                        .is_ok();
+                    if !claimed {
+                        continue;
+                    }
+                    let mut x = job.start;
+                    let mut retry = Monitored {
+                        inner: AtParameter {
+                            problem: &mut problem,
+                            lambda: job.lambda,
+                        },
+                        evaluations: 0,
+                        hook: None,
+                        cancel: Some(&job.state),
+                    };
+                    let result = solver.solve(&mut retry, &mut x);
+                    if done.send((job.step, x, result)).is_err() {
+                        break;
+                    }
+                }
+            })
+            .ok()?;
+        Some(Self {
+            jobs: Some(jobs),
+            results,
+            thread: Some(thread),
+        })
+    }
+
+    /// The worker's outcome of the retry of `step` (stale outcomes of cancelled retries are
+    /// skipped); `None` if the worker is gone.
+    fn outcome(&self, step: usize) -> Option<(Vec<f64>, Result<SolveInfo, SolveError>)> {
+        loop {
+            let (s, x, result) = self.results.recv().ok()?;
+            if s == step {
+                return Some((x, result));
+            }
+        }
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        drop(self.jobs.take());
+        if let Some(thread) = self.thread.take() {
+            // A panic on the worker has already been reported by its thread.
+            let _ = thread.join();
+        }
+    }
+}
+
+impl std::fmt::Debug for Worker {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Worker")
+    }
+}
+
+impl<P, S> Sequential<P, S> {
+    /// Counts of the speculative retries so far (all zero for a driver run with
+    /// [`Sequential::step`] only).
+    pub fn speculation_stats(&self) -> SpeculationStats {
+        self.speculation
+    }
+}
+
+impl<P, S> Sequential<P, S>
+where
+    P: ContinuationProblem + Clone + Send + 'static,
+    S: NonlinearSolver + Clone + Send + 'static,
+{
+    /// [`Sequential::step`] with the first retry run speculatively on a worker thread (see
+    /// [`Speculation`]): the same outcome as `step`, in less wall time when steps fail and a
+    /// second core is free. The worker is started on first use with clones of the problem and
+    /// the solver, and stopped when the driver is dropped. The driver never waits for a retry
+    /// it does not need: a cancelled retry is dropped, and one the worker has not started
+    /// when the first attempt fails is run by the driver itself. Deeper retries
+    /// ([`SequentialOptions::retry_depth`](super::SequentialOptions::retry_depth) above 1)
+    /// run serially after it.
+    pub fn step_speculative(&mut self, speculation: Speculation) -> StepOutcome {
+        let Some((step, lambda)) = self.next_value() else {
+            return StepOutcome::Finished;
+        };
+        let mut x = self.predict(lambda);
+        if self.retry_count() > 0 && self.worker.is_none() {
+            self.worker = Worker::spawn(self.problem.clone(), self.solver.clone());
+        }
+        let job = match (&self.worker, self.retry_count()) {
+            (Some(worker), 1..) => worker.jobs.as_ref().map(|jobs| (jobs, self.retry_start(0))),
+            _ => None,
+        };
+        let state = Arc::new(AtomicU8::new(PENDING));
+        let mut sent = false;
+        let result = {
+            let mut pending = job;
+            let mut launch = || {
+                if let Some((jobs, start)) = pending.take() {
+                    let job = Job {
+                        step,
+                        lambda,
+                        start,
+                        state: Arc::clone(&state),
+                    };
+                    sent = jobs.send(job).is_ok();
+                }
+            };
+            let mut first = Monitored {
+                inner: AtParameter {
+                    problem: &mut self.problem,
+                    lambda,
+                },
+                evaluations: 0,
+                hook: Some((speculation.after_evaluations, &mut launch)),
+                cancel: None,
+            };
+            self.solver.solve(&mut first, &mut x)
+        };
+        let accepted = accepts(&mut self.accept, &result, &x, lambda);
+        let first = Attempt {
+            x,
+            result,
+            accepted,
+            from_history: None,
+        };
+        let stats = &mut self.speculation;
+        stats.launched += usize::from(sent);
+        if first.joins() {
+            state.store(CANCELLED, Ordering::Release);
+            stats.cancelled += usize::from(sent);
+            return self.conclude(step, lambda, first);
+        }
+        let taken = !sent
+            || state
+                .compare_exchange(PENDING, TAKEN, Ordering::AcqRel, Ordering::Acquire)
+                .is_ok();
+        stats.taken_back += usize::from(sent && taken);
+        let speculated = match (taken, &self.worker) {
+            (false, Some(worker)) => worker.outcome(step),
+            _ => None,
+        };
+        stats.used += usize::from(speculated.is_some());
+        let chosen = match speculated {
+            // The worker ran the first retry: judge it as `step` would have, then go deeper.
+            Some((y, result)) => {
+                let accepted = accepts(&mut self.accept, &result, &y, lambda);
+                let retried = Attempt {
+                    x: y,
+                    result,
+                    accepted,
+                    from_history: Some(0),
+                };
+                let best = if retried.joins() { retried } else { first };
+                self.retry_from(lambda, 1, best)
+            }
+            None => self.retry_from(lambda, 0, first),
+        };
+        self.conclude(step, lambda, chosen)
+    }
+
+    /// [`Sequential::run`] with [`Sequential::step_speculative`]: the same points, in less
+    /// wall time when steps fail.
+    ///
+    /// # Errors
+    /// [`ContinuationError::Stalled`] if too many consecutive steps failed.
+    pub fn run_speculative(
+        &mut self,
+        speculation: Speculation,
+        observer: impl FnMut(&super::Point) -> ControlFlow<()>,
+    ) -> Result<usize, ContinuationError> {
+        run_with(
+            self,
+            |driver| driver.step_speculative(speculation),
+            observer,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::{NewtonOptions, SemismoothNewton};
+
+    /// `F(x) = x^2 - 2` in one unknown.
+    struct Square;
+
+    impl Problem for Square {
+        fn dimension(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+            f[0] = x[0] * x[0] - 2.0;
+        }
+        fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+            jac.reset(1, 1);
+            jac[(0, 0)] = 2.0 * x[0];
+        }
+    }
+
+    #[test]
+    fn the_hook_fires_once_at_its_count_and_leaves_the_solve_alone() {
+        let solver = SemismoothNewton::new(NewtonOptions::default()).unwrap();
+        let mut plain = [3.0];
+        let info = solver.solve(&mut Square, &mut plain).unwrap();
+        let mut watched = [3.0];
+        let mut count = 0;
+        let mut hook = || count += 1;
+        let mut monitored = Monitored {
+            inner: Square,
+            evaluations: 0,
+            hook: Some((2, &mut hook)),
+            cancel: None,
+        };
+        let watched_info = solver.solve(&mut monitored, &mut watched).unwrap();
+        assert_eq!(monitored.evaluations, info.residual_evaluations);
+        assert_eq!(watched, plain);
+        assert_eq!(watched_info, info);
+        assert_eq!(count, 1);
+    }
+
+    #[test]
+    fn a_cancelled_solve_stops_at_once() {
+        let solver = SemismoothNewton::default();
+        let state = AtomicU8::new(CANCELLED);
+        let mut monitored = Monitored {
+            inner: Square,
+            evaluations: 0,
+            hook: None,
+            cancel: Some(&state),
+        };
+        let mut x = [3.0];
+        let result = solver.solve(&mut monitored, &mut x);
+        assert!(
+            matches!(result, Err(SolveError::NonFinite { .. })),
+            "{result:?}"
+        );
+        assert_eq!(monitored.evaluations, 1);
+        // Running, not cancelled: the solve goes on.
+        state.store(RUNNING, Ordering::Release);
+        let mut monitored = Monitored {
+            inner: Square,
+            evaluations: 0,
+            hook: None,
+            cancel: Some(&state),
+        };
+        let mut x = [3.0];
+        solver.solve(&mut monitored, &mut x).unwrap();
+        assert!((x[0] - 2f64.sqrt()).abs() < 1e-9);
+    }
+}
