@@ -1,7 +1,8 @@
 //! Criterion benchmarks of the harmonic-balance hot path on the clamped bar with an obstacle
 //! (gap `1e-3`, `n_h = 30`): residual, generalised Jacobian, one continuation step's solve,
-//! whole 181-step backbones at `m = 20, 40, 80`, a sweep of backbones (parallel with
-//! `--features parallel`), and the closed-form energy of a point.
+//! whole 181-step backbones at `m = 20, 40, 80` (serial and with speculative retries), a
+//! sweep of backbones (parallel with `--features parallel`), and the closed-form energy of a
+//! point.
 //!
 //! ```text
 //! cargo bench --bench harmonic_balance                       # everything
@@ -10,9 +11,10 @@
 //! ```
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use nonsmooth_modes::continuation::{AtParameter, ContinuationProblem};
+use nonsmooth_modes::continuation::{AtParameter, ContinuationProblem, Speculation};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::linalg::DenseMatrix;
+use nonsmooth_modes::modal::backbone::backbone_speculative_with;
 use nonsmooth_modes::modal::{
     backbone, energy, energy_at, BackboneOptions, BackbonePoint, PeriodGrid,
 };
@@ -21,6 +23,7 @@ use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::hint::black_box;
+use std::ops::ControlFlow;
 use std::time::Duration;
 
 const GAP: f64 = 1e-3;
@@ -128,12 +131,19 @@ fn whole_backbone(c: &mut Criterion) {
         .sample_size(10)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(5));
+    // The `backbone` example's solver: the fail-fast budget of sequential runs.
+    let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
     for m in [20, 40, 80] {
-        group.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, &m| {
+        group.bench_with_input(BenchmarkId::new("serial", m), &m, |b, &m| {
+            b.iter(|| backbone(&system, settings(m), &options, solver).unwrap());
+        });
+        // The same points with the first retry of failing steps on a worker thread.
+        group.bench_with_input(BenchmarkId::new("speculative", m), &m, |b, &m| {
             b.iter(|| {
-                // The `backbone` example's solver: the fail-fast budget of sequential runs.
-                let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
-                backbone(&system, settings(m), &options, solver).unwrap()
+                let see = |_: &BackbonePoint| ControlFlow::Continue(());
+                let spec = Speculation::default();
+                backbone_speculative_with(&system, settings(m), &options, spec, solver, see)
+                    .unwrap()
             });
         });
     }

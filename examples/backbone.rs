@@ -5,7 +5,8 @@
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
-//!     [--newton fail-fast|full] [--retry-depth K] [--serial] [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--newton fail-fast|full] [--retry-depth K] [--selection first|lowest-energy] [--serial]
+//!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
@@ -33,10 +34,19 @@
 //! switches the retry off). Where the machine has more than one core, the first retry runs on
 //! a second thread beside the first attempt (`backbone_speculative_with`; the same points, bit
 //! for bit); `--serial` keeps everything on one thread.
+//!
+//! `--selection lowest-energy` (`Selection::LowestMeasure` through
+//! `BackboneOptions::selection`; period runs only) solves every step from the prediction and
+//! from the `--retry-depth` earlier converged points and keeps the lowest-energy solution,
+//! which near an internal resonance stays on the backbone rather than on a resonance spike of
+//! the truncated system. It costs about `--retry-depth` extra solves per step and runs serially
+//! (every start is solved anyway); on the clamped bar at `m = 80` with `--retry-depth 2` it
+//! converges 176 steps instead of 169. `--selection first` (the default) keeps the first
+//! accepted solution.
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
-    linspace, Arclength, ArclengthOptions, ArclengthOutcome, Event, Point, Sequential,
+    linspace, Arclength, ArclengthOptions, ArclengthOutcome, Event, Point, Selection, Sequential,
     SequentialOptions, Speculation, StallEscape,
 };
 use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
@@ -47,12 +57,12 @@ use nonsmooth_modes::modal::{
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{
-    Dogleg, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton, SolveInfo,
-};
+use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
+// A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
+use nonsmooth_modes::sweep::Solver;
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
-use nonsmooth_modes::{ModelError, SolveError};
+use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -61,7 +71,8 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
   [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--serial] [--out FILE]
+  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K]
+  [--selection first|lowest-energy] [--serial] [--out FILE]
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
@@ -102,6 +113,7 @@ struct Args {
     /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
     fail_fast: Option<bool>,
     retry_depth: usize,
+    selection: Selection,
     /// No speculative retry on a second thread.
     serial: bool,
     out: Option<String>,
@@ -155,6 +167,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         dogleg: false,
         fail_fast: None,
         retry_depth: 1,
+        selection: Selection::FirstConverged,
         serial: false,
         out: None,
         arclength: false,
@@ -209,6 +222,13 @@ fn parse() -> Result<Args, lexopt::Error> {
                 }
             }
             Long("retry-depth") => a.retry_depth = parser.value()?.parse()?,
+            Long("selection") => {
+                a.selection = match parser.value()?.string()?.as_str() {
+                    "first" => Selection::FirstConverged,
+                    "lowest-energy" => Selection::LowestMeasure,
+                    other => return Err(format!("unknown selection `{other}`").into()),
+                }
+            }
             Long("serial") => a.serial = true,
             Long("out") => a.out = Some(parser.value()?.string()?),
             Long("method") => {
@@ -360,29 +380,6 @@ impl Sink<'_> {
     }
 }
 
-/// The solver of the command line (a plain enum, so that it can be cloned onto the thread of
-/// speculative retries).
-#[derive(Debug, Clone, Copy)]
-enum Solver {
-    Newton(SemismoothNewton),
-    Dogleg(Dogleg),
-}
-
-impl NonlinearSolver for Solver {
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
-        match self {
-            Solver::Newton(s) => s.solve(problem, x),
-            Solver::Dogleg(s) => s.solve(problem, x),
-        }
-    }
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
-        match self {
-            Solver::Newton(s) => s.tolerance(problem),
-            Solver::Dogleg(s) => s.tolerance(problem),
-        }
-    }
-}
-
 fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::error::Error>> {
     let system = build_system(a, Parameter::Omega, f64::NAN)?;
     let (t0, t1) = default_periods(a.system);
@@ -447,6 +444,7 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
             mode: a.mode,
             subharmonic: a.subharmonic,
             retry_depth: a.retry_depth,
+            selection: a.selection,
             ..Default::default()
         };
         let see = |p: &BackbonePoint| sink.row(&system, p, f64::NAN);

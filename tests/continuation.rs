@@ -357,21 +357,16 @@ fn speculative_retries_give_the_serial_points() {
     let late = Speculation {
         after_evaluations: usize::MAX,
     };
-    let points: Vec<_> = std::iter::from_fn(|| match never.step_speculative(late) {
-        nonsmooth_modes::continuation::StepOutcome::Converged(p)
-        | nonsmooth_modes::continuation::StepOutcome::Failed(p) => Some(p),
-        _ => None,
-    })
-    .collect();
-    assert_eq!(points, serial);
+    assert_eq!(speculative_points(&mut never, late), serial);
     assert_eq!(never.speculation_stats(), Default::default());
 }
 
-/// On the clamped bar at m = 40 (16 first attempts fail, 5 retries converge) the speculative
-/// backbone is the serial one, bit for bit.
-#[test]
-fn speculative_backbone_is_the_serial_backbone() {
-    use nonsmooth_modes::continuation::Speculation;
+/// The clamped bar's 181-step backbone at m = 40 with the `backbone` example's solver,
+/// serial (`speculation = None`) or with speculative retries.
+fn clamped_backbone_m40(
+    options: &BackboneOptions,
+    speculation: Option<nonsmooth_modes::continuation::Speculation>,
+) -> Vec<BackbonePoint> {
     use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
     use nonsmooth_modes::solve::NewtonOptions;
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
@@ -379,25 +374,182 @@ fn speculative_backbone_is_the_serial_backbone() {
         harmonics: 40,
         ..Default::default()
     };
-    let options = BackboneOptions::default();
     let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
-    let collect = |speculation: Option<Speculation>| {
-        let mut points = Vec::new();
-        let see = |p: &BackbonePoint| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        };
-        match speculation {
-            None => backbone_with(&system, settings, &options, solver, see),
-            Some(s) => backbone_speculative_with(&system, settings, &options, s, solver, see),
-        }
-        .unwrap();
-        points
+    let mut points = Vec::new();
+    let see = |p: &BackbonePoint| {
+        points.push(p.clone());
+        ControlFlow::Continue(())
     };
-    let serial = collect(None);
+    match speculation {
+        None => backbone_with(&system, settings, options, solver, see),
+        Some(s) => backbone_speculative_with(&system, settings, options, s, solver, see),
+    }
+    .unwrap();
+    points
+}
+
+/// The points of `driver` stepped with [`Sequential::step_speculative`] to the end.
+fn speculative_points<P, S>(
+    driver: &mut nonsmooth_modes::continuation::Sequential<P, S>,
+    speculation: nonsmooth_modes::continuation::Speculation,
+) -> Vec<Point>
+where
+    P: ContinuationProblem + Clone + Send + 'static,
+    S: nonsmooth_modes::solve::NonlinearSolver + Clone + Send + 'static,
+{
+    use nonsmooth_modes::continuation::StepOutcome;
+    std::iter::from_fn(|| match driver.step_speculative(speculation) {
+        StepOutcome::Converged(p) | StepOutcome::Failed(p) => Some(p),
+        _ => None,
+    })
+    .collect()
+}
+
+/// On the clamped bar at m = 40 (16 first attempts fail, 5 retries converge) the speculative
+/// backbone is the serial one, bit for bit.
+#[test]
+fn speculative_backbone_is_the_serial_backbone() {
+    use nonsmooth_modes::continuation::Speculation;
+    let options = BackboneOptions::default();
+    let serial = clamped_backbone_m40(&options, None);
     assert_eq!(serial.len(), 181);
     assert!(serial.iter().filter(|p| !p.converged).count() > 0);
     for after_evaluations in [0, 10] {
-        assert_eq!(collect(Some(Speculation { after_evaluations })), serial);
+        let speculation = Some(Speculation { after_evaluations });
+        assert_eq!(clamped_backbone_m40(&options, speculation), serial);
     }
+}
+
+/// A branch `x = lambda` with a spike `0.45` at `lambda = 0.1` (where the branch is missing)
+/// and a high branch `x = lambda + 0.4` from `lambda = 0.2` on; the residual is `x` minus the
+/// solution nearest to `x`.
+#[derive(Clone)]
+struct TwoBranches;
+
+impl ContinuationProblem for TwoBranches {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
+        let roots: Vec<f64> = if (lambda - 0.1).abs() < 1e-12 {
+            vec![0.45]
+        } else if lambda > 0.15 {
+            vec![lambda, lambda + 0.4]
+        } else {
+            vec![lambda]
+        };
+        let nearest = roots
+            .into_iter()
+            .min_by(|a, b| (x[0] - a).abs().total_cmp(&(x[0] - b).abs()))
+            .unwrap();
+        f[0] = x[0] - nearest;
+    }
+    fn jacobian(&mut self, _: &[f64], _: f64, jac: &mut nonsmooth_modes::linalg::DenseMatrix) {
+        jac.reset(1, 1);
+        jac[(0, 0)] = 1.0;
+    }
+    fn parameter_derivative(&mut self, _: &[f64], _: f64, df: &mut [f64]) {
+        df[0] = -1.0;
+    }
+}
+
+/// `x` of every point of a run, rounded, with its convergence flag.
+fn rounded(points: impl Iterator<Item = Point>) -> Vec<(bool, f64)> {
+    points
+        .map(|p| (p.converged, (p.x[0] * 1e9).round() / 1e9))
+        .collect()
+}
+
+/// After a spike, the last point leads to the high branch and the point before it back to the
+/// low one: `Selection::LowestMeasure` keeps the low branch, `FirstConverged` follows the
+/// high one. A NaN measure ranks last, and without a measure the rule is `FirstConverged`.
+#[test]
+fn sequential_lowest_measure_leaves_a_spike_for_the_low_branch() {
+    use nonsmooth_modes::continuation::{Selection, Sequential, SequentialOptions};
+    let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
+    let driver = |selection| {
+        let options = SequentialOptions {
+            retry_depth: 1,
+            selection,
+            ..Default::default()
+        };
+        Sequential::new(
+            TwoBranches,
+            Local::default(),
+            vec![0.0],
+            values.clone(),
+            options,
+        )
+        .unwrap()
+    };
+    let on = |xs: [f64; 5]| xs.iter().map(|&x| (true, x)).collect::<Vec<_>>();
+    let high = on([0.0, 0.45, 0.6, 0.7, 0.8]);
+    let low = on([0.0, 0.45, 0.2, 0.3, 0.4]);
+    let first = rounded(driver(Selection::FirstConverged).with_measure(|x, _| x[0]));
+    assert_eq!(first, high);
+    let lowest = rounded(driver(Selection::LowestMeasure).with_measure(|x, _| x[0]));
+    assert_eq!(lowest, low);
+    // NaN on the low branch ranks it last.
+    let nan_low =
+        driver(Selection::LowestMeasure)
+            .with_measure(|x, _| if x[0] < 0.5 { f64::NAN } else { x[0] });
+    assert_eq!(rounded(nan_low), high);
+    assert_eq!(rounded(driver(Selection::LowestMeasure)), high);
+    assert_eq!(
+        SequentialOptions::default().selection,
+        Selection::FirstConverged
+    );
+}
+
+/// With `Selection::LowestMeasure`, `step_speculative` is `step`: the same points, and no
+/// speculative retry.
+#[test]
+fn speculative_lowest_measure_gives_the_serial_points() {
+    use nonsmooth_modes::continuation::{Selection, Sequential, SequentialOptions, Speculation};
+    let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
+    for retry_depth in [1, 2] {
+        let driver = || {
+            let options = SequentialOptions {
+                retry_depth,
+                selection: Selection::LowestMeasure,
+                ..Default::default()
+            };
+            let solver = Local {
+                patience: std::time::Duration::from_millis(20),
+            };
+            Sequential::new(TwoBranches, solver, vec![0.0], values.clone(), options)
+                .unwrap()
+                .with_measure(|x, _| x[0])
+        };
+        let serial: Vec<_> = driver().collect();
+        let mut speculative = driver();
+        let every_step = Speculation {
+            after_evaluations: 0,
+        };
+        let points = speculative_points(&mut speculative, every_step);
+        assert_eq!(points, serial);
+        assert_eq!(rounded(points.into_iter())[2], (true, 0.2));
+        assert_eq!(speculative.speculation_stats(), Default::default());
+    }
+}
+
+/// On the clamped bar at m = 40 the lowest-energy backbone is the same with and without
+/// speculative retries, and differs from the default one.
+#[test]
+fn speculative_lowest_energy_backbone_is_the_serial_backbone() {
+    use nonsmooth_modes::continuation::{Selection, Speculation};
+    let options = |selection| BackboneOptions {
+        retry_depth: 2,
+        selection,
+        ..Default::default()
+    };
+    let lowest = options(Selection::LowestMeasure);
+    let serial = clamped_backbone_m40(&lowest, None);
+    assert_eq!(serial.len(), 181);
+    let speculation = Speculation {
+        after_evaluations: 0,
+    };
+    assert_eq!(clamped_backbone_m40(&lowest, Some(speculation)), serial);
+    let first = options(Selection::FirstConverged);
+    assert_ne!(clamped_backbone_m40(&first, None), serial);
 }

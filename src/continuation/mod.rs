@@ -19,7 +19,7 @@ pub use arclength::{
     Rejection, StallEscape, TangentPredictor,
 };
 pub use progress::{quiet, Progress};
-pub use sequential::{linspace, Predictor, Sequential, SequentialOptions, StepOutcome};
+pub use sequential::{linspace, Predictor, Selection, Sequential, SequentialOptions, StepOutcome};
 pub use speculative::{Speculation, SpeculationStats};
 
 use crate::error::SolveError;

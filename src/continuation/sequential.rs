@@ -16,6 +16,34 @@ pub enum Predictor {
     Secant,
 }
 
+/// How a step of the [`Sequential`] driver chooses among the solutions reached from its
+/// starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Selection {
+    /// Solve from the prediction; if that fails, from up to
+    /// [`SequentialOptions::retry_depth`] earlier converged points in turn, the most recent
+    /// first, and keep the first accepted solution. A successful retry drops the points it
+    /// stepped over from the history (default).
+    #[default]
+    FirstConverged,
+    /// Solve from the prediction and from each of up to [`SequentialOptions::retry_depth`]
+    /// earlier converged points, and keep the accepted solution with the lowest measure
+    /// ([`Sequential::with_measure`]; a NaN measure ranks last, ties keep the most recent
+    /// start). The history is a rolling window of the last converged points: a retry does
+    /// not drop the points it stepped over.
+    ///
+    /// Why: the first converged start is not always the right one. Near an internal
+    /// resonance of a truncated system the last point can lead to a solution carrying extra
+    /// energy in a resonant harmonic (a spike, or a neighbouring branch) while an earlier
+    /// point leads back to the backbone; with the energy as measure the start that reaches
+    /// the lowest energy is the one still on the backbone. The cost: every step solves from
+    /// all its starts, about `retry_depth` extra solves per step (see
+    /// [`BackboneOptions::selection`](crate::modal::BackboneOptions::selection) for the
+    /// measured trade-off on the clamped bar). Without a measure it is
+    /// [`Selection::FirstConverged`].
+    LowestMeasure,
+}
+
 /// Options of the [`Sequential`] driver.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SequentialOptions {
@@ -29,8 +57,12 @@ pub struct SequentialOptions {
     /// paper's plain sequential continuation). Near an internal resonance the last point can
     /// be a resonance spike of the truncated system whose neighbourhood holds no solution at
     /// the next parameter, while an earlier point still leads back to the backbone. A
-    /// successful retry drops the points it stepped over from the driver's history.
+    /// successful retry drops the points it stepped over from the driver's history (not with
+    /// [`Selection::LowestMeasure`], which also uses these points as starts of every step).
     pub retry_depth: usize,
+    /// How a step chooses among its starts' solutions (default
+    /// [`Selection::FirstConverged`]).
+    pub selection: Selection,
 }
 
 impl Default for SequentialOptions {
@@ -39,6 +71,7 @@ impl Default for SequentialOptions {
             predictor: Predictor::Constant,
             max_consecutive_failures: 40,
             retry_depth: 1,
+            selection: Selection::FirstConverged,
         }
     }
 }
@@ -58,7 +91,9 @@ pub enum StepOutcome {
 
 /// Sequential continuation over a fixed list of parameter values: at each value, solve
 /// `F(x, lambda) = 0` from the predicted guess (and, if that fails and
-/// [`SequentialOptions::retry_depth`] allows, from earlier converged points). Failed steps are reported and skipped; the next step starts again from the last
+/// [`SequentialOptions::retry_depth`] allows, from earlier converged points; with
+/// [`Selection::LowestMeasure`] and a measure, from all of them, keeping the lowest measure).
+/// Failed steps are reported and skipped; the next step starts again from the last
 /// converged solution.
 pub struct Sequential<P, S> {
     pub(super) problem: P,
@@ -78,6 +113,7 @@ pub struct Sequential<P, S> {
     failures: usize,
     stalled: bool,
     pub(super) accept: Option<Acceptance>,
+    measure: Option<Measure>,
 }
 
 /// One solve of a step: where it ended, how, and from which start.
@@ -99,6 +135,9 @@ impl Attempt {
 
 /// A test that a converged solution `(x, lambda)` belongs to the branch.
 pub(super) type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
+
+/// A scalar ranking accepted solutions `(x, lambda)` for [`Selection::LowestMeasure`].
+type Measure = Box<dyn FnMut(&[f64], f64) -> f64>;
 
 /// Whether a solve's outcome joins the branch: it converged and the acceptance test (if any)
 /// takes the solution.
@@ -160,6 +199,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             failures: 0,
             stalled: false,
             accept: None,
+            measure: None,
         })
     }
 
@@ -169,6 +209,29 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'static) -> Self {
         self.accept = Some(Box::new(accept));
         self
+    }
+
+    /// Sets the measure [`Selection::LowestMeasure`] minimises over a step's accepted
+    /// solutions (for a backbone, the energy). It is called once per accepted solution, right
+    /// after the acceptance test took it (so it may reuse what the test computed), and only
+    /// with [`Selection::LowestMeasure`]. A NaN measure ranks last.
+    pub fn with_measure(mut self, measure: impl FnMut(&[f64], f64) -> f64 + 'static) -> Self {
+        self.measure = Some(Box::new(measure));
+        self
+    }
+
+    /// Whether steps keep the lowest-measure solution ([`Selection::LowestMeasure`] with a
+    /// measure) rather than the first accepted one.
+    pub(super) fn selects_lowest(&self) -> bool {
+        self.options.selection == Selection::LowestMeasure && self.measure.is_some()
+    }
+
+    /// The measure of an accepted solution, NaN (or no measure) ranked last.
+    fn measure_of(&mut self, x: &[f64], lambda: f64) -> f64 {
+        match self.measure.as_mut().map(|m| m(x, lambda)) {
+            Some(v) if !v.is_nan() => v,
+            _ => f64::INFINITY,
+        }
     }
 
     /// The problem (for post-processing between steps).
@@ -216,6 +279,22 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         (result, accepted)
     }
 
+    /// Solves at `lambda` from `x`, the start `from_history` (see [`Attempt`]).
+    fn attempt_from(
+        &mut self,
+        lambda: f64,
+        mut x: Vec<f64>,
+        from_history: Option<usize>,
+    ) -> Attempt {
+        let (result, accepted) = self.attempt(lambda, &mut x);
+        Attempt {
+            x,
+            result,
+            accepted,
+            from_history,
+        }
+    }
+
     /// The index and value of the next parameter, advancing the driver; `None` when the
     /// values are exhausted or the run stalled.
     pub(super) fn next_value(&mut self) -> Option<(usize, f64)> {
@@ -244,18 +323,31 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             if attempt.joins() {
                 break;
             }
-            let mut y = self.retry_start(d);
-            let (result, accepted) = self.attempt(lambda, &mut y);
-            if result.is_ok() && accepted {
-                attempt = Attempt {
-                    x: y,
-                    result,
-                    accepted,
-                    from_history: Some(d),
-                };
+            let retried = self.attempt_from(lambda, self.retry_start(d), Some(d));
+            if retried.joins() {
+                attempt = retried;
             }
         }
         attempt
+    }
+
+    /// Solves from every retry start after `first` (the prediction's attempt) and keeps the
+    /// accepted solution of lowest measure ([`Selection::LowestMeasure`]); strict comparison,
+    /// so ties keep the most recent start. `first` stands if nothing joins the branch.
+    fn lowest_from(&mut self, lambda: f64, first: Attempt) -> Attempt {
+        let mut best = first.joins().then(|| self.measure_of(&first.x, lambda));
+        let mut chosen = first;
+        for d in 0..self.retry_count() {
+            let retried = self.attempt_from(lambda, self.retry_start(d), Some(d));
+            if retried.joins() {
+                let value = self.measure_of(&retried.x, lambda);
+                if best.is_none_or(|b| value < b) {
+                    best = Some(value);
+                    chosen = retried;
+                }
+            }
+        }
+        chosen
     }
 
     /// Solves at the next parameter value.
@@ -263,20 +355,21 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         let Some((step, lambda)) = self.next_value() else {
             return StepOutcome::Finished;
         };
-        let mut x = self.predict(lambda);
-        let (result, accepted) = self.attempt(lambda, &mut x);
-        let first = Attempt {
-            x,
-            result,
-            accepted,
-            from_history: None,
+        let prediction = self.predict(lambda);
+        let first = self.attempt_from(lambda, prediction, None);
+        let chosen = if self.selects_lowest() {
+            self.lowest_from(lambda, first)
+        } else {
+            self.retry_from(lambda, 0, first)
         };
-        let chosen = self.retry_from(lambda, 0, first);
         self.conclude(step, lambda, chosen)
     }
 
     /// Records the outcome of the step at `lambda`: on success the point joins the branch
-    /// (and the history), on failure the failure count grows.
+    /// (and the history), on failure the failure count grows. With
+    /// [`Selection::FirstConverged`] a retry from `history[d]` drops the `d` points it stepped
+    /// over; with [`Selection::LowestMeasure`] the history is a rolling window of the last
+    /// converged points.
     pub(super) fn conclude(&mut self, step: usize, lambda: f64, chosen: Attempt) -> StepOutcome {
         let Attempt {
             x,
@@ -289,12 +382,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                 self.failures = 0;
                 let last = std::mem::replace(&mut self.last, x.clone());
                 match from_history {
-                    None => {
+                    // Drop the points stepped over; the start used heads the history.
+                    Some(d) if !self.selects_lowest() => drop(self.history.drain(..d)),
+                    _ => {
                         self.history.push_front((last, self.last_lambda));
                         self.history.truncate(self.options.retry_depth.max(1));
                     }
-                    // Drop the points stepped over; the start used heads the history.
-                    Some(d) => drop(self.history.drain(..d)),
                 }
                 self.last_lambda = lambda;
                 StepOutcome::Converged(Point {

@@ -245,7 +245,15 @@ where
     /// when the first attempt fails is run by the driver itself. Deeper retries
     /// ([`SequentialOptions::retry_depth`](super::SequentialOptions::retry_depth) above 1)
     /// run serially after it.
+    ///
+    /// With [`Selection::LowestMeasure`](super::Selection::LowestMeasure) and a measure
+    /// ([`Sequential::with_measure`]) this is [`Sequential::step`]: every start of every step
+    /// is solved anyway, so a retry is never speculative, and the serial path is the one whose
+    /// result is the reference.
     pub fn step_speculative(&mut self, speculation: Speculation) -> StepOutcome {
+        if self.selects_lowest() {
+            return self.step();
+        }
         let Some((step, lambda)) = self.next_value() else {
             return StepOutcome::Finished;
         };
@@ -389,12 +397,13 @@ mod tests {
     fn a_cancelled_solve_stops_at_once() {
         let solver = SemismoothNewton::default();
         let state = AtomicU8::new(CANCELLED);
-        let mut monitored = Monitored {
+        let watched = |state| Monitored {
             inner: Square,
             evaluations: 0,
             hook: None,
-            cancel: Some(&state),
+            cancel: Some(state),
         };
+        let mut monitored = watched(&state);
         let mut x = [3.0];
         let result = solver.solve(&mut monitored, &mut x);
         assert!(
@@ -404,12 +413,7 @@ mod tests {
         assert_eq!(monitored.evaluations, 1);
         // Running, not cancelled: the solve goes on.
         state.store(RUNNING, Ordering::Release);
-        let mut monitored = Monitored {
-            inner: Square,
-            evaluations: 0,
-            hook: None,
-            cancel: Some(&state),
-        };
+        let mut monitored = watched(&state);
         let mut x = [3.0];
         solver.solve(&mut monitored, &mut x).unwrap();
         assert!((x[0] - 2f64.sqrt()).abs() < 1e-9);
