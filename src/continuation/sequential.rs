@@ -109,7 +109,7 @@ pub struct Sequential<P, S> {
     last: Vec<f64>,
     last_lambda: f64,
     /// Converged points before `last`, the most recent first (at most `max(retry_depth, 1)`).
-    history: VecDeque<(Vec<f64>, f64)>,
+    pub(super) history: VecDeque<(Vec<f64>, f64)>,
     failures: usize,
     stalled: bool,
     pub(super) accept: Option<Acceptance>,
@@ -312,7 +312,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     }
 
     /// The start of retry `d`: the converged point `d + 1` places before the last.
-    pub(super) fn retry_start(&self, d: usize) -> Vec<f64> {
+    fn retry_start(&self, d: usize) -> Vec<f64> {
         self.history[d].0.clone()
     }
 

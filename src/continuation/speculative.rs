@@ -261,23 +261,26 @@ where
         if self.retry_count() > 0 && self.worker.is_none() {
             self.worker = Worker::spawn(self.problem.clone(), self.solver.clone());
         }
-        let job = match (&self.worker, self.retry_count()) {
-            (Some(worker), 1..) => worker.jobs.as_ref().map(|jobs| (jobs, self.retry_start(0))),
+        // The retry's start is copied, and its state allocated, only if it is handed over.
+        let retries = self.retry_count() > 0;
+        let mut pending = match (&self.worker, self.history.front()) {
+            (Some(worker), Some((start, _))) if retries => {
+                worker.jobs.as_ref().map(|jobs| (jobs, start))
+            }
             _ => None,
         };
-        let state = Arc::new(AtomicU8::new(PENDING));
-        let mut sent = false;
+        let mut handed: Option<Arc<AtomicU8>> = None;
         let result = {
-            let mut pending = job;
             let mut launch = || {
                 if let Some((jobs, start)) = pending.take() {
+                    let state = Arc::new(AtomicU8::new(PENDING));
                     let job = Job {
                         step,
                         lambda,
-                        start,
+                        start: start.clone(),
                         state: Arc::clone(&state),
                     };
-                    sent = jobs.send(job).is_ok();
+                    handed = jobs.send(job).is_ok().then_some(state);
                 }
             };
             let mut first = Monitored {
@@ -299,16 +302,20 @@ where
             from_history: None,
         };
         let stats = &mut self.speculation;
+        let sent = handed.is_some();
         stats.launched += usize::from(sent);
         if first.joins() {
-            state.store(CANCELLED, Ordering::Release);
+            if let Some(state) = &handed {
+                state.store(CANCELLED, Ordering::Release);
+            }
             stats.cancelled += usize::from(sent);
             return self.conclude(step, lambda, first);
         }
-        let taken = !sent
-            || state
+        let taken = handed.as_ref().is_none_or(|state| {
+            state
                 .compare_exchange(PENDING, TAKEN, Ordering::AcqRel, Ordering::Acquire)
-                .is_ok();
+                .is_ok()
+        });
         stats.taken_back += usize::from(sent && taken);
         let speculated = match (taken, &self.worker) {
             (false, Some(worker)) => worker.outcome(step),
