@@ -252,10 +252,11 @@ impl<B: Basis> NonsmoothSystem<B> {
             .laws()
             .map(|l| (l.gap().offset, l.force().offset))
             .collect();
-        let n = basis.samples();
+        // Laws are evaluated on the basis' folded samples only (the others repeat them).
+        let n = basis.folded_samples();
         let len = basis.len();
         let mut unit_gram = vec![0.0; len * len];
-        basis.weighted_gram(&vec![1.0; n], &mut unit_gram);
+        basis.weighted_gram_folded(&vec![1.0; n], &mut unit_gram);
         let ws = Workspace {
             coefficients: vec![0.0; len],
             gap: vec![0.0; laws * n],
@@ -415,12 +416,12 @@ impl<B: Basis> NonsmoothSystem<B> {
         gap: &mut [f64],
         force: &mut [f64],
     ) {
-        let n = self.basis.samples();
+        let n = self.basis.folded_samples();
         for l in 0..self.laws {
             let range = l * n..(l + 1) * n;
             for (is_gap, out) in [(true, &mut gap[range.clone()]), (false, &mut force[range])] {
                 self.observable_coefficients(x, l, is_gap, false, coefficients);
-                self.basis.synthesize(coefficients, out);
+                self.basis.synthesize_folded(coefficients, out);
                 if offsets {
                     let (g0, f0) = self.offsets[l];
                     let offset = if is_gap { g0 } else { f0 };
@@ -433,7 +434,7 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// Evaluates every law on the gap and force samples of `ws` (those of the unknowns `x`),
     /// and marks the samples as those of `x`.
     fn evaluate_laws(&self, ws: &mut Workspace, x: &[f64]) {
-        let n = self.basis.samples();
+        let n = self.basis.folded_samples();
         let blend = self.kink_blend * self.residual_scale();
         for (l, law) in self.system.laws().enumerate() {
             let range = l * n..(l + 1) * n;
@@ -473,10 +474,10 @@ impl<B: Basis> NonsmoothSystem<B> {
 
     /// The law block of `F` from the sampled law values, into `f`.
     fn project_laws(&self, f: &mut [f64]) {
-        let (len, n) = (self.basis.len(), self.basis.samples());
+        let (len, n) = (self.basis.len(), self.basis.folded_samples());
         let base = len * self.linear_count;
         for l in 0..self.laws {
-            self.basis.project(
+            self.basis.project_folded(
                 &self.ws.values[l * n..(l + 1) * n],
                 &mut f[base + l * len..base + (l + 1) * len],
             );
@@ -489,10 +490,10 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// When the force weight is an affine function of the gap weight (complementarity laws),
     /// `G(w_force)` is formed from `G(w_gap)` and `G(1)` instead of by a transform.
     fn law_grams(&self, ws: &mut Workspace, l: usize) {
-        let n = self.basis.samples();
+        let n = self.basis.folded_samples();
         let range = l * n..(l + 1) * n;
         let (w_gap, w_force) = (&ws.w_gap[range.clone()], &ws.w_force[range]);
-        self.basis.weighted_gram(w_gap, &mut ws.gram_gap);
+        self.basis.weighted_gram_folded(w_gap, &mut ws.gram_gap);
         match affine_relation(w_gap, w_force) {
             Some((alpha, beta)) => {
                 let terms = self.unit_gram.iter().zip(&ws.gram_gap);
@@ -500,7 +501,7 @@ impl<B: Basis> NonsmoothSystem<B> {
                     *g = alpha * u + beta * w;
                 }
             }
-            None => self.basis.weighted_gram(w_force, &mut ws.gram_force),
+            None => self.basis.weighted_gram_folded(w_force, &mut ws.gram_force),
         }
     }
 
@@ -690,15 +691,15 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         self.prepare(omega);
         self.linear_block(x, true, df);
         self.sample_laws(x);
-        let (len, n) = (self.basis.len(), self.basis.samples());
+        let (len, n) = (self.basis.len(), self.basis.folded_samples());
         let base = len * self.linear_count;
         let mut ws = std::mem::take(&mut self.ws);
         for l in 0..self.laws {
             let dg = &mut ws.d_samples;
             self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
-            self.basis.synthesize(&ws.coefficients, dg);
+            self.basis.synthesize_folded(&ws.coefficients, dg);
             self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
-            self.basis.synthesize(&ws.coefficients, &mut ws.scratch);
+            self.basis.synthesize_folded(&ws.coefficients, &mut ws.scratch);
             let (w_gap, w_force) = (
                 &ws.w_gap[l * n..(l + 1) * n],
                 &ws.w_force[l * n..(l + 1) * n],
@@ -706,7 +707,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             for (((s, d), wg), wf) in ws.scratch.iter_mut().zip(dg.iter()).zip(w_gap).zip(w_force) {
                 *s = wg * d + wf * *s;
             }
-            self.basis.project(&ws.scratch, &mut ws.projection);
+            self.basis.project_folded(&ws.scratch, &mut ws.projection);
             df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
         }
         self.ws = ws;
@@ -733,14 +734,16 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
     fn active_set(&mut self, x: &[f64], omega: f64) -> Option<Vec<usize>> {
         self.prepare(omega);
         self.sample_laws(x);
-        let n = self.basis.samples();
+        let n = self.basis.folded_samples();
         Some(
             (0..self.laws)
                 .map(|l| {
                     self.ws.w_gap[l * n..(l + 1) * n]
                         .iter()
-                        .filter(|w| **w != 0.0)
-                        .count()
+                        .enumerate()
+                        .filter(|(_, w)| **w != 0.0)
+                        .map(|(k, _)| self.basis.multiplicity(k))
+                        .sum()
                 })
                 .collect(),
         )
