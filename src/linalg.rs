@@ -267,6 +267,29 @@ impl Lu {
     }
 }
 
+/// `sum a_k b_k` with four interleaved partial sums: a long dot product is otherwise one
+/// chain of dependent additions (latency-bound, not vectorised); this one vectorises.
+///
+/// # Panics
+/// If the lengths differ.
+pub(crate) fn dot_lanes(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len(), "dot product of equal lengths");
+    let mut lanes = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = a4
+        .remainder()
+        .iter()
+        .zip(b4.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in a4.zip(b4) {
+        for i in 0..4 {
+            lanes[i] += x[i] * y[i];
+        }
+    }
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
+}
+
 /// Singular values (descending) and right singular vectors (columns of `v`, `ncols x ncols`)
 /// of a small matrix given row-major as `nrows x ncols`.
 pub(crate) fn svd_small(rows: &[f64], nrows: usize, ncols: usize) -> (Vec<f64>, DenseMatrix) {
@@ -344,6 +367,16 @@ pub(crate) fn singular_values_small(rows: &[f64], nrows: usize, ncols: usize, ou
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lane_dot_matches_the_plain_sum() {
+        for n in 0..11 {
+            let a: Vec<f64> = (0..n).map(|i| 1.0 + i as f64).collect();
+            let b: Vec<f64> = (0..n).map(|i| 0.5 - i as f64).collect();
+            let plain: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+            assert_eq!(dot_lanes(&a, &b), plain, "n = {n}");
+        }
+    }
 
     #[test]
     fn lu_solves_and_detects_singularity() {

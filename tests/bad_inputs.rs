@@ -449,29 +449,37 @@ fn iteration_budget() {
     let info = generous.solve(&mut frozen(&mut problem), &mut x).unwrap();
     assert!(info.residual_norm <= tolerance && info.residual_norm.is_finite());
     assert!(x.iter().all(|v| v.is_finite()));
-    // The same poor start with a stagnation window of five iterations: its residual does not
-    // halve within five iterations, so the solve stops early with the two norms that show it.
-    let mut x = start.clone();
-    let fast = SemismoothNewton::new(NewtonOptions {
+    // The same poor start with a stagnation (or plateau) window of five iterations: its
+    // residual does not halve within five iterations, so the solve stops early with the two
+    // norms that show it.
+    let stall = NewtonOptions {
         stall_window: 5,
         ..Default::default()
-    })
-    .unwrap();
-    match fast.solve(&mut frozen(&mut problem), &mut x).unwrap_err() {
-        SolveError::Stagnated {
-            iteration,
-            residual_norm,
-            earlier_residual_norm,
-            window,
-        } => {
-            assert_eq!(window, 5);
-            assert!(iteration >= 5 && iteration < info.iterations);
-            assert!(residual_norm > 0.5 * earlier_residual_norm);
-            assert!(residual_norm.is_finite() && residual_norm > tolerance);
+    };
+    let plateau = NewtonOptions {
+        plateau_window: 5,
+        plateau_ratio: 0.5,
+        ..Default::default()
+    };
+    for options in [stall, plateau] {
+        let mut x = start.clone();
+        let fast = SemismoothNewton::new(options).unwrap();
+        match fast.solve(&mut frozen(&mut problem), &mut x).unwrap_err() {
+            SolveError::Stagnated {
+                iteration,
+                residual_norm,
+                earlier_residual_norm,
+                window,
+            } => {
+                assert_eq!(window, 5);
+                assert!(iteration >= 5 && iteration < info.iterations);
+                assert!(residual_norm > 0.5 * earlier_residual_norm);
+                assert!(residual_norm.is_finite() && residual_norm > tolerance);
+            }
+            other => panic!("expected Stagnated, got {other:?}"),
         }
-        other => panic!("expected Stagnated, got {other:?}"),
+        assert!(x.iter().all(|v| v.is_finite()));
     }
-    assert!(x.iter().all(|v| v.is_finite()));
     // The same start with half the residual evaluations the generous solve needed: it stops
     // in a line search once the budget is spent, with the count that shows it.
     let budget = info.residual_evaluations / 2;
@@ -519,16 +527,30 @@ fn zero_evaluation_budget_is_refused() {
 }
 
 #[test]
-fn stall_ratio_above_one_is_refused() {
-    let e = SemismoothNewton::new(NewtonOptions {
-        stall_ratio: 1.5,
-        ..NewtonOptions::fail_fast()
-    })
-    .unwrap_err();
-    assert!(
-        matches!(e, SolveError::InvalidOption { value, .. } if value == 1.5),
-        "{e:?}"
-    );
+fn stall_and_plateau_ratios_above_one_are_refused() {
+    let o = NewtonOptions::fail_fast();
+    for (options, name) in [
+        (
+            NewtonOptions {
+                stall_ratio: 1.5,
+                ..o
+            },
+            "stall_ratio",
+        ),
+        (
+            NewtonOptions {
+                plateau_ratio: 1.5,
+                ..o
+            },
+            "plateau_ratio",
+        ),
+    ] {
+        let e = SemismoothNewton::new(options).unwrap_err();
+        assert!(
+            matches!(e, SolveError::InvalidOption { what, value } if value == 1.5 && what.starts_with(name)),
+            "{e:?}"
+        );
+    }
 }
 
 /// `F(x) = x - 1` with a zero Jacobian.
@@ -635,6 +657,14 @@ fn invalid_solver_options() {
             })
             .map(|_| ()),
             "stall_ratio",
+        );
+        check(
+            SemismoothNewton::new(NewtonOptions {
+                plateau_ratio: v,
+                ..o
+            })
+            .map(|_| ()),
+            "plateau_ratio",
         );
         let o = DoglegOptions::default();
         check(

@@ -19,6 +19,7 @@
 //! `N` there is no such folding; the signal is unfolded and goes through a real FFT of size
 //! `N`.
 
+use crate::linalg::dot_lanes;
 use num_complex::Complex;
 use realfft::{RealFftPlanner, RealToComplex};
 use std::f64::consts::PI;
@@ -85,12 +86,14 @@ impl EvenTransform {
         self.samples / 2 + 1
     }
 
-    /// The cosine sums `C_l`, `l = 0..S`, of the even signal whose folded samples are
-    /// `folded`, into `sums` (both of length `S`).
+    /// The leading cosine sums `C_l`, `l = 0..sums.len()` (at most `S`), of the even signal
+    /// whose leading folded samples are `folded` (at most `S`; the others are zero), into
+    /// `sums`. A short signal (a synthesis from `m + 1 << S` coefficients) costs less before
+    /// the FFT; asking for fewer sums shortens the recurrence of the odd ones after it.
     pub(super) fn cosine_sums(&self, folded: &[f64], sums: &mut [f64], buffers: &mut Buffers) {
         let len = self.folded_len();
-        assert_eq!(folded.len(), len, "one folded period of samples");
-        assert_eq!(sums.len(), len, "one folded period of sums");
+        assert!(folded.len() <= len, "at most one folded period of samples");
+        assert!(sums.len() <= len, "at most one folded period of sums");
         let Buffers {
             real,
             spectrum,
@@ -100,36 +103,65 @@ impl EvenTransform {
             Kind::Half { fft, sin, cos } => {
                 let half = len - 1;
                 let x = folded;
-                real.clear();
-                real.extend((0..half).map(|k| {
-                    let (a, b) = (x[k], x[half - k]);
-                    (a + b) - 2.0 * sin[k] * (a - b)
-                }));
+                fold_for_half_length(x, half, sin, real);
                 run(fft.as_ref(), real, spectrum, scratch);
-                let interior: f64 = x[1..half].iter().zip(&cos[1..]).map(|(a, c)| a * c).sum();
-                let mut odd = x[0] - x[half] + 2.0 * interior;
-                sums[0] = spectrum[0].re;
+                let at = |k: usize| x.get(k).copied().unwrap_or(0.0);
+                let interior = &x[1.min(x.len())..x.len().min(half)];
+                let mut odd =
+                    at(0) - at(half) + 2.0 * dot_lanes(interior, &cos[1..interior.len() + 1]);
+                let Some((first, rest)) = sums.split_first_mut() else {
+                    return;
+                };
+                *first = spectrum[0].re;
                 // Bin l gives C_(2l) and carries C_(2l-1) to C_(2l+1) (l <= M/2).
-                for (l, y) in spectrum.iter().enumerate().skip(1) {
-                    sums[2 * l - 1] = odd;
-                    sums[2 * l] = y.re;
+                let mut pairs = rest.chunks_exact_mut(2);
+                for (pair, y) in pairs.by_ref().zip(&spectrum[1..]) {
+                    pair[0] = odd;
+                    pair[1] = y.re;
                     odd -= y.im;
                 }
-                if half % 2 == 1 {
-                    // M odd: the last sum is odd and follows the last bin.
-                    sums[half] = odd;
+                if let [last] = pairs.into_remainder() {
+                    // An even count of sums ends on an odd one, carried past the last pair.
+                    *last = odd;
                 }
             }
             Kind::Full { fft } => {
+                // Unfolded: x_0..x_S, then the mirror x_(S-1)..x_1 (N = 2S - 1), zero-padded.
                 real.clear();
                 real.extend_from_slice(folded);
-                real.extend(folded[1..].iter().rev());
+                real.resize(len, 0.0);
+                real.extend_from_within(1..len);
+                real[len..].reverse();
                 run(fft.as_ref(), real, spectrum, scratch);
                 for (s, y) in sums.iter_mut().zip(spectrum.iter()) {
                     *s = y.re;
                 }
             }
         }
+    }
+}
+
+/// `y_k = (x_k + x_(M-k)) - 2 sin(pi k / M) (x_k - x_(M-k))`, `k = 0..M`, into `real`, for
+/// the leading folded samples `x` (zero beyond).
+fn fold_for_half_length(x: &[f64], half: usize, sin: &[f64], real: &mut Vec<f64>) {
+    real.resize(half, 0.0);
+    if x.len() == half + 1 {
+        // Full signal: the mirror runs x_M, x_(M-1), .., x_1.
+        let pairs = x[..half].iter().zip(x[1..].iter().rev());
+        for ((y, (&a, &b)), &s) in real.iter_mut().zip(pairs).zip(sin) {
+            *y = (a + b) - 2.0 * s * (a - b);
+        }
+        return;
+    }
+    // x_k vanishes from k = len on, x_(M-k) up to k = M - len.
+    real.fill(0.0);
+    let lead = x.len().min(half);
+    for k in 0..lead {
+        let (a, b) = (x[k], if half - k < x.len() { x[half - k] } else { 0.0 });
+        real[k] = (a + b) - 2.0 * sin[k] * (a - b);
+    }
+    for k in (half + 1 - x.len()).max(lead)..half {
+        real[k] = x[half - k] * (1.0 + 2.0 * sin[k]);
     }
 }
 

@@ -195,25 +195,30 @@ impl CosineBasis {
             .extend((0..=n / 2).map(|k| 0.5 * (x[k] + x[(n - k) % n])));
     }
 
-    /// The cosine sums `C_l = sum_k x_k cos(l theta_k)` (full period, `l = 0..S`) of the
-    /// even signal with folded samples `folded`, into `scratch.sums`.
-    fn cosine_sums(&self, folded: &[f64], scratch: &mut Scratch) {
+    /// The cosine sums `C_l = sum_k x_k cos(l theta_k)` (full period, `l = 0..count`,
+    /// `count <= S`) of the even signal with folded samples `folded`, into `scratch.sums`.
+    fn cosine_sums(&self, folded: &[f64], count: usize, scratch: &mut Scratch) {
         let Scratch {
             sums, transform, ..
         } = scratch;
-        sums.resize(self.folded_samples(), 0.0);
+        sums.resize(count, 0.0);
         self.transform.cosine_sums(folded, sums, transform);
+    }
+
+    /// How many cosine sums the Gram moments `sigma_0..sigma_2m` read: `C_l = C_(N-l)`
+    /// serves the moments above `N/2`.
+    fn moment_sums(&self) -> usize {
+        (2 * self.harmonics).min(self.samples / 2) + 1
     }
 
     /// Synthesis into `scratch.sums`: the cosine sums of the even coefficient sequence
     /// `(c_0, c_1, .., c_m, 0, .., 0, c_m, .., c_1) / 2`, whose folded half is
-    /// `(c_0 .. c_m) / 2` padded with zeros.
+    /// `(c_0 .. c_m) / 2` followed by zeros.
     fn synthesize_into_sums(&self, coefficients: &[f64], scratch: &mut Scratch) {
         let mut folded = std::mem::take(&mut scratch.folded);
         folded.clear();
         folded.extend(coefficients.iter().take(self.len()).map(|c| 0.5 * c));
-        folded.resize(self.folded_samples(), 0.0);
-        self.cosine_sums(&folded, scratch);
+        self.cosine_sums(&folded, self.folded_samples(), scratch);
         scratch.folded = folded;
     }
 
@@ -297,7 +302,7 @@ impl Basis for CosineBasis {
         with_scratch(|scratch| {
             self.fold(samples, scratch);
             let folded = std::mem::take(&mut scratch.folded);
-            self.cosine_sums(&folded, scratch);
+            self.cosine_sums(&folded, self.len(), scratch);
             scratch.folded = folded;
             self.project_sums(coefficients, scratch);
         });
@@ -306,7 +311,7 @@ impl Basis for CosineBasis {
         with_scratch(|scratch| {
             self.fold(weights, scratch);
             let folded = std::mem::take(&mut scratch.folded);
-            self.cosine_sums(&folded, scratch);
+            self.cosine_sums(&folded, self.moment_sums(), scratch);
             scratch.folded = folded;
             self.gram_from_sums(gram, scratch);
         });
@@ -332,13 +337,13 @@ impl Basis for CosineBasis {
     }
     fn project_folded(&self, samples: &[f64], coefficients: &mut [f64]) {
         with_scratch(|scratch| {
-            self.cosine_sums(samples, scratch);
+            self.cosine_sums(samples, self.len(), scratch);
             self.project_sums(coefficients, scratch);
         });
     }
     fn weighted_gram_folded(&self, weights: &[f64], gram: &mut [f64]) {
         with_scratch(|scratch| {
-            self.cosine_sums(weights, scratch);
+            self.cosine_sums(weights, self.moment_sums(), scratch);
             self.gram_from_sums(gram, scratch);
         });
     }

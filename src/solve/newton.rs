@@ -28,6 +28,15 @@ pub struct NewtonOptions {
     /// Least decrease factor over [`NewtonOptions::stall_window`] iterations (default 0.5,
     /// in `(0, 1]`).
     pub stall_ratio: f64,
+    /// Plateau window (default 0: off; 4 in [`NewtonOptions::fail_fast`]): a second, short
+    /// stagnation test with its own ratio, failing with [`SolveError::Stagnated`] too. A
+    /// hopeless start typically drops its residual fast, then creeps along a plateau with
+    /// line searches of ever shorter steps; a solve that converges never spends four
+    /// iterations on a plateau first (`docs/performance.md`).
+    pub plateau_window: usize,
+    /// Least decrease factor over [`NewtonOptions::plateau_window`] iterations (default 0.98,
+    /// in `(0, 1]`).
+    pub plateau_ratio: f64,
     /// Budget of residual evaluations per solve, line-search trials included (default
     /// `usize::MAX`: none; 80 in [`NewtonOptions::fail_fast`]): give up with
     /// [`SolveError::EvaluationBudget`] when a line search has spent it. A hopeless start
@@ -46,6 +55,8 @@ impl Default for NewtonOptions {
             min_step: 1e-10,
             stall_window: 0,
             stall_ratio: 0.5,
+            plateau_window: 0,
+            plateau_ratio: 0.98,
             max_evaluations: usize::MAX,
         }
     }
@@ -54,21 +65,24 @@ impl Default for NewtonOptions {
 impl NewtonOptions {
     /// Settings for sequential continuation on a fine grid, where each step starts from a
     /// converged neighbour and a failed step is simply skipped: the line search gives up at
-    /// step length `1e-4` (instead of `1e-10`) and the stagnation test is on
-    /// (`stall_window = 15`, `stall_ratio = 0.5`). A start that needs steps shorter than
-    /// `1e-4` or fifteen iterations to halve its residual is outside every solution's basin
-    /// in practice, and so is one that has spent 80 residual evaluations
-    /// ([`NewtonOptions::max_evaluations`]); the default settings spend most of a backbone's
-    /// time proving it (`docs/performance.md`). On the clamped bar's 181-step backbone they converge the same
-    /// steps as the defaults at `m = 20` and `40` and two fewer at `m = 80` (169 of 181), in a
-    /// half to a third of the time. Not for
-    /// far starts (a seed, the jumps of [`crate::continuation::StallEscape`]): those can need
-    /// a slow first phase before converging.
+    /// step length `1e-4` (instead of `1e-10`), the stagnation test is on
+    /// (`stall_window = 15`, `stall_ratio = 0.5`) and so is the plateau test
+    /// (`plateau_window = 4`, `plateau_ratio = 0.98`). A start that needs steps shorter than
+    /// `1e-4`, fifteen iterations to halve its residual or four to cut it by 2 % is outside
+    /// every solution's basin in practice, and so is one that has spent 80 residual
+    /// evaluations ([`NewtonOptions::max_evaluations`]); the default settings spend most of a
+    /// backbone's time proving it (`docs/performance.md`). On the clamped bar's 181-step
+    /// backbone they converge the same steps as the defaults at `m = 20` and `40` and one
+    /// fewer at `m = 80` (169 of 181), in a half to a third of the time. Not for far starts
+    /// (a seed, the jumps of [`crate::continuation::StallEscape`]): those can need a slow
+    /// first phase before converging.
     pub fn fail_fast() -> Self {
         Self {
             min_step: 1e-4,
             stall_window: 15,
             stall_ratio: 0.5,
+            plateau_window: 4,
+            plateau_ratio: 0.98,
             max_evaluations: 80,
             ..Self::default()
         }
@@ -93,24 +107,27 @@ impl SemismoothNewton {
     ///
     /// # Errors
     /// [`SolveError::InvalidOption`] for a non-positive or non-finite tolerance, Armijo
-    /// constant or minimum step, a stagnation ratio outside `(0, 1]`, or a zero evaluation
-    /// budget.
+    /// constant or minimum step, a stagnation or plateau ratio outside `(0, 1]`, or a zero
+    /// evaluation budget.
     pub fn new(options: NewtonOptions) -> Result<Self, SolveError> {
         check_positive("tolerance", options.tolerance)?;
         check_positive("armijo", options.armijo)?;
         check_positive("min_step", options.min_step)?;
         check_positive("stall_ratio", options.stall_ratio)?;
+        check_positive("plateau_ratio", options.plateau_ratio)?;
         if options.max_evaluations == 0 {
             return Err(SolveError::InvalidOption {
                 what: "max_evaluations",
                 value: 0.0,
             });
         }
-        if options.stall_ratio > 1.0 {
-            return Err(SolveError::InvalidOption {
-                what: "stall_ratio (at most 1)",
-                value: options.stall_ratio,
-            });
+        for (what, ratio) in [
+            ("stall_ratio (at most 1)", options.stall_ratio),
+            ("plateau_ratio (at most 1)", options.plateau_ratio),
+        ] {
+            if ratio > 1.0 {
+                return Err(SolveError::InvalidOption { what, value: ratio });
+            }
         }
         Ok(Self { options })
     }
@@ -137,11 +154,13 @@ impl NonlinearSolver for SemismoothNewton {
             } = ws;
             let mut r = it.residual_into(x, f, 0)?;
             let mut history = Stagnation::new(o.stall_window, o.stall_ratio);
+            let mut plateau = Stagnation::new(o.plateau_window, o.plateau_ratio);
             for iteration in 0..o.max_iterations {
                 if r <= tol {
                     return Ok(it.info(iteration, r));
                 }
                 history.check(iteration, r)?;
+                plateau.check(iteration, r)?;
                 match it.problem.newton_step(x, f, dx) {
                     Some(Ok(())) => {
                         it.jacobians += 1;

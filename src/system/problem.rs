@@ -18,7 +18,7 @@ use crate::bc::LawSamples;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
-use crate::linalg::{DenseMatrix, Lu};
+use crate::linalg::{dot_lanes, DenseMatrix, Lu};
 use crate::solve::{point_on_ray, SingularStep};
 use crate::system::condense::{condense_into, CondenseScratch, Condensed};
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
@@ -575,9 +575,13 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         self.dimension()
     }
 
+    /// Samples `x` afresh even when a line-search trial left samples of the same point (they
+    /// differ from a synthesis in the last bits): the value depends on `x` alone, so clones
+    /// of the problem (speculative retries) report the same residuals.
     fn residual(&mut self, x: &[f64], omega: f64, f: &mut [f64]) {
         self.prepare(omega);
         self.linear_block(x, false, f);
+        self.ws.sampled = None;
         self.sample_laws(x);
         self.project_laws(f);
     }
@@ -699,7 +703,8 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
             self.basis.synthesize_folded(&ws.coefficients, dg);
             self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
-            self.basis.synthesize_folded(&ws.coefficients, &mut ws.scratch);
+            self.basis
+                .synthesize_folded(&ws.coefficients, &mut ws.scratch);
             let (w_gap, w_force) = (
                 &ws.w_gap[l * n..(l + 1) * n],
                 &ws.w_force[l * n..(l + 1) * n],
@@ -834,7 +839,8 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
                     &ws.gram_gap[j * len..(j + 1) * len],
                     &ws.gram_force[j * len..(j + 1) * len],
                 );
-                red.rhs[row] = -f[base + row] - dot(gg, &red.gap_p) - dot(gf, &red.force_p);
+                red.rhs[row] =
+                    -f[base + row] - dot_lanes(gg, &red.gap_p) - dot_lanes(gf, &red.force_p);
             }
             // The transpose is stored (column `l len + j` of the column-major storage is
             // row `j` of the law's block): reads of the row-major Gram matrices and writes
