@@ -272,6 +272,7 @@ impl Lu {
 ///
 /// # Panics
 /// If the lengths differ.
+#[inline]
 pub(crate) fn dot_lanes(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len(), "dot product of equal lengths");
     let mut lanes = [0.0; 4];
