@@ -41,8 +41,8 @@ pub struct NewtonOptions {
     /// `usize::MAX`: none; 80 in [`NewtonOptions::fail_fast`]): give up with
     /// [`SolveError::EvaluationBudget`] when a line search has spent it. A hopeless start
     /// spends its time in long line searches at tiny steps; the solves that converge on the
-    /// clamped bar's backbones use at most 44 (`m = 40`) and 105 (`m = 80`) evaluations, the
-    /// failed ones 34 to 179 (`docs/performance.md`).
+    /// clamped bar's backbones use at most 44 (`m = 40`) and 74 (`m = 80`) evaluations, nine
+    /// in ten of them at most 6 and 9 (`docs/performance.md`).
     pub max_evaluations: usize,
 }
 
