@@ -205,6 +205,18 @@ impl CosineBasis {
         self.transform.cosine_sums(folded, sums, transform);
     }
 
+    /// [`Self::cosine_sums`] of the signal in `scratch.folded` (left there).
+    fn cosine_sums_of_scratch(&self, count: usize, scratch: &mut Scratch) {
+        let Scratch {
+            folded,
+            sums,
+            transform,
+            ..
+        } = scratch;
+        sums.resize(count, 0.0);
+        self.transform.cosine_sums(folded, sums, transform);
+    }
+
     /// How many cosine sums the Gram moments `sigma_0..sigma_2m` read: `C_l = C_(N-l)`
     /// serves the moments above `N/2`.
     fn moment_sums(&self) -> usize {
@@ -215,11 +227,10 @@ impl CosineBasis {
     /// `(c_0, c_1, .., c_m, 0, .., 0, c_m, .., c_1) / 2`, whose folded half is
     /// `(c_0 .. c_m) / 2` followed by zeros.
     fn synthesize_into_sums(&self, coefficients: &[f64], scratch: &mut Scratch) {
-        let mut folded = std::mem::take(&mut scratch.folded);
-        folded.clear();
-        folded.extend(coefficients.iter().take(self.len()).map(|c| 0.5 * c));
-        self.cosine_sums(&folded, self.folded_samples(), scratch);
-        scratch.folded = folded;
+        scratch.folded.clear();
+        let halves = coefficients.iter().take(self.len()).map(|c| 0.5 * c);
+        scratch.folded.extend(halves);
+        self.cosine_sums_of_scratch(self.folded_samples(), scratch);
     }
 
     /// `R_j = (2/N) C_j` for the coefficients, from `scratch.sums`.
@@ -301,18 +312,14 @@ impl Basis for CosineBasis {
     fn project(&self, samples: &[f64], coefficients: &mut [f64]) {
         with_scratch(|scratch| {
             self.fold(samples, scratch);
-            let folded = std::mem::take(&mut scratch.folded);
-            self.cosine_sums(&folded, self.len(), scratch);
-            scratch.folded = folded;
+            self.cosine_sums_of_scratch(self.len(), scratch);
             self.project_sums(coefficients, scratch);
         });
     }
     fn weighted_gram(&self, weights: &[f64], gram: &mut [f64]) {
         with_scratch(|scratch| {
             self.fold(weights, scratch);
-            let folded = std::mem::take(&mut scratch.folded);
-            self.cosine_sums(&folded, self.moment_sums(), scratch);
-            scratch.folded = folded;
+            self.cosine_sums_of_scratch(self.moment_sums(), scratch);
             self.gram_from_sums(gram, scratch);
         });
     }
