@@ -11,7 +11,7 @@
 //! ```
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use nonsmooth_modes::continuation::{AtParameter, ContinuationProblem, Speculation};
+use nonsmooth_modes::continuation::{ContinuationProblem, Speculation};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::backbone::backbone_speculative_with;
@@ -19,7 +19,7 @@ use nonsmooth_modes::modal::{
     backbone, energy, energy_at, BackboneOptions, BackbonePoint, PeriodGrid,
 };
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, Problem, SemismoothNewton};
 use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::hint::black_box;
@@ -78,8 +78,9 @@ fn residual_and_jacobian(c: &mut Criterion) {
         let (_, p) = two_points(&system, m);
         let mut problem = NonsmoothSystem::new(&system, settings(m)).unwrap();
         let mut f = vec![0.0; problem.dimension()];
+        problem.set_parameter(p.omega);
         residual.bench_with_input(BenchmarkId::from_parameter(m), &p, |b, p| {
-            b.iter(|| problem.residual(black_box(&p.x), p.omega, &mut f));
+            b.iter(|| problem.residual(black_box(&p.x), &mut f));
         });
     }
     residual.finish();
@@ -88,8 +89,9 @@ fn residual_and_jacobian(c: &mut Criterion) {
         let (_, p) = two_points(&system, m);
         let mut problem = NonsmoothSystem::new(&system, settings(m)).unwrap();
         let mut jac = DenseMatrix::zeros(0, 0);
+        problem.set_parameter(p.omega);
         jacobian.bench_with_input(BenchmarkId::from_parameter(m), &p, |b, p| {
-            b.iter(|| problem.jacobian(black_box(&p.x), p.omega, &mut jac));
+            b.iter(|| problem.jacobian(black_box(&p.x), &mut jac));
         });
     }
     jacobian.finish();
@@ -110,11 +112,8 @@ fn one_solve(c: &mut Criterion) {
             |b, (from, to)| {
                 b.iter(|| {
                     x.copy_from_slice(&from.x);
-                    let mut frozen = AtParameter {
-                        problem: &mut problem,
-                        lambda: to.omega,
-                    };
-                    solver.solve(&mut frozen, black_box(&mut x)).unwrap()
+                    problem.set_parameter(to.omega);
+                    solver.solve(&mut problem, black_box(&mut x)).unwrap()
                 });
             },
         );

@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let start = branch_seed(&mut problem, 1, 1, 2.0 * PI / 3.95)?;
     let periods: Vec<f64> = (0..=180).map(|i| 3.95 - 0.005 * i as f64).collect();
     let mut sequential = Sequential::new(
-        PeriodParametrised(problem),
+        PeriodParametrised::new(problem),
         SemismoothNewton::default(),
         start,
         periods,
@@ -78,7 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let Some(from) = last else {
         return Err("no converged point to switch from".into());
     };
-    let problem = PeriodParametrised(NonsmoothSystem::new(&system, settings)?);
+    let problem = PeriodParametrised::new(NonsmoothSystem::new(&system, settings)?);
     let options = ArclengthOptions {
         direction: -1.0,
         parameter_range: (3.0, 4.0),

@@ -20,7 +20,7 @@
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
-    ArclengthOptions, AtParameter, ContinuationProblem, EndReason, StallEscape,
+    ArclengthOptions, ContinuationProblem, EndReason, StallEscape,
 };
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::write_columns_csv;
@@ -39,7 +39,7 @@ use nonsmooth_modes::plot::{
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{NonlinearSolver, Problem, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use nonsmooth_modes::verify::{march, periodicity_check, MarchOptions, PeriodicityOptions, State};
 use std::f64::consts::PI;
@@ -444,7 +444,8 @@ fn fig02(ctx: &Ctx) -> Res<Stats> {
         x[problem.index(0, 0, 1)] = 2.0 * a * GAP;
         x[problem.index(1, 0, 1)] = b * GAP * k1 / k1.sin();
         let mut f = vec![0.0; dim];
-        problem.residual(&x, omega, &mut f);
+        problem.set_parameter(omega);
+        problem.residual(&x, &mut f);
         (f[dim - 2] / GAP, f[dim - 1] / GAP)
     };
     let (mut g0, mut g1) = (Vec::new(), Vec::new());
@@ -565,12 +566,9 @@ fn exact_seeded_point(m: usize, period: f64) -> Res<Option<BackbonePoint>> {
     let exact = ClampedFirstMode::new(GAP, period);
     let mut x = exact.unknowns(m);
     let solver = SemismoothNewton::default();
-    let mut frozen = AtParameter {
-        problem: &mut problem,
-        lambda: omega,
-    };
-    let tolerance = solver.tolerance(&frozen);
-    let info = match solver.solve(&mut frozen, &mut x) {
+    problem.set_parameter(omega);
+    let tolerance = solver.tolerance(&mut problem);
+    let info = match solver.solve(&mut problem, &mut x) {
         Ok(info) => info,
         Err(_) => return Ok(None),
     };

@@ -249,6 +249,14 @@ pub enum SolveError {
         /// The rejected value.
         value: f64,
     },
+    /// The solve's [`SolveMonitor`](crate::solve::SolveMonitor) cancelled it.
+    #[error("solve cancelled at iteration {iteration} after {evaluations} residual evaluations")]
+    Cancelled {
+        /// Iteration at which it was cancelled.
+        iteration: usize,
+        /// Residual evaluations made.
+        evaluations: usize,
+    },
 }
 
 /// Errors of a continuation run.

@@ -142,6 +142,22 @@ pub(crate) struct Lu {
     rhs: RefCell<Vec<f64>>,
 }
 
+impl Clone for Lu {
+    /// The factors and permutation; faer's scratch memory is made anew on the next
+    /// factorisation.
+    fn clone(&self) -> Self {
+        Self {
+            n: self.n,
+            factors: self.factors.clone(),
+            perm: self.perm.clone(),
+            perm_inv: self.perm_inv.clone(),
+            scratch: None,
+            scratch_n: 0,
+            rhs: self.rhs.clone(),
+        }
+    }
+}
+
 impl std::fmt::Debug for Lu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Lu")

@@ -38,7 +38,7 @@
 
 use crate::error::{Error, SolveError};
 use crate::modal::{backbone, BackboneOptions, BackbonePoint};
-use crate::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo};
+use crate::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo, SolveMonitor};
 use crate::system::{BarSystem, HarmonicBalance};
 
 /// A solver chosen per job (so that one sweep can mix solvers).
@@ -57,14 +57,19 @@ impl Default for Solver {
 }
 
 impl NonlinearSolver for Solver {
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError> {
         match self {
-            Self::Newton(s) => s.solve(problem, x),
-            Self::Dogleg(s) => s.solve(problem, x),
+            Self::Newton(s) => s.solve_monitored(problem, x, monitor),
+            Self::Dogleg(s) => s.solve_monitored(problem, x, monitor),
         }
     }
 
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
         match self {
             Self::Newton(s) => s.tolerance(problem),
             Self::Dogleg(s) => s.tolerance(problem),

@@ -4,7 +4,7 @@ use nonsmooth_modes::bar::{Bar, EndRef};
 use nonsmooth_modes::bc::{
     BoundaryCondition, Contact, LinearRows, Quantity, Robin, Signorini, Term,
 };
-use nonsmooth_modes::continuation::{linspace, Sequential, SequentialOptions};
+use nonsmooth_modes::continuation::{linspace, ContinuationProblem, Sequential, SequentialOptions};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{
     backbone, branch_seed, grazing_energy, natural_frequencies, BackboneOptions, ContactState,
@@ -342,14 +342,10 @@ fn bad_modes_and_subharmonics() {
     }
 }
 
-/// The clamped system frozen at `T = 3.6`.
-fn frozen(
-    problem: &mut NonsmoothSystem,
-) -> nonsmooth_modes::continuation::AtParameter<'_, NonsmoothSystem> {
-    nonsmooth_modes::continuation::AtParameter {
-        problem,
-        lambda: 2.0 * PI / 3.6,
-    }
+/// The clamped system at `T = 3.6`.
+fn frozen(problem: &mut NonsmoothSystem) -> &mut NonsmoothSystem {
+    problem.set_parameter(2.0 * PI / 3.6);
+    problem
 }
 
 #[test]

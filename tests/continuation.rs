@@ -11,7 +11,7 @@ use nonsmooth_modes::modal::{
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::{residual_scale, Problem, SemismoothNewton};
 use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem, ParameterFamily};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -51,11 +51,12 @@ fn assert_all_converged(
         ..Default::default()
     };
     let mut problem = NonsmoothSystem::new(system, settings).unwrap();
-    let tolerance = 1e-9 * problem.residual_scale();
+    let tolerance = 1e-9 * residual_scale(&mut problem);
     let mut f = vec![0.0; problem.dimension()];
     for p in points {
         assert!(p.converged);
-        problem.residual(&p.x, p.omega, &mut f);
+        problem.set_parameter(p.omega);
+        problem.residual(&p.x, &mut f);
         let r = f.iter().map(|v| v * v).sum::<f64>().sqrt();
         assert!(r <= tolerance, "residual {r:e} at T = {}", p.period);
     }
@@ -174,7 +175,7 @@ fn iterator_restart_and_reverse_direction() {
         ..Default::default()
     };
     let (driver, _) = Arclength::new(
-        PeriodParametrised(problem.clone()),
+        PeriodParametrised::new(problem.clone()),
         SemismoothNewton::default(),
         x0,
         3.9,
@@ -187,7 +188,7 @@ fn iterator_restart_and_reverse_direction() {
     // Restart from a stored point in the other direction: the period grows again.
     let pivot = &forward[10];
     let (mut back, _) = Arclength::restart(
-        PeriodParametrised(problem),
+        PeriodParametrised::new(problem),
         SemismoothNewton::default(),
         pivot,
         ArclengthOptions {
@@ -212,14 +213,17 @@ fn iterator_restart_and_reverse_direction() {
 
 /// `F(x, lambda) = x - s(lambda)` with a spike `s(0.2) = 0.55` between `s(0.1) = 0.1` and
 /// `s(0.3) = 0`.
-#[derive(Clone)]
-struct Spiky;
+#[derive(Clone, Default)]
+struct Spiky {
+    lambda: f64,
+}
 
-impl ContinuationProblem for Spiky {
+impl Problem for Spiky {
     fn dimension(&self) -> usize {
         1
     }
-    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        let lambda = self.lambda;
         let s = if (lambda - 0.2).abs() < 1e-12 {
             0.55
         } else if (lambda - 0.3).abs() < 1e-12 {
@@ -229,30 +233,47 @@ impl ContinuationProblem for Spiky {
         };
         f[0] = x[0] - s;
     }
-    fn jacobian(&mut self, _: &[f64], _: f64, jac: &mut nonsmooth_modes::linalg::DenseMatrix) {
+    fn jacobian(&mut self, _: &[f64], jac: &mut nonsmooth_modes::linalg::DenseMatrix) {
         jac.reset(1, 1);
         jac[(0, 0)] = 1.0;
     }
-    fn parameter_derivative(&mut self, _: &[f64], _: f64, df: &mut [f64]) {
+}
+
+impl ContinuationProblem for Spiky {
+    fn parameter(&self) -> f64 {
+        self.lambda
+    }
+    fn set_parameter(&mut self, lambda: f64) {
+        self.lambda = lambda;
+    }
+    fn parameter_derivative(&mut self, _: &[f64], df: &mut [f64]) {
         df[0] = -1.0;
     }
 }
 
 /// A local solver: one exact Newton step when the start is within 0.5 of the solution,
-/// otherwise a failure (after `patience`, to let a speculative retry start beside it).
+/// otherwise a failure (after `patience`, to let a speculative retry start beside it). It
+/// tells its monitor of its one residual evaluation.
 #[derive(Clone, Copy, Default)]
 struct Local {
     patience: std::time::Duration,
 }
 
 impl nonsmooth_modes::solve::NonlinearSolver for Local {
-    fn solve(
+    fn solve_monitored(
         &self,
         problem: &mut dyn nonsmooth_modes::solve::Problem,
         x: &mut [f64],
+        monitor: &mut dyn nonsmooth_modes::solve::SolveMonitor,
     ) -> Result<nonsmooth_modes::solve::SolveInfo, nonsmooth_modes::SolveError> {
         let mut f = [0.0];
         problem.residual(x, &mut f);
+        if monitor.evaluated(1).is_break() {
+            return Err(nonsmooth_modes::SolveError::Cancelled {
+                iteration: 0,
+                evaluations: 1,
+            });
+        }
         if f[0].abs() > 0.5 {
             std::thread::sleep(self.patience);
             return Err(nonsmooth_modes::SolveError::MaxIterations {
@@ -269,7 +290,7 @@ impl nonsmooth_modes::solve::NonlinearSolver for Local {
             jacobian_evaluations: 0,
         })
     }
-    fn tolerance(&self, _: &dyn nonsmooth_modes::solve::Problem) -> f64 {
+    fn tolerance(&self, _: &mut dyn nonsmooth_modes::solve::Problem) -> f64 {
         0.0
     }
 }
@@ -285,10 +306,16 @@ fn sequential_retry_steps_back_over_a_spike() {
             retry_depth,
             ..Default::default()
         };
-        Sequential::new(Spiky, Local::default(), vec![0.0], values.clone(), options)
-            .unwrap()
-            .map(|p| (p.converged, p.x[0]))
-            .collect::<Vec<_>>()
+        Sequential::new(
+            Spiky::default(),
+            Local::default(),
+            vec![0.0],
+            values.clone(),
+            options,
+        )
+        .unwrap()
+        .map(|p| (p.converged, p.x[0]))
+        .collect::<Vec<_>>()
     };
     let with = run(1);
     assert_eq!(
@@ -319,7 +346,7 @@ fn speculative_retries_give_the_serial_points() {
     let driver = |patience| {
         let solver = Local { patience };
         Sequential::new(
-            Spiky,
+            Spiky::default(),
             solver,
             vec![0.0],
             values.clone(),
@@ -423,14 +450,17 @@ fn speculative_backbone_is_the_serial_backbone() {
 /// A branch `x = lambda` with a spike `0.45` at `lambda = 0.1` (where the branch is missing)
 /// and a high branch `x = lambda + 0.4` from `lambda = 0.2` on; the residual is `x` minus the
 /// solution nearest to `x`.
-#[derive(Clone)]
-struct TwoBranches;
+#[derive(Clone, Default)]
+struct TwoBranches {
+    lambda: f64,
+}
 
-impl ContinuationProblem for TwoBranches {
+impl Problem for TwoBranches {
     fn dimension(&self) -> usize {
         1
     }
-    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        let lambda = self.lambda;
         let roots: Vec<f64> = if (lambda - 0.1).abs() < 1e-12 {
             vec![0.45]
         } else if lambda > 0.15 {
@@ -444,11 +474,20 @@ impl ContinuationProblem for TwoBranches {
             .unwrap();
         f[0] = x[0] - nearest;
     }
-    fn jacobian(&mut self, _: &[f64], _: f64, jac: &mut nonsmooth_modes::linalg::DenseMatrix) {
+    fn jacobian(&mut self, _: &[f64], jac: &mut nonsmooth_modes::linalg::DenseMatrix) {
         jac.reset(1, 1);
         jac[(0, 0)] = 1.0;
     }
-    fn parameter_derivative(&mut self, _: &[f64], _: f64, df: &mut [f64]) {
+}
+
+impl ContinuationProblem for TwoBranches {
+    fn parameter(&self) -> f64 {
+        self.lambda
+    }
+    fn set_parameter(&mut self, lambda: f64) {
+        self.lambda = lambda;
+    }
+    fn parameter_derivative(&mut self, _: &[f64], df: &mut [f64]) {
         df[0] = -1.0;
     }
 }
@@ -474,7 +513,7 @@ fn sequential_lowest_measure_leaves_a_spike_for_the_low_branch() {
             ..Default::default()
         };
         Sequential::new(
-            TwoBranches,
+            TwoBranches::default(),
             Local::default(),
             vec![0.0],
             values.clone(),
@@ -517,9 +556,15 @@ fn speculative_lowest_measure_gives_the_serial_points() {
             let solver = Local {
                 patience: std::time::Duration::from_millis(20),
             };
-            Sequential::new(TwoBranches, solver, vec![0.0], values.clone(), options)
-                .unwrap()
-                .with_measure(|x, _| x[0])
+            Sequential::new(
+                TwoBranches::default(),
+                solver,
+                vec![0.0],
+                values.clone(),
+                options,
+            )
+            .unwrap()
+            .with_measure(|x, _| x[0])
         };
         let serial: Vec<_> = driver().collect();
         let mut speculative = driver();

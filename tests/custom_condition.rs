@@ -18,7 +18,7 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, clamped_free_frequency, robin_bar_with_obstacle,
     ROBIN_FREE_FREQUENCIES,
 };
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::{Problem, SemismoothNewton};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::f64::consts::PI;
 
@@ -154,15 +154,19 @@ fn massless_spring_is_the_robin_condition() {
         .collect();
     let n = x.len();
     let (mut fa, mut fb) = (vec![0.0; n], vec![0.0; n]);
-    a.residual(&x, omega, &mut fa);
-    b.residual(&x, omega, &mut fb);
+    a.set_parameter(omega);
+    a.residual(&x, &mut fa);
+    b.set_parameter(omega);
+    b.residual(&x, &mut fb);
     let close = |u: &[f64], v: &[f64]| {
         let s = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         u.iter().zip(v).all(|(p, q)| (p - q).abs() <= 1e-13 * s)
     };
     assert!(close(&fa, &fb), "{fa:?}\n{fb:?}");
-    a.parameter_derivative(&x, omega, &mut fa);
-    b.parameter_derivative(&x, omega, &mut fb);
+    a.set_parameter(omega);
+    a.parameter_derivative(&x, &mut fa);
+    b.set_parameter(omega);
+    b.parameter_derivative(&x, &mut fb);
     assert!(close(&fa, &fb));
 
     let options = BackboneOptions {
@@ -214,9 +218,12 @@ fn mass_row_derivative_reaches_the_system() {
         let n = x.len();
         let h = 1e-6 * omega;
         let (mut fp, mut fm, mut df) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        problem.residual(&x, omega + h, &mut fp);
-        problem.residual(&x, omega - h, &mut fm);
-        problem.parameter_derivative(&x, omega, &mut df);
+        problem.set_parameter(omega + h);
+        problem.residual(&x, &mut fp);
+        problem.set_parameter(omega - h);
+        problem.residual(&x, &mut fm);
+        problem.set_parameter(omega);
+        problem.parameter_derivative(&x, &mut df);
         let scale = df.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let error = df
             .iter()
@@ -332,7 +339,7 @@ fn compliant_backbone(
     let start: Vec<f64> = seed.iter().map(|s| seed_scale * s).collect();
     let (accept_system, accept_basis) = (system.clone(), basis.clone());
     let driver = Sequential::new(
-        PeriodParametrised(problem),
+        PeriodParametrised::new(problem),
         SemismoothNewton::default(),
         start,
         periods.to_vec(),
@@ -433,7 +440,8 @@ fn custom_law_jacobian_matches_finite_differences() {
             .collect();
         let n = x.len();
         let mut jac = DenseMatrix::zeros(n, n);
-        problem.jacobian(&x, omega, &mut jac);
+        problem.set_parameter(omega);
+        problem.jacobian(&x, &mut jac);
         let h = 1e-9;
         let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
         let mut worst = 0.0_f64;
@@ -441,8 +449,10 @@ fn custom_law_jacobian_matches_finite_differences() {
             let (mut xp, mut xm) = (x.clone(), x.clone());
             xp[j] += h;
             xm[j] -= h;
-            problem.residual(&xp, omega, &mut fp);
-            problem.residual(&xm, omega, &mut fm);
+            problem.set_parameter(omega);
+            problem.residual(&xp, &mut fp);
+            problem.set_parameter(omega);
+            problem.residual(&xm, &mut fm);
             let col = jac.column(j);
             let scale = col.iter().fold(1e-12_f64, |m, v| m.max(v.abs()));
             for (a, (p, m)) in col.iter().zip(fp.iter().zip(&fm)) {

@@ -1,7 +1,7 @@
 //! Diagnostics of computed points: the Signorini residual norm `R^(m)` converges with `m`
 //! (paper Fig. 5), and the reported penetration and energy drift shrink with it.
 
-use nonsmooth_modes::continuation::AtParameter;
+use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::diagnose;
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
@@ -27,14 +27,9 @@ fn signorini_residual_norm_decreases_with_m_at_about_the_first_order_rate() {
         let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
         let mut x = ClampedFirstMode::new(GAP, PERIOD).unknowns(m);
         assert_eq!(x.len(), problem.dimension());
+        problem.set_parameter(omega);
         SemismoothNewton::default()
-            .solve(
-                &mut AtParameter {
-                    problem: &mut problem,
-                    lambda: omega,
-                },
-                &mut x,
-            )
+            .solve(&mut problem, &mut x)
             .unwrap();
         let d = diagnose(&problem, &x, omega, 8).unwrap();
         let e = nonsmooth_modes::modal::energy(&system, problem.basis(), &x, omega)

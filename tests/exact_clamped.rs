@@ -2,7 +2,7 @@
 //! and the linear frequencies (formulation §7–§8) as oracles.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::continuation::AtParameter;
+use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{
     backbone, energy, grazing_energy, natural_frequencies, BackboneOptions, BackbonePoint,
     ContactState,
@@ -312,15 +312,8 @@ fn solved_energy_near_the_exact_mode() {
             assert!((a - b).abs() <= 1e-12 * (a.abs() + b.abs()) + 1e-18);
         }
         let solver = SemismoothNewton::default();
-        let info = solver
-            .solve(
-                &mut AtParameter {
-                    problem: &mut problem,
-                    lambda: omega,
-                },
-                &mut x,
-            )
-            .unwrap();
+        problem.set_parameter(omega);
+        let info = solver.solve(&mut problem, &mut x).unwrap();
         assert!(info.residual_norm <= 1e-9 * GAP);
         let e = energy(&system, &basis, &x, omega) / e_g;
         let error = e / mode.energy_normalized() - 1.0;

@@ -8,6 +8,7 @@ use nonsmooth_modes::modal::branch_seed;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
+use nonsmooth_modes::solve::Problem;
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -95,7 +96,8 @@ fn check_jacobian(
 ) -> Result<Checked, TestCaseError> {
     let n = x.len();
     let mut jac = DenseMatrix::zeros(n, n);
-    problem.jacobian(x, omega, &mut jac);
+    problem.set_parameter(omega);
+    problem.jacobian(x, &mut jac);
     let reference = active_set(problem, x, omega);
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
     let mut checked = 0;
@@ -115,8 +117,10 @@ fn check_jacobian(
             continue;
         };
         let (xp, xm) = shifted(h);
-        problem.residual(&xp, omega, &mut fp);
-        problem.residual(&xm, omega, &mut fm);
+        problem.set_parameter(omega);
+        problem.residual(&xp, &mut fp);
+        problem.set_parameter(omega);
+        problem.residual(&xm, &mut fm);
         let fd: Vec<f64> = fp
             .iter()
             .zip(&fm)
@@ -154,10 +158,13 @@ fn check_omega_derivative(
         return Ok(false);
     }
     let mut df = vec![0.0; n];
-    problem.parameter_derivative(x, omega, &mut df);
+    problem.set_parameter(omega);
+    problem.parameter_derivative(x, &mut df);
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-    problem.residual(x, omega + h, &mut fp);
-    problem.residual(x, omega - h, &mut fm);
+    problem.set_parameter(omega + h);
+    problem.residual(x, &mut fp);
+    problem.set_parameter(omega - h);
+    problem.residual(x, &mut fm);
     let fd: Vec<f64> = fp
         .iter()
         .zip(&fm)
@@ -229,25 +236,31 @@ proptest! {
         let n = x.len();
 
         let (mut f_omega, mut df_omega) = (vec![0.0; n], vec![0.0; n]);
-        problem.residual(&x, omega, &mut f_omega);
-        problem.parameter_derivative(&x, omega, &mut df_omega);
+        problem.set_parameter(omega);
+        problem.residual(&x, &mut f_omega);
+        problem.set_parameter(omega);
+        problem.parameter_derivative(&x, &mut df_omega);
         let mut j_omega = DenseMatrix::zeros(n, n);
-        problem.jacobian(&x, omega, &mut j_omega);
+        problem.set_parameter(omega);
+        problem.jacobian(&x, &mut j_omega);
 
         let h = 1e-6 * period;
         let in_set = active_set(&mut problem, &x, omega);
         let stable = active_set(&mut problem, &x, 2.0 * PI / (period + h)) == in_set
             && active_set(&mut problem, &x, 2.0 * PI / (period - h)) == in_set;
 
-        let mut by_period = PeriodParametrised(&mut problem);
+        let mut by_period = PeriodParametrised::new(&mut problem);
         prop_assert_eq!(by_period.dimension(), n);
         let (mut f, mut df) = (vec![0.0; n], vec![0.0; n]);
-        by_period.residual(&x, period, &mut f);
+        by_period.set_parameter(period);
+        by_period.residual(&x, &mut f);
         prop_assert_eq!(&f, &f_omega);
         let mut jac = DenseMatrix::zeros(n, n);
-        by_period.jacobian(&x, period, &mut jac);
+        by_period.set_parameter(period);
+        by_period.jacobian(&x, &mut jac);
         prop_assert_eq!(&jac, &j_omega);
-        by_period.parameter_derivative(&x, period, &mut df);
+        by_period.set_parameter(period);
+        by_period.parameter_derivative(&x, &mut df);
         let chain = -2.0 * PI / (period * period);
         let scale = inf_norm(&df_omega).max(1e-15);
         for (a, b) in df.iter().zip(&df_omega) {
@@ -255,8 +268,10 @@ proptest! {
         }
         if stable {
             let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-            by_period.residual(&x, period + h, &mut fp);
-            by_period.residual(&x, period - h, &mut fm);
+            by_period.set_parameter(period + h);
+            by_period.residual(&x, &mut fp);
+            by_period.set_parameter(period - h);
+            by_period.residual(&x, &mut fm);
             let scale = inf_norm(&df).max(1e-15);
             for (i, (a, (p, m))) in df.iter().zip(fp.iter().zip(&fm)).enumerate() {
                 let d = (p - m) / (2.0 * h);

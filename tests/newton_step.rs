@@ -1,4 +1,5 @@
-//! The structured Newton step (linear rows condensed) equals the dense solve of `J dx = -F`.
+//! The structured solve (linear rows condensed) equals the dense solve of `J dx = -F`, for one
+//! right-hand side and for several at once.
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::ContinuationProblem;
@@ -7,6 +8,7 @@ use nonsmooth_modes::modal::branch_seed;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
+use nonsmooth_modes::solve::{Problem, Structured};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::f64::consts::PI;
 
@@ -56,25 +58,33 @@ fn check(system: &BarSystem, harmonics: usize, period: f64) {
         .map(|(i, s)| 1.7 * s + 2e-5 * (((i * 7) % 11) as f64 - 5.0))
         .collect();
     let n = problem.dimension();
+    problem.set_parameter(omega);
     let mut f = vec![0.0; n];
-    problem.residual(&x, omega, &mut f);
+    problem.residual(&x, &mut f);
     let mut jac = DenseMatrix::zeros(n, n);
-    problem.jacobian(&x, omega, &mut jac);
-    let want = dense_solve(&jac, &f);
-    let mut got = vec![0.0; n];
+    problem.jacobian(&x, &mut jac);
+    // Two right-hand sides in one call: -F and a second vector that is not a residual.
+    let other: Vec<f64> = (0..n).map(|i| ((i * 5) % 7) as f64 * 1e-4 - 3e-4).collect();
+    let mut got: Vec<f64> = f.iter().map(|v| -v).chain(other.iter().cloned()).collect();
     problem
-        .newton_step(&x, omega, &f, &mut got)
+        .solve_jacobian(&x, &mut got, 2)
         .expect("a structured step")
         .expect("regular");
-    let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let err = want
+    let minus_other: Vec<f64> = other.iter().map(|v| -v).collect();
+    for (want, got) in [dense_solve(&jac, &f), dense_solve(&jac, &minus_other)]
         .iter()
-        .zip(&got)
-        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(
-        err <= 1e-9 * scale,
-        "m {harmonics}, T {period}: {err:e} vs {scale:e}"
-    );
+        .zip(got.chunks_exact(n))
+    {
+        let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let err = want
+            .iter()
+            .zip(got)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            err <= 1e-9 * scale,
+            "m {harmonics}, T {period}: {err:e} vs {scale:e}"
+        );
+    }
 }
 
 #[test]
@@ -110,7 +120,8 @@ fn line_search_residual_equals_the_residual_at_the_trial_point() {
             let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
             let x: Vec<f64> = seed.iter().map(|s| scale * s).collect();
             let mut f = vec![0.0; n];
-            problem.residual(&x, omega, &mut f);
+            problem.set_parameter(omega);
+            problem.residual(&x, &mut f);
             for shift in [0usize, 3] {
                 let dx: Vec<f64> = seed
                     .iter()
@@ -126,11 +137,12 @@ fn line_search_residual_equals_the_residual_at_the_trial_point() {
                     1.01 * omega,
                 ]) {
                     let (mut trial, mut along) = (vec![0.0; n], vec![0.0; n]);
-                    problem.residual_along(&x, &dx, t, omega, &mut trial, &mut along);
+                    problem.set_parameter(omega);
+                    assert!(problem.residual_along(&x, &dx, t, &mut trial, &mut along));
                     let point: Vec<f64> = x.iter().zip(&dx).map(|(a, d)| a + t * d).collect();
                     assert_eq!(trial, point);
                     let mut direct = vec![0.0; n];
-                    problem.residual(&point, omega, &mut direct);
+                    problem.residual(&point, &mut direct);
                     let scale = direct.iter().fold(1e-3_f64, |m, v| m.max(v.abs()));
                     for (k, (a, b)) in along.iter().zip(&direct).enumerate() {
                         assert!(

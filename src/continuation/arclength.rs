@@ -26,7 +26,7 @@
 //!
 //! Events are reported on accepted points: folds (the parameter component of the tangent
 //! changes sign), jumps that could not be refined away, and grazing (the problem's active
-//! set, see [`ContinuationProblem::active_set`], appears or disappears).
+//! set, see [`Structured::active_set`], appears or disappears).
 //!
 //! Reference: E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*,
 //! SIAM Classics in Applied Mathematics 45 (2003), chapter 2.
@@ -34,7 +34,9 @@
 use super::{ContinuationProblem, Event, Point};
 use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::solve::{NonlinearSolver, Problem, SolveInfo, PIVOT_TOLERANCE};
+use crate::solve::{
+    residual_scale, NonlinearSolver, Problem, SingularStep, SolveInfo, Structured, PIVOT_TOLERANCE,
+};
 use std::ops::ControlFlow;
 
 /// How the predictor direction is formed.
@@ -51,7 +53,7 @@ pub enum TangentPredictor {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum ArclengthScale {
     /// `|x|^2 = sum_i w_i x_i^2 / sum_i w_i x0_i^2` with the problem's
-    /// [`ContinuationProblem::state_weights`] (an energy norm for harmonic balance; all 1 if it
+    /// [`Structured::state_weights`] (an energy norm for harmonic balance; all 1 if it
     /// has none), so that `ds` is the relative change of the state; and
     /// `s_lambda = |lambda_0|` (or 1 when `lambda_0 = 0`) (default).
     #[default]
@@ -310,13 +312,22 @@ impl Branch {
     }
 }
 
-/// The bordered corrector system `[F(x, lambda); scale <t, y - y_p>_W]` as a [`Problem`].
+/// The bordered corrector system `[F(x, lambda); s <t, y - y_p>_W]` as a [`Problem`] in
+/// `y = (x, lambda)`, with `s` the residual scale of the problem.
+///
+/// Its structured solve is the bordering algorithm on the problem's own structured solve:
+/// `J a = r_x` and `J b = dF/dlambda` in one call, then
+/// `dlambda = (r_lambda - c.a) / (d - c.b)`, `dx = a - dlambda b`, where `(c, d)` is the
+/// border row. Where `J` alone is singular (a fold) or has no structure, it falls back to
+/// the dense bordered Jacobian.
 struct Bordered<'a, P: ?Sized> {
     problem: &'a mut P,
     tangent: &'a [f64],
     predicted: &'a [f64],
     metric: &'a Metric,
     scratch: &'a mut BorderScratch,
+    /// The residual scale of the problem at the last parameter evaluated.
+    scale: f64,
 }
 
 /// Storage of the bordered Jacobian's blocks, kept by the driver across corrector iterations
@@ -327,44 +338,134 @@ struct BorderScratch {
     inner: DenseMatrix,
     /// `dF/dlambda`.
     df: Vec<f64>,
+    /// Right-hand sides of the bordering algorithm.
+    columns: Vec<f64>,
+}
+
+impl<'a, P: ContinuationProblem + ?Sized> Bordered<'a, P> {
+    fn new(
+        problem: &'a mut P,
+        (tangent, predicted): (&'a [f64], &'a [f64]),
+        metric: &'a Metric,
+        scratch: &'a mut BorderScratch,
+    ) -> Self {
+        let scale = residual_scale(problem);
+        Self {
+            problem,
+            tangent,
+            predicted,
+            metric,
+            scratch,
+            scale,
+        }
+    }
+
+    /// Moves the problem to the parameter of `y` and returns the unknowns of `y`.
+    fn at<'y>(&mut self, y: &'y [f64]) -> &'y [f64] {
+        let n = self.problem.dimension();
+        self.problem.set_parameter(y[n]);
+        self.scale = residual_scale(self.problem);
+        &y[..n]
+    }
+
+    /// The border row `(c, d)`: `c_i = s t_i w_i`, `d = s t_lambda w_lambda`.
+    fn border(&self, i: usize) -> f64 {
+        self.scale * self.tangent[i] * self.metric.weight(i)
+    }
 }
 
 impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
     fn dimension(&self) -> usize {
         self.problem.dimension() + 1
     }
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.problem.set_smoothing(smoothing)
-    }
     fn residual(&mut self, y: &[f64], f: &mut [f64]) {
         let n = self.problem.dimension();
-        self.problem.residual(&y[..n], y[n], &mut f[..n]);
-        f[n] =
-            self.problem.residual_scale() * self.metric.dot_diff(self.tangent, y, self.predicted);
+        let x = self.at(y);
+        self.problem.residual(x, &mut f[..n]);
+        f[n] = self.scale * self.metric.dot_diff(self.tangent, y, self.predicted);
     }
-    /// `[dF/dx, dF/dlambda; s t^T W]` with `s` the residual scale.
+    /// `[dF/dx, dF/dlambda; s t^T W]`.
     fn jacobian(&mut self, y: &[f64], jac: &mut DenseMatrix) {
         let n = self.problem.dimension();
-        let BorderScratch { inner, df } = &mut *self.scratch;
+        let x = self.at(y);
+        let BorderScratch { inner, df, .. } = &mut *self.scratch;
         df.resize(n, 0.0);
-        self.problem.jacobian(&y[..n], y[n], inner);
-        self.problem.parameter_derivative(&y[..n], y[n], df);
+        self.problem.jacobian(x, inner);
+        self.problem.parameter_derivative(x, df);
         jac.reset(n + 1, n + 1);
         for j in 0..n {
             for i in 0..n {
                 jac[(i, j)] = inner[(i, j)];
             }
         }
-        let s = self.problem.residual_scale();
         for i in 0..n {
             jac[(i, n)] = df[i];
         }
         for i in 0..=n {
-            jac[(n, i)] = s * self.tangent[i] * self.metric.weight(i);
+            jac[(n, i)] = self.border(i);
         }
     }
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        Some(self)
+    }
+}
+
+impl<P: ContinuationProblem + ?Sized> Structured for Bordered<'_, P> {
     fn residual_scale(&self) -> f64 {
-        self.problem.residual_scale()
+        self.scale
+    }
+
+    fn solve_jacobian(
+        &mut self,
+        y: &[f64],
+        rhs: &mut [f64],
+        columns: usize,
+    ) -> Option<Result<(), SingularStep>> {
+        let n = self.problem.dimension();
+        let x = self.at(y);
+        let mut buffer = std::mem::take(&mut self.scratch.columns);
+        buffer.clear();
+        for column in rhs.chunks_exact(n + 1).take(columns) {
+            buffer.extend_from_slice(&column[..n]);
+        }
+        buffer.resize((columns + 1) * n, 0.0);
+        self.problem
+            .parameter_derivative(x, &mut buffer[columns * n..]);
+        let solved = self
+            .problem
+            .structure()
+            .and_then(|s| s.solve_jacobian(x, &mut buffer, columns + 1));
+        let result = match solved {
+            Some(Ok(())) => {
+                let b = &buffer[columns * n..];
+                let cb: f64 = (0..n).map(|i| self.border(i) * b[i]).sum();
+                let pivot = self.border(n) - cb;
+                let size = self.border(n).abs() + cb.abs();
+                if pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * size {
+                    for (column, a) in rhs.chunks_exact_mut(n + 1).zip(buffer.chunks_exact(n)) {
+                        let ca: f64 = (0..n).map(|i| self.border(i) * a[i]).sum();
+                        let dl = (column[n] - ca) / pivot;
+                        for i in 0..n {
+                            column[i] = a[i] - dl * b[i];
+                        }
+                        column[n] = dl;
+                    }
+                    Some(Ok(()))
+                } else {
+                    None
+                }
+            }
+            // A singular J with a regular bordered matrix (a fold): the dense path decides.
+            _ => None,
+        };
+        self.scratch.columns = buffer;
+        result
+    }
+
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.problem
+            .structure()
+            .is_some_and(|s| s.set_smoothing(smoothing))
     }
 }
 
@@ -447,19 +548,15 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             });
         }
         let mut x = x0;
+        problem.set_parameter(lambda0);
         let info = solver
-            .solve(
-                &mut super::AtParameter {
-                    problem: &mut problem,
-                    lambda: lambda0,
-                },
-                &mut x,
-            )
+            .solve(&mut problem, &mut x)
             .map_err(ContinuationError::Start)?;
         let metric = match options.scale {
             ArclengthScale::Automatic => {
                 let raw = problem
-                    .state_weights(lambda0)
+                    .structure()
+                    .and_then(|s| s.state_weights())
                     .filter(|w| w.len() == n && w.iter().all(|v| v.is_finite() && *v > 0.0))
                     .unwrap_or_else(|| vec![1.0; n]);
                 let sx2 = (0..n).map(|i| raw[i] * x[i] * x[i]).sum::<f64>();
@@ -503,7 +600,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         driver.tangent = driver
             .tangent_at(&driver.y.clone(), &seed)
             .ok_or(ContinuationError::SingularTangent { lambda: lambda0 })?;
-        driver.active = driver.problem.active_set(&driver.y[..n], lambda0);
+        driver.active = driver.active_set();
         let point = driver.point(0, &info, Vec::new());
         Ok((driver, point))
     }
@@ -543,24 +640,38 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         &self.tangent
     }
 
+    /// The active sets of the problem at the current point.
+    fn active_set(&mut self) -> Option<Vec<usize>> {
+        let n = self.problem.dimension();
+        self.problem.set_parameter(self.y[n]);
+        let x = &self.y[..n];
+        self.problem.structure().and_then(|s| s.active_set(x))
+    }
+
     /// Unit tangent at `y` oriented along `reference` (`<t, reference>_W > 0`).
     fn tangent_at(&mut self, y: &[f64], reference: &[f64]) -> Option<Vec<f64>> {
         let n = self.problem.dimension();
         // The bordered Jacobian with `reference` as border: its solution for `e_n` is the
         // tangent (up to scale) oriented along `reference`.
-        let mut b = DenseMatrix::default();
-        Bordered {
-            problem: &mut self.problem,
-            tangent: reference,
-            predicted: y,
-            metric: &self.metric,
-            scratch: &mut self.border,
-        }
-        .jacobian(y, &mut b);
-        let lu = Lu::factor(&b, PIVOT_TOLERANCE).ok()?;
         let mut t = vec![0.0; n + 1];
         t[n] = 1.0;
-        lu.solve_in_place(&mut t);
+        let mut bordered = Bordered::new(
+            &mut self.problem,
+            (reference, y),
+            &self.metric,
+            &mut self.border,
+        );
+        let structured = bordered
+            .solve_jacobian(y, &mut t, 1)
+            .is_some_and(|r| r.is_ok());
+        if !structured {
+            let mut b = DenseMatrix::default();
+            bordered.jacobian(y, &mut b);
+            let lu = Lu::factor(&b, PIVOT_TOLERANCE).ok()?;
+            t.fill(0.0);
+            t[n] = 1.0;
+            lu.solve_in_place(&mut t);
+        }
         let len = self.metric.norm(&t);
         if !(len.is_finite() && len > 0.0) {
             return None;
@@ -633,13 +744,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             .collect();
         let mut y = predicted.clone();
         let result = {
-            let mut bordered = Bordered {
-                problem: &mut self.problem,
-                tangent: &direction,
-                predicted: &predicted,
-                metric: &self.metric,
-                scratch: &mut self.border,
-            };
+            let mut bordered = Bordered::new(
+                &mut self.problem,
+                (&direction, &predicted),
+                &self.metric,
+                &mut self.border,
+            );
             self.solver.solve(&mut bordered, &mut y)
         };
         let info = match result {
@@ -681,7 +791,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         if tangent[n] * self.tangent[n] < 0.0 {
             events.push(Event::Fold { lambda: y[n] });
         }
-        let active = self.problem.active_set(&y[..n], y[n]);
+        self.problem.set_parameter(y[n]);
+        let active = self.problem.structure().and_then(|s| s.active_set(&y[..n]));
         if let (Some(old), Some(new)) = (&self.active, &active) {
             for (law, (a, b)) in old.iter().zip(new).enumerate() {
                 if (*a == 0) != (*b == 0) {
@@ -771,13 +882,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             for from in &anchors {
                 let from_norm = self.metric.norm(&from.1);
                 let mut x = from.1.clone();
-                let solved = self.solver.solve(
-                    &mut super::AtParameter {
-                        problem: &mut self.problem,
-                        lambda: target,
-                    },
-                    &mut x,
-                );
+                self.problem.set_parameter(target);
+                let solved = self.solver.solve(&mut self.problem, &mut x);
                 let accepted = solved.is_ok()
                     && self.metric.norm(&x) <= escape.max_norm_ratio * from_norm
                     && self.accept.as_mut().is_none_or(|accept| accept(&x, target));
@@ -794,7 +900,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                         self.tangent = t;
                         self.history.clear();
                         self.history.push_back((target, self.y[..n].to_vec()));
-                        self.active = self.problem.active_set(&self.y[..n], target);
+                        self.active = self.active_set();
                         self.accepted += 1;
                         self.ds = self.options.ds;
                         let mut point =
@@ -864,21 +970,32 @@ mod tests {
     use crate::solve::SemismoothNewton;
 
     /// `F(x, lambda) = x^2 + lambda^2 - 1`: a circle with folds at `lambda = +-1`.
-    struct Circle;
+    struct Circle {
+        lambda: f64,
+    }
 
-    impl ContinuationProblem for Circle {
+    impl Problem for Circle {
         fn dimension(&self) -> usize {
             1
         }
-        fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
-            f[0] = x[0] * x[0] + lambda * lambda - 1.0;
+        fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+            f[0] = x[0] * x[0] + self.lambda * self.lambda - 1.0;
         }
-        fn jacobian(&mut self, x: &[f64], _: f64, jac: &mut DenseMatrix) {
+        fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
             jac.reset(1, 1);
             jac[(0, 0)] = 2.0 * x[0];
         }
-        fn parameter_derivative(&mut self, _: &[f64], lambda: f64, df: &mut [f64]) {
-            df[0] = 2.0 * lambda;
+    }
+
+    impl ContinuationProblem for Circle {
+        fn parameter(&self) -> f64 {
+            self.lambda
+        }
+        fn set_parameter(&mut self, lambda: f64) {
+            self.lambda = lambda;
+        }
+        fn parameter_derivative(&mut self, _: &[f64], df: &mut [f64]) {
+            df[0] = 2.0 * self.lambda;
         }
     }
 
@@ -892,8 +1009,14 @@ mod tests {
             scale: ArclengthScale::Fixed(1.0, 1.0),
             ..Default::default()
         };
-        let (mut driver, start) =
-            Arclength::new(Circle, SemismoothNewton::default(), vec![0.9], 0.0, options).unwrap();
+        let (mut driver, start) = Arclength::new(
+            Circle { lambda: 0.0 },
+            SemismoothNewton::default(),
+            vec![0.9],
+            0.0,
+            options,
+        )
+        .unwrap();
         let branch = driver.run(Some(start), |_| ControlFlow::Continue(()));
         // Leaves through lambda < -0.5 on the lower half after turning at lambda = 1.
         assert!(
@@ -926,8 +1049,14 @@ mod tests {
             scale: ArclengthScale::Fixed(1.0, 1.0),
             ..Default::default()
         };
-        let (mut driver, _) =
-            Arclength::new(Circle, SemismoothNewton::default(), vec![1.0], 0.0, options).unwrap();
+        let (mut driver, _) = Arclength::new(
+            Circle { lambda: 0.0 },
+            SemismoothNewton::default(),
+            vec![1.0],
+            0.0,
+            options,
+        )
+        .unwrap();
         let mut seen = 0;
         let branch = driver.run(None, |o| {
             seen += usize::from(matches!(o, ArclengthOutcome::Accepted(_)));
@@ -981,7 +1110,13 @@ mod tests {
         ];
         for o in bad {
             assert!(matches!(
-                Arclength::new(Circle, SemismoothNewton::default(), vec![1.0], 0.0, o),
+                Arclength::new(
+                    Circle { lambda: 0.0 },
+                    SemismoothNewton::default(),
+                    vec![1.0],
+                    0.0,
+                    o
+                ),
                 Err(ContinuationError::InvalidOption { .. })
             ));
         }

@@ -24,219 +24,103 @@ pub use speculative::{Speculation, SpeculationStats};
 
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;
-use crate::solve::{point_on_ray, Problem, SingularStep};
+use crate::solve::{Problem, Structured};
 
-/// A family of square systems `F(x, lambda) = 0` in one scalar parameter.
-pub trait ContinuationProblem {
-    /// Number of unknowns `x` (and equations).
-    fn dimension(&self) -> usize;
+/// A family of square systems `F(x, lambda) = 0` in one scalar parameter: a [`Problem`] at
+/// its current parameter, plus the parameter and the derivative in it.
+///
+/// Drivers set the parameter, then solve the problem as it is; an adapter that changes the
+/// parameter (the period for a frequency, [`PeriodParametrised`]) forwards the problem and
+/// its [`Problem::structure`] unchanged.
+pub trait ContinuationProblem: Problem {
+    /// The current parameter `lambda`.
+    fn parameter(&self) -> f64;
 
-    /// `F(x, lambda)` into `f`.
-    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]);
+    /// Moves the problem to parameter `lambda` (cheap when it does not change). A value the
+    /// problem cannot take makes its residual non-finite, which solvers report as
+    /// [`SolveError::NonFinite`].
+    fn set_parameter(&mut self, lambda: f64);
 
-    /// Generalised Jacobian `dF/dx` into `jac` (resized by the callee).
-    fn jacobian(&mut self, x: &[f64], lambda: f64, jac: &mut DenseMatrix);
-
-    /// `x + t dx` into `trial` and `F(x + t dx, lambda)` into `f` (see
-    /// [`Problem::residual_along`]); the default forms the point and calls `residual`.
-    fn residual_along(
-        &mut self,
-        x: &[f64],
-        dx: &[f64],
-        t: f64,
-        lambda: f64,
-        trial: &mut [f64],
-        f: &mut [f64],
-    ) {
-        point_on_ray(x, dx, t, trial);
-        self.residual(trial, lambda, f);
-    }
-
-    /// `dF/dlambda` at fixed `x` into `df`.
-    fn parameter_derivative(&mut self, x: &[f64], lambda: f64, df: &mut [f64]);
-
-    /// Typical magnitude of residual entries (see [`Problem::residual_scale`]).
-    fn residual_scale(&self) -> f64 {
-        1.0
-    }
-
-    /// Diagonal weights `w_i` of a natural norm `sum_i w_i x_i^2` of the unknowns at
-    /// parameter `lambda` (for harmonic balance, an energy norm). The arclength drivers use it
-    /// for their scaled norm; `None` (default) means all weights 1.
-    fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
-        let _ = lambda;
-        None
-    }
-
-    /// A structured Newton step at parameter `lambda` (see [`Problem::newton_step`]); `None`
-    /// by default.
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        lambda: f64,
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        let _ = (x, lambda, f, dx);
-        None
-    }
-
-    /// Sets the smoothing of the nonsmooth terms (see [`Problem::set_smoothing`]); returns
-    /// whether the problem supports it (`false` by default).
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        let _ = smoothing;
-        false
-    }
-
-    /// For nonsmooth problems: the size of the active set of each unilateral law at
-    /// `(x, lambda)` (for harmonic balance, the number of time samples in contact). Drivers
-    /// report a grazing event when one of these appears or vanishes. `None` by default.
-    fn active_set(&mut self, x: &[f64], lambda: f64) -> Option<Vec<usize>> {
-        let _ = (x, lambda);
-        None
-    }
+    /// `dF/dlambda` at fixed `x` and the current parameter into `df`.
+    fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]);
 }
 
 impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
-    fn dimension(&self) -> usize {
-        (**self).dimension()
+    fn parameter(&self) -> f64 {
+        (**self).parameter()
     }
-    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
-        (**self).residual(x, lambda, f)
+    fn set_parameter(&mut self, lambda: f64) {
+        (**self).set_parameter(lambda)
     }
-    fn residual_along(
-        &mut self,
-        x: &[f64],
-        dx: &[f64],
-        t: f64,
-        lambda: f64,
-        trial: &mut [f64],
-        f: &mut [f64],
-    ) {
-        (**self).residual_along(x, dx, t, lambda, trial, f)
-    }
-    fn jacobian(&mut self, x: &[f64], lambda: f64, jac: &mut DenseMatrix) {
-        (**self).jacobian(x, lambda, jac)
-    }
-    fn parameter_derivative(&mut self, x: &[f64], lambda: f64, df: &mut [f64]) {
-        (**self).parameter_derivative(x, lambda, df)
-    }
-    fn residual_scale(&self) -> f64 {
-        (**self).residual_scale()
-    }
-    fn active_set(&mut self, x: &[f64], lambda: f64) -> Option<Vec<usize>> {
-        (**self).active_set(x, lambda)
-    }
-    fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
-        (**self).state_weights(lambda)
-    }
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        (**self).set_smoothing(smoothing)
-    }
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        lambda: f64,
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        (**self).newton_step(x, lambda, f, dx)
-    }
-}
-
-/// A continuation problem frozen at one parameter value: a [`Problem`] for the solvers.
-#[derive(Debug)]
-pub struct AtParameter<'a, P: ?Sized> {
-    /// The family.
-    pub problem: &'a mut P,
-    /// The frozen parameter.
-    pub lambda: f64,
-}
-
-impl<P: ContinuationProblem + ?Sized> Problem for AtParameter<'_, P> {
-    fn dimension(&self) -> usize {
-        self.problem.dimension()
-    }
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.problem.set_smoothing(smoothing)
-    }
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        self.problem.newton_step(x, self.lambda, f, dx)
-    }
-    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
-        self.problem.residual(x, self.lambda, f)
-    }
-    fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
-        self.problem.residual_along(x, dx, t, self.lambda, trial, f)
-    }
-    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
-        self.problem.jacobian(x, self.lambda, jac)
-    }
-    fn residual_scale(&self) -> f64 {
-        self.problem.residual_scale()
+    fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
+        (**self).parameter_derivative(x, df)
     }
 }
 
 /// A problem in an angular frequency `Omega`, continued in the period `T = 2 pi / Omega`
-/// instead (chain rule `dF/dT = -(2 pi / T^2) dF/dOmega`).
+/// instead (chain rule `dF/dT = -(2 pi / T^2) dF/dOmega`). The parameter of its points is the
+/// period.
 #[derive(Debug, Clone)]
-pub struct PeriodParametrised<P>(pub P);
+pub struct PeriodParametrised<P> {
+    inner: P,
+    period: f64,
+}
 
-fn omega_of(period: f64) -> f64 {
-    2.0 * std::f64::consts::PI / period
+impl<P: ContinuationProblem> PeriodParametrised<P> {
+    /// `inner` continued in the period (starting at the period of its current frequency).
+    pub fn new(inner: P) -> Self {
+        let period = period_of(inner.parameter());
+        Self { inner, period }
+    }
+
+    /// The problem in the frequency.
+    pub fn inner(&self) -> &P {
+        &self.inner
+    }
+
+    /// The problem in the frequency, mutably (its frequency is the current period's).
+    pub fn inner_mut(&mut self) -> &mut P {
+        &mut self.inner
+    }
+
+    /// The problem in the frequency.
+    pub fn into_inner(self) -> P {
+        self.inner
+    }
+}
+
+/// `2 pi / v`: a period from an angular frequency and back.
+fn period_of(v: f64) -> f64 {
+    2.0 * std::f64::consts::PI / v
+}
+
+impl<P: ContinuationProblem> Problem for PeriodParametrised<P> {
+    fn dimension(&self) -> usize {
+        self.inner.dimension()
+    }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        self.inner.residual(x, f)
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        self.inner.jacobian(x, jac)
+    }
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        self.inner.structure()
+    }
 }
 
 impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
-    fn dimension(&self) -> usize {
-        self.0.dimension()
+    fn parameter(&self) -> f64 {
+        self.period
     }
-    fn residual(&mut self, x: &[f64], period: f64, f: &mut [f64]) {
-        self.0.residual(x, omega_of(period), f)
+    fn set_parameter(&mut self, period: f64) {
+        self.period = period;
+        self.inner.set_parameter(period_of(period));
     }
-    fn residual_along(
-        &mut self,
-        x: &[f64],
-        dx: &[f64],
-        t: f64,
-        period: f64,
-        trial: &mut [f64],
-        f: &mut [f64],
-    ) {
-        self.0.residual_along(x, dx, t, omega_of(period), trial, f)
-    }
-    fn jacobian(&mut self, x: &[f64], period: f64, jac: &mut DenseMatrix) {
-        self.0.jacobian(x, omega_of(period), jac)
-    }
-    fn parameter_derivative(&mut self, x: &[f64], period: f64, df: &mut [f64]) {
-        self.0.parameter_derivative(x, omega_of(period), df);
-        let chain = -2.0 * std::f64::consts::PI / (period * period);
+    fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
+        self.inner.parameter_derivative(x, df);
+        let chain = -2.0 * std::f64::consts::PI / (self.period * self.period);
         df.iter_mut().for_each(|v| *v *= chain);
-    }
-    fn residual_scale(&self) -> f64 {
-        self.0.residual_scale()
-    }
-    fn active_set(&mut self, x: &[f64], period: f64) -> Option<Vec<usize>> {
-        self.0.active_set(x, omega_of(period))
-    }
-    fn state_weights(&mut self, period: f64) -> Option<Vec<f64>> {
-        self.0.state_weights(omega_of(period))
-    }
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.0.set_smoothing(smoothing)
-    }
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        period: f64,
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        self.0.newton_step(x, omega_of(period), f, dx)
     }
 }
 
@@ -246,7 +130,8 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
 pub struct Point {
     /// Step number (0-based).
     pub step: usize,
-    /// Parameter value.
+    /// Value of the continuation parameter (the period under [`PeriodParametrised`], the
+    /// frequency for a harmonic-balance system, the system parameter of a family).
     pub lambda: f64,
     /// Solution (the last iterate when the step failed).
     pub x: Vec<f64>,

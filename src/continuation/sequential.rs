@@ -1,6 +1,6 @@
 //! Sequential (natural-parameter) continuation.
 
-use super::{AtParameter, ContinuationProblem, Point};
+use super::{ContinuationProblem, Point};
 use crate::error::{ContinuationError, SolveError};
 use crate::solve::{norm, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
@@ -270,11 +270,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         lambda: f64,
         x: &mut [f64],
     ) -> (Result<SolveInfo, SolveError>, bool) {
-        let mut frozen = AtParameter {
-            problem: &mut self.problem,
-            lambda,
-        };
-        let result = self.solver.solve(&mut frozen, x);
+        self.problem.set_parameter(lambda);
+        let result = self.solver.solve(&mut self.problem, x);
         let accepted = accepts(&mut self.accept, &result, x, lambda);
         (result, accepted)
     }
@@ -409,7 +406,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                 };
                 self.failures += 1;
                 let mut f = vec![0.0; x.len()];
-                self.problem.residual(&x, lambda, &mut f);
+                self.problem.set_parameter(lambda);
+                self.problem.residual(&x, &mut f);
                 let iterations = match (&error, solved) {
                     (_, Some(info)) => info.iterations,
                     (Some(SolveError::MaxIterations { iterations, .. }), _) => *iterations,
@@ -420,7 +418,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                             | SolveError::TrustRegion { iteration, .. }
                             | SolveError::Stagnated { iteration, .. }
                             | SolveError::EvaluationBudget { iteration, .. }
-                            | SolveError::NonFinite { iteration, .. },
+                            | SolveError::NonFinite { iteration, .. }
+                            | SolveError::Cancelled { iteration, .. },
                         ),
                         _,
                     ) => *iteration,

@@ -9,10 +9,9 @@
 //! first attempt joins the branch.
 
 use super::sequential::{accepts, run_with, Attempt};
-use super::{AtParameter, ContinuationProblem, Sequential, StepOutcome};
+use super::{ContinuationProblem, Sequential, StepOutcome};
 use crate::error::{ContinuationError, SolveError};
-use crate::linalg::DenseMatrix;
-use crate::solve::{NonlinearSolver, Problem, SingularStep, SolveInfo};
+use crate::solve::{NonlinearSolver, SolveInfo, SolveMonitor};
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::{mpsc, Arc};
@@ -51,77 +50,25 @@ pub struct SpeculationStats {
     pub taken_back: usize,
 }
 
-/// A problem seen by a solver through a counter of residual evaluations (with a hook fired
-/// at a given count) and a cancellation flag (a cancelled solve meets a singular step and
-/// non-finite residuals, and stops at once).
-struct Monitored<'a, Q> {
-    inner: Q,
-    evaluations: usize,
+/// A solve's monitor: fires a hook once at a given count of residual evaluations, and cancels
+/// the solve once its flag says [`CANCELLED`].
+struct Watch<'a> {
     hook: Option<(usize, &'a mut dyn FnMut())>,
     cancel: Option<&'a AtomicU8>,
 }
 
-impl<Q: Problem> Monitored<'_, Q> {
-    fn cancelled(&self) -> bool {
-        self.cancel
-            .is_some_and(|c| c.load(Ordering::Acquire) == CANCELLED)
-    }
-
-    /// Counts an evaluation and fires the hook when its count is reached; returns whether the
-    /// evaluation should go ahead.
-    fn count(&mut self) -> bool {
-        self.evaluations += 1;
+impl SolveMonitor for Watch<'_> {
+    fn evaluated(&mut self, evaluations: usize) -> ControlFlow<()> {
         if let Some((at, hook)) = self.hook.as_mut() {
-            if self.evaluations >= *at {
+            if evaluations >= *at {
                 hook();
                 self.hook = None;
             }
         }
-        !self.cancelled()
-    }
-}
-
-impl<Q: Problem> Problem for Monitored<'_, Q> {
-    fn dimension(&self) -> usize {
-        self.inner.dimension()
-    }
-    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
-        if self.count() {
-            self.inner.residual(x, f);
-        } else {
-            f.fill(f64::NAN);
+        match self.cancel {
+            Some(c) if c.load(Ordering::Acquire) == CANCELLED => ControlFlow::Break(()),
+            _ => ControlFlow::Continue(()),
         }
-    }
-    fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
-        if self.count() {
-            self.inner.residual_along(x, dx, t, trial, f);
-        } else {
-            trial.copy_from_slice(x);
-            f.fill(f64::NAN);
-        }
-    }
-    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
-        self.inner.jacobian(x, jac);
-    }
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.inner.set_smoothing(smoothing)
-    }
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        if self.cancelled() {
-            return Some(Err(SingularStep {
-                pivot: 0,
-                ratio: 0.0,
-            }));
-        }
-        self.inner.newton_step(x, f, dx)
-    }
-    fn residual_scale(&self) -> f64 {
-        self.inner.residual_scale()
     }
 }
 
@@ -173,16 +120,12 @@ impl Worker {
                         continue;
                     }
                     let mut x = job.start;
-                    let mut retry = Monitored {
-                        inner: AtParameter {
-                            problem: &mut problem,
-                            lambda: job.lambda,
-                        },
-                        evaluations: 0,
+                    let mut watch = Watch {
                         hook: None,
                         cancel: Some(&job.state),
                     };
-                    let result = solver.solve(&mut retry, &mut x);
+                    problem.set_parameter(job.lambda);
+                    let result = solver.solve_monitored(&mut problem, &mut x, &mut watch);
                     if done.send((job.step, x, result)).is_err() {
                         break;
                     }
@@ -283,16 +226,18 @@ where
                     handed = jobs.send(job).is_ok().then_some(state);
                 }
             };
-            let mut first = Monitored {
-                inner: AtParameter {
-                    problem: &mut self.problem,
-                    lambda,
-                },
-                evaluations: 0,
+            // At 0 the retry starts with the first attempt (also beside a solver that does not
+            // report its evaluations).
+            if speculation.after_evaluations == 0 {
+                launch();
+            }
+            let mut watch = Watch {
                 hook: Some((speculation.after_evaluations, &mut launch)),
                 cancel: None,
             };
-            self.solver.solve(&mut first, &mut x)
+            self.problem.set_parameter(lambda);
+            self.solver
+                .solve_monitored(&mut self.problem, &mut x, &mut watch)
         };
         let accepted = accepts(&mut self.accept, &result, &x, lambda);
         let first = Attempt {
@@ -361,7 +306,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::{NewtonOptions, SemismoothNewton};
+    use crate::linalg::DenseMatrix;
+    use crate::solve::{NewtonOptions, Problem, SemismoothNewton};
 
     /// `F(x) = x^2 - 2` in one unknown.
     struct Square;
@@ -387,14 +333,13 @@ mod tests {
         let mut watched = [3.0];
         let mut count = 0;
         let mut hook = || count += 1;
-        let mut monitored = Monitored {
-            inner: Square,
-            evaluations: 0,
+        let mut watch = Watch {
             hook: Some((2, &mut hook)),
             cancel: None,
         };
-        let watched_info = solver.solve(&mut monitored, &mut watched).unwrap();
-        assert_eq!(monitored.evaluations, info.residual_evaluations);
+        let watched_info = solver
+            .solve_monitored(&mut Square, &mut watched, &mut watch)
+            .unwrap();
         assert_eq!(watched, plain);
         assert_eq!(watched_info, info);
         assert_eq!(count, 1);
@@ -404,25 +349,25 @@ mod tests {
     fn a_cancelled_solve_stops_at_once() {
         let solver = SemismoothNewton::default();
         let state = AtomicU8::new(CANCELLED);
-        let watched = |state| Monitored {
-            inner: Square,
-            evaluations: 0,
+        let watch = |state| Watch {
             hook: None,
             cancel: Some(state),
         };
-        let mut monitored = watched(&state);
         let mut x = [3.0];
-        let result = solver.solve(&mut monitored, &mut x);
-        assert!(
-            matches!(result, Err(SolveError::NonFinite { .. })),
-            "{result:?}"
+        let result = solver.solve_monitored(&mut Square, &mut x, &mut watch(&state));
+        assert_eq!(
+            result,
+            Err(SolveError::Cancelled {
+                iteration: 0,
+                evaluations: 1
+            })
         );
-        assert_eq!(monitored.evaluations, 1);
         // Running, not cancelled: the solve goes on.
         state.store(RUNNING, Ordering::Release);
-        let mut monitored = watched(&state);
         let mut x = [3.0];
-        solver.solve(&mut monitored, &mut x).unwrap();
+        solver
+            .solve_monitored(&mut Square, &mut x, &mut watch(&state))
+            .unwrap();
         assert!((x[0] - 2f64.sqrt()).abs() < 1e-9);
     }
 }

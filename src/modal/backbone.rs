@@ -243,7 +243,7 @@ fn drive_backbone<S: NonlinearSolver>(
     // took the same point: it reuses the energy the test computed.
     let measured_energy = Rc::clone(&last_energy);
     let mut driver = Sequential::new(
-        PeriodParametrised(problem),
+        PeriodParametrised::new(problem),
         solver,
         start,
         values,

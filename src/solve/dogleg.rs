@@ -1,7 +1,8 @@
 //! Powell's hybrid trust-region dogleg method.
 
 use super::{
-    check_positive, norm, with_workspace, Iteration, NonlinearSolver, Problem, SolveInfo, Workspace,
+    check_positive, norm, residual_scale, with_workspace, Iteration, NonlinearSolver, Problem,
+    SolveInfo, SolveMonitor, Workspace,
 };
 use crate::error::SolveError;
 
@@ -58,15 +59,20 @@ impl Dogleg {
 }
 
 impl NonlinearSolver for Dogleg {
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
-        self.options.tolerance * problem.residual_scale()
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
+        self.options.tolerance * residual_scale(problem)
     }
 
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError> {
         let o = &self.options;
         let tol = self.tolerance(problem);
-        let scale = problem.residual_scale();
-        let mut it = Iteration::new(problem, x)?;
+        let scale = residual_scale(problem);
+        let mut it = Iteration::new(problem, monitor, x)?;
         let reference = norm(x).max(scale);
         let mut radius = o.initial_radius * reference;
         with_workspace(x.len(), |ws| {

@@ -1,10 +1,10 @@
 //! Smoothing homotopy around any solver, for starts where the nonsmooth problem is hard.
 
-use super::{NonlinearSolver, Problem, SolveInfo};
+use super::{residual_scale, NonlinearSolver, Problem, SolveInfo, SolveMonitor};
 use crate::error::SolveError;
 
 /// Tries `inner` on the nonsmooth problem; if it fails and the problem supports smoothing
-/// ([`Problem::set_smoothing`]), solves again from the same start a sequence of smoothed
+/// ([`Structured::set_smoothing`](super::Structured::set_smoothing)), solves again from the same start a sequence of smoothed
 /// problems with decreasing smoothing `eps_i = levels[i] * residual_scale`, each from the
 /// previous solution, and finishes on the nonsmooth problem (`eps = 0`). For unilateral contact
 /// the smoothing replaces `min(lambda, a_c g)` by `(a + b - sqrt((a - b)^2 + 4 eps^2)) / 2`,
@@ -42,21 +42,27 @@ impl<S: Default> Default for SmoothingHomotopy<S> {
 }
 
 impl<S: NonlinearSolver> NonlinearSolver for SmoothingHomotopy<S> {
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
         self.inner.tolerance(problem)
     }
 
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError> {
         let start = x.to_vec();
-        let first = match self.inner.solve(problem, x) {
+        let first = match self.inner.solve_monitored(problem, x, monitor) {
             Ok(info) => return Ok(info),
+            Err(e @ SolveError::Cancelled { .. }) => return Err(e),
             Err(e) => e,
         };
-        if self.levels.is_empty() || !problem.set_smoothing(0.0) {
+        if self.levels.is_empty() || !set_smoothing(problem, 0.0) {
             return Err(first);
         }
         let failed = x.to_vec();
-        let scale = problem.residual_scale();
+        let scale = residual_scale(problem);
         x.copy_from_slice(&start);
         let mut total = SolveInfo {
             iterations: 0,
@@ -70,22 +76,33 @@ impl<S: NonlinearSolver> NonlinearSolver for SmoothingHomotopy<S> {
             .map(|l| l * scale)
             .chain(std::iter::once(0.0));
         for eps in levels {
-            problem.set_smoothing(eps);
-            match self.inner.solve(problem, x) {
+            set_smoothing(problem, eps);
+            match self.inner.solve_monitored(problem, x, monitor) {
                 Ok(info) => {
                     total.iterations += info.iterations;
                     total.residual_evaluations += info.residual_evaluations;
                     total.jacobian_evaluations += info.jacobian_evaluations;
                     total.residual_norm = info.residual_norm;
                 }
-                Err(_) => {
-                    problem.set_smoothing(0.0);
+                Err(e) => {
+                    set_smoothing(problem, 0.0);
+                    if let SolveError::Cancelled { .. } = e {
+                        return Err(e);
+                    }
                     x.copy_from_slice(&failed);
                     return Err(first);
                 }
             }
         }
-        problem.set_smoothing(0.0);
+        set_smoothing(problem, 0.0);
         Ok(total)
     }
+}
+
+/// [`Structured::set_smoothing`](super::Structured::set_smoothing) of a problem (`false`
+/// without structure).
+fn set_smoothing(problem: &mut dyn Problem, smoothing: f64) -> bool {
+    problem
+        .structure()
+        .is_some_and(|s| s.set_smoothing(smoothing))
 }

@@ -8,6 +8,13 @@
 //! |---|---|---|
 //! | [`SemismoothNewton`] (default) | `J dx = -F` | backtracking (Armijo) on `|F|^2 / 2` |
 //! | [`Dogleg`] | Powell's dogleg between Newton and Cauchy steps | trust region |
+//!
+//! A problem is three methods ([`Problem`]: dimension, residual, Jacobian). What a problem can
+//! do beyond them (solve with its Jacobian without forming it densely, evaluate the residual
+//! cheaply along a ray, smooth its kinks, weigh its unknowns, report its active set, state the
+//! scale of its residual) is one capability object, [`Structured`], reached through
+//! [`Problem::structure`]: an adapter that wraps a problem forwards that one accessor and so
+//! keeps every capability of the problem it wraps.
 
 mod dogleg;
 mod homotopy;
@@ -20,8 +27,12 @@ pub use newton::{NewtonOptions, SemismoothNewton};
 use crate::error::SolveError;
 use crate::linalg::{DenseMatrix, Lu};
 use std::cell::Cell;
+use std::ops::ControlFlow;
 
 /// A square system `F(x) = 0` with a generalised Jacobian.
+///
+/// Only the three required methods are needed to solve it; optional capabilities come through
+/// [`Problem::structure`].
 pub trait Problem {
     /// Number of unknowns (and equations).
     fn dimension(&self) -> usize;
@@ -32,46 +43,101 @@ pub trait Problem {
     /// Writes a generalised Jacobian `J(x)` into `jac` (resized to `n x n` by the callee).
     fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix);
 
-    /// A line search's evaluation: writes `x + t dx` into `trial` and `F(x + t dx)` into `f`.
-    /// The default forms the point and calls [`Problem::residual`]; a problem whose residual
-    /// is cheaper along a fixed direction overrides it (harmonic balance: the time samples
-    /// are affine in `t`, so a whole line search needs one synthesis).
-    fn residual_along(&mut self, x: &[f64], dx: &[f64], t: f64, trial: &mut [f64], f: &mut [f64]) {
-        point_on_ray(x, dx, t, trial);
-        self.residual(trial, f);
+    /// The problem's optional capabilities (`None` by default: a plain problem). Adapters
+    /// forward this one accessor.
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        None
+    }
+}
+
+/// Optional capabilities of a [`Problem`], each with a default that means "not available".
+///
+/// Solvers and drivers use a capability when [`Problem::structure`] offers it and fall back to
+/// the plain methods otherwise; results agree to rounding either way.
+pub trait Structured {
+    /// Typical magnitude of the residual's entries: tolerances are relative to it (1 by
+    /// default).
+    fn residual_scale(&self) -> f64 {
+        1.0
+    }
+
+    /// Solves `J(x) z = r` for `columns` right-hand sides stored one after the other in `rhs`
+    /// (each of the problem's dimension), in place, exploiting the problem's structure instead
+    /// of factorising the dense Jacobian. `None` (the default): no structured solve here, the
+    /// caller factorises [`Problem::jacobian`]; `Some(Err(..))`: the structured matrix is
+    /// singular.
+    fn solve_jacobian(
+        &mut self,
+        x: &[f64],
+        rhs: &mut [f64],
+        columns: usize,
+    ) -> Option<Result<(), SingularStep>> {
+        let _ = (x, rhs, columns);
+        None
+    }
+
+    /// A line search's evaluation: writes `x + t dx` into `trial` and `F(x + t dx)` into `f`,
+    /// and returns `true`; `false` (the default) if the problem has no cheaper way than
+    /// forming the point and calling [`Problem::residual`]. (Harmonic balance: the time
+    /// samples are affine in `t`, so a whole line search needs one synthesis.)
+    fn residual_along(
+        &mut self,
+        x: &[f64],
+        dx: &[f64],
+        t: f64,
+        trial: &mut [f64],
+        f: &mut [f64],
+    ) -> bool {
+        let _ = (x, dx, t, trial, f);
+        false
     }
 
     /// Sets a smoothing `eps >= 0` of the problem's nonsmooth terms (`eps = 0`: the original
-    /// problem) and returns whether the problem supports it; `false` by default. Used by
+    /// problem) and returns whether the problem supports it (`false` by default). Used by
     /// [`SmoothingHomotopy`].
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
         let _ = smoothing;
         false
     }
 
-    /// A structured Newton step: writes into `dx` the solution of `J(x) dx = -f`, where
-    /// `f = F(x)`, exploiting the problem's structure instead of factorising the dense
-    /// Jacobian. `None` (the default): no structured step, the solver factorises
-    /// [`Problem::jacobian`]; `Some(Err(..))`: the reduced system is singular.
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        let _ = (x, f, dx);
+    /// Diagonal weights `w_i` of a natural norm `sum_i w_i x_i^2` of the unknowns (for
+    /// harmonic balance, an energy norm at the current frequency). Arclength continuation
+    /// scales its norm with them; `None` (default) means all weights 1.
+    fn state_weights(&mut self) -> Option<Vec<f64>> {
         None
     }
 
-    /// Typical magnitude of the residual's entries (tolerances are relative to it); 1 by
-    /// default.
-    fn residual_scale(&self) -> f64 {
-        1.0
+    /// For nonsmooth problems: the size of the active set of each unilateral law at `x` (for
+    /// harmonic balance, the number of time samples in contact). Continuation drivers report
+    /// a grazing event when one appears or vanishes. `None` by default.
+    fn active_set(&mut self, x: &[f64]) -> Option<Vec<usize>> {
+        let _ = x;
+        None
     }
 }
 
-/// A singular (reduced) matrix met by [`Problem::newton_step`]: the smallest pivot of its LU
-/// and its ratio to the largest, as in [`SolveError::SingularJacobian`].
+/// [`Structured::residual_scale`] of a problem (1 without structure).
+pub fn residual_scale(problem: &mut (impl Problem + ?Sized)) -> f64 {
+    problem.structure().map_or(1.0, |s| s.residual_scale())
+}
+
+impl<P: Problem + ?Sized> Problem for &mut P {
+    fn dimension(&self) -> usize {
+        (**self).dimension()
+    }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        (**self).residual(x, f)
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        (**self).jacobian(x, jac)
+    }
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        (**self).structure()
+    }
+}
+
+/// A singular (structured) matrix met by [`Structured::solve_jacobian`]: the smallest pivot
+/// of its LU and its ratio to the largest, as in [`SolveError::SingularJacobian`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SingularStep {
     /// Index of the smallest pivot.
@@ -93,36 +159,74 @@ pub struct SolveInfo {
     pub jacobian_evaluations: usize,
 }
 
+/// Watches a solve from outside: told of every residual evaluation, it may cancel the solve
+/// ([`SolveError::Cancelled`]). `()` watches nothing.
+pub trait SolveMonitor {
+    /// Called after each residual evaluation with the number made so far;
+    /// `ControlFlow::Break` cancels the solve.
+    fn evaluated(&mut self, evaluations: usize) -> ControlFlow<()>;
+}
+
+impl SolveMonitor for () {
+    fn evaluated(&mut self, _: usize) -> ControlFlow<()> {
+        ControlFlow::Continue(())
+    }
+}
+
 /// A solver of square nonsmooth systems. Object safe: continuation drivers take
 /// `&dyn NonlinearSolver` or a generic `S: NonlinearSolver`.
 pub trait NonlinearSolver {
-    /// Solves `F(x) = 0` starting from `x`; on success `x` holds the solution, on failure the
-    /// last iterate.
+    /// Solves `F(x) = 0` starting from `x`, telling `monitor` of every residual evaluation;
+    /// on success `x` holds the solution, on failure the last iterate. A solver that cannot
+    /// be interrupted may ignore the monitor.
+    ///
+    /// # Errors
+    /// See [`SolveError`]; [`SolveError::Cancelled`] when the monitor cancels.
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError>;
+
+    /// [`NonlinearSolver::solve_monitored`] with no monitor.
     ///
     /// # Errors
     /// See [`SolveError`].
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError>;
+    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+        self.solve_monitored(problem, x, &mut ())
+    }
 
     /// The absolute tolerance on `|F|_2` this solver uses for `problem` (so that callers can
     /// judge a point with the same yardstick).
-    fn tolerance(&self, problem: &dyn Problem) -> f64;
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64;
 }
 
 impl<S: NonlinearSolver + ?Sized> NonlinearSolver for &S {
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
-        (**self).solve(problem, x)
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError> {
+        (**self).solve_monitored(problem, x, monitor)
     }
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
         (**self).tolerance(problem)
     }
 }
 
 /// A boxed solver (`Box<dyn NonlinearSolver>`, chosen at run time) is a solver.
 impl<S: NonlinearSolver + ?Sized> NonlinearSolver for Box<S> {
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
-        (**self).solve(problem, x)
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError> {
+        (**self).solve_monitored(problem, x, monitor)
     }
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
         (**self).tolerance(problem)
     }
 }
@@ -207,15 +311,20 @@ pub(crate) fn with_workspace<R>(n: usize, f: impl FnOnce(&mut Workspace) -> R) -
     result
 }
 
-/// Shared state of an iteration: the problem and counters.
+/// Shared state of an iteration: the problem, its monitor and counters.
 pub(crate) struct Iteration<'p> {
     pub problem: &'p mut dyn Problem,
+    monitor: &'p mut dyn SolveMonitor,
     pub residuals: usize,
     pub jacobians: usize,
 }
 
 impl<'p> Iteration<'p> {
-    pub fn new(problem: &'p mut dyn Problem, x: &[f64]) -> Result<Self, SolveError> {
+    pub fn new(
+        problem: &'p mut dyn Problem,
+        monitor: &'p mut dyn SolveMonitor,
+        x: &[f64],
+    ) -> Result<Self, SolveError> {
         let n = problem.dimension();
         if x.len() != n {
             return Err(SolveError::Dimension {
@@ -231,6 +340,7 @@ impl<'p> Iteration<'p> {
         }
         Ok(Self {
             problem,
+            monitor,
             residuals: 0,
             jacobians: 0,
         })
@@ -247,9 +357,16 @@ impl<'p> Iteration<'p> {
         self.counted_norm(out, iteration)
     }
 
-    /// Counts a residual evaluation and returns its norm, or an error if it is not finite.
+    /// Counts a residual evaluation, tells the monitor, and returns the norm, or an error if
+    /// it is not finite or the monitor cancels.
     fn counted_norm(&mut self, f: &[f64], iteration: usize) -> Result<f64, SolveError> {
         self.residuals += 1;
+        if self.monitor.evaluated(self.residuals).is_break() {
+            return Err(SolveError::Cancelled {
+                iteration,
+                evaluations: self.residuals,
+            });
+        }
         let r = norm(f);
         if r.is_finite() {
             Ok(r)
@@ -261,8 +378,9 @@ impl<'p> Iteration<'p> {
         }
     }
 
-    /// [`Problem::residual_along`] with its norm, counted and checked like
-    /// [`Iteration::residual_into`].
+    /// `F(x + t dx)` (and the point into `trial`) with its norm, counted and checked like
+    /// [`Iteration::residual_into`]; through [`Structured::residual_along`] when the problem
+    /// offers it.
     pub fn residual_along_into(
         &mut self,
         (x, dx, t): (&[f64], &[f64], f64),
@@ -270,7 +388,14 @@ impl<'p> Iteration<'p> {
         out: &mut [f64],
         iteration: usize,
     ) -> Result<f64, SolveError> {
-        self.problem.residual_along(x, dx, t, trial, out);
+        let along = self
+            .problem
+            .structure()
+            .is_some_and(|s| s.residual_along(x, dx, t, trial, out));
+        if !along {
+            point_on_ray(x, dx, t, trial);
+            self.problem.residual(trial, out);
+        }
         self.counted_norm(out, iteration)
     }
 
@@ -297,6 +422,51 @@ impl<'p> Iteration<'p> {
                 pivot: p.pivot,
                 ratio: p.ratio,
             })
+    }
+
+    /// The Newton direction `dx = -J(x)^-1 f`: by the problem's structured solve when it
+    /// offers one, else by a dense LU of its Jacobian (in `jac`, `lu`).
+    pub fn newton_direction(
+        &mut self,
+        (x, f): (&[f64], &[f64]),
+        dx: &mut [f64],
+        (jac, lu): (&mut DenseMatrix, &mut Lu),
+        iteration: usize,
+    ) -> Result<(), SolveError> {
+        for (d, fi) in dx.iter_mut().zip(f) {
+            *d = -fi;
+        }
+        let structured = self
+            .problem
+            .structure()
+            .and_then(|s| s.solve_jacobian(x, dx, 1));
+        match structured {
+            Some(Ok(())) => {
+                self.jacobians += 1;
+                if dx.iter().all(|v| v.is_finite()) {
+                    Ok(())
+                } else {
+                    Err(SolveError::NonFinite {
+                        what: "Jacobian",
+                        iteration,
+                    })
+                }
+            }
+            Some(Err(p)) => Err(SolveError::SingularJacobian {
+                iteration,
+                pivot: p.pivot,
+                ratio: p.ratio,
+            }),
+            None => {
+                // The structured solve may have left partial results: start again from -f.
+                for (d, fi) in dx.iter_mut().zip(f) {
+                    *d = -fi;
+                }
+                self.factor_jacobian(x, jac, lu, iteration)?;
+                lu.solve_in_place(dx);
+                Ok(())
+            }
+        }
     }
 
     pub fn info(&self, iterations: usize, residual_norm: f64) -> SolveInfo {

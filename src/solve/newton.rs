@@ -1,7 +1,8 @@
 //! Semismooth Newton with a backtracking line search.
 
 use super::{
-    check_positive, with_workspace, Iteration, NonlinearSolver, Problem, SolveInfo, Workspace,
+    check_positive, residual_scale, with_workspace, Iteration, NonlinearSolver, Problem, SolveInfo,
+    SolveMonitor, Workspace,
 };
 use crate::error::SolveError;
 
@@ -134,14 +135,19 @@ impl SemismoothNewton {
 }
 
 impl NonlinearSolver for SemismoothNewton {
-    fn tolerance(&self, problem: &dyn Problem) -> f64 {
-        self.options.tolerance * problem.residual_scale()
+    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
+        self.options.tolerance * residual_scale(problem)
     }
 
-    fn solve(&self, problem: &mut dyn Problem, x: &mut [f64]) -> Result<SolveInfo, SolveError> {
+    fn solve_monitored(
+        &self,
+        problem: &mut dyn Problem,
+        x: &mut [f64],
+        monitor: &mut dyn SolveMonitor,
+    ) -> Result<SolveInfo, SolveError> {
         let o = &self.options;
         let tol = self.tolerance(problem);
-        let mut it = Iteration::new(problem, x)?;
+        let mut it = Iteration::new(problem, monitor, x)?;
         with_workspace(x.len(), |ws| {
             let Workspace {
                 f,
@@ -161,31 +167,7 @@ impl NonlinearSolver for SemismoothNewton {
                 }
                 history.check(iteration, r)?;
                 plateau.check(iteration, r)?;
-                match it.problem.newton_step(x, f, dx) {
-                    Some(Ok(())) => {
-                        it.jacobians += 1;
-                        if !dx.iter().all(|v| v.is_finite()) {
-                            return Err(SolveError::NonFinite {
-                                what: "Jacobian",
-                                iteration,
-                            });
-                        }
-                    }
-                    Some(Err(p)) => {
-                        return Err(SolveError::SingularJacobian {
-                            iteration,
-                            pivot: p.pivot,
-                            ratio: p.ratio,
-                        })
-                    }
-                    None => {
-                        it.factor_jacobian(x, jac, lu, iteration)?;
-                        for (d, fi) in dx.iter_mut().zip(f.iter()) {
-                            *d = -fi;
-                        }
-                        lu.solve_in_place(dx);
-                    }
-                }
+                it.newton_direction((x, f), dx, (jac, lu), iteration)?;
                 let mut t = 1.0;
                 loop {
                     let rt = it.residual_along_into((x, dx, t), trial, f_trial, iteration)?;

@@ -17,7 +17,7 @@
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, ModelError, SettingsError};
 use crate::linalg::DenseMatrix;
-use crate::solve::point_on_ray;
+use crate::solve::{Problem, Structured};
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 
 /// A one-parameter family of bar systems.
@@ -38,24 +38,26 @@ impl<F: Fn(f64) -> Result<BarSystem, ModelError>> SystemFamily for F {
 /// Harmonic balance at fixed `Omega` as a continuation problem in a family's parameter.
 ///
 /// `dF/dlambda` is a central difference of the residual in the parameter with relative step
-/// `1e-6` (the family is arbitrary user code); `dF/dx` stays analytic. Where a parameter value
-/// is not admissible, residual and Jacobian are NaN, which the solvers report as
-/// [`SolveError::NonFinite`](crate::SolveError::NonFinite), so a continuation step that
-/// leaves the admissible set is rejected rather than silently wrong.
+/// `1e-6` (the family is arbitrary user code); `dF/dx` stays analytic, and the system at the
+/// current parameter lends its [`Structured`] capabilities (the condensed Newton step among
+/// them). Where a parameter value is not admissible, residual and Jacobian are NaN, which the
+/// solvers report as [`SolveError::NonFinite`](crate::SolveError::NonFinite), so a
+/// continuation step that leaves the admissible set is rejected rather than silently wrong.
 pub struct ParameterFamily<F> {
     family: F,
     settings: HarmonicBalance,
     omega: f64,
-    current: Option<(f64, Option<NonsmoothSystem>)>,
+    value: f64,
+    /// The system at `value` (`None` where the family rejects it).
+    current: Option<NonsmoothSystem>,
     dimension: usize,
-    smoothing: f64,
 }
 
 impl<F: SystemFamily> ParameterFamily<F> {
     /// The family `family` under `settings` at fundamental frequency `omega`.
     ///
-    /// The dimension is taken from the system at parameter 1; use
-    /// [`ParameterFamily::at`] to probe another value.
+    /// The dimension is taken from the system at parameter 1, where the family starts; use
+    /// [`ParameterFamily::at`] to start at another value.
     ///
     /// # Errors
     /// A non-positive `omega`, invalid settings, or a family that fails at the probe value.
@@ -63,7 +65,7 @@ impl<F: SystemFamily> ParameterFamily<F> {
         Self::at(family, settings, omega, 1.0)
     }
 
-    /// As [`ParameterFamily::new`], probing the family at `value`.
+    /// As [`ParameterFamily::new`], starting at parameter `value`.
     ///
     /// # Errors
     /// See [`ParameterFamily::new`].
@@ -75,14 +77,15 @@ impl<F: SystemFamily> ParameterFamily<F> {
             }
             .into());
         }
-        let system = NonsmoothSystem::new(&family.build(value)?, settings)?;
+        let mut system = NonsmoothSystem::new(&family.build(value)?, settings)?;
+        system.set_parameter(omega);
         Ok(Self {
             dimension: system.dimension(),
-            current: Some((value, Some(system))),
+            current: Some(system),
+            value,
             family,
             settings,
             omega,
-            smoothing: 0.0,
         })
     }
 
@@ -91,62 +94,47 @@ impl<F: SystemFamily> ParameterFamily<F> {
         self.omega
     }
 
-    /// The harmonic-balance system at `value` (None where the family rejects it).
-    pub fn system_at(&mut self, value: f64) -> Option<&mut NonsmoothSystem> {
-        let stale = !matches!(&self.current, Some((v, _)) if *v == value);
-        if stale {
-            let system = self
-                .family
-                .build(value)
-                .ok()
-                .and_then(|s| NonsmoothSystem::new(&s, self.settings).ok())
-                .filter(|s| s.dimension() == self.dimension)
-                .map(|mut s| {
-                    s.set_smoothing(self.smoothing);
-                    s
-                });
-            self.current = Some((value, system));
-        }
-        self.current.as_mut().and_then(|(_, s)| s.as_mut())
+    /// The harmonic-balance system at the current parameter (None where the family rejects
+    /// it).
+    pub fn system(&mut self) -> Option<&mut NonsmoothSystem> {
+        self.current.as_mut()
+    }
+
+    /// The harmonic-balance system at `value` at the family's frequency, or `None` where the
+    /// family rejects `value` or changes the dimension there.
+    fn build(&self, value: f64) -> Option<NonsmoothSystem> {
+        let mut system = self
+            .family
+            .build(value)
+            .ok()
+            .and_then(|s| NonsmoothSystem::new(&s, self.settings).ok())
+            .filter(|s| s.dimension() == self.dimension)?;
+        system.set_parameter(self.omega);
+        Some(system)
     }
 }
 
-impl<F: SystemFamily> ContinuationProblem for ParameterFamily<F> {
+/// `F(x)` of `system` into `f`, or NaN where there is no system.
+fn residual_or_nan(system: Option<&mut NonsmoothSystem>, x: &[f64], f: &mut [f64]) {
+    match system {
+        Some(s) => s.residual(x, f),
+        None => f.fill(f64::NAN),
+    }
+}
+
+impl<F: SystemFamily> Problem for ParameterFamily<F> {
     fn dimension(&self) -> usize {
         self.dimension
     }
 
-    fn residual(&mut self, x: &[f64], lambda: f64, f: &mut [f64]) {
-        let omega = self.omega;
-        match self.system_at(lambda) {
-            Some(s) => s.residual(x, omega, f),
-            None => f.fill(f64::NAN),
-        }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        residual_or_nan(self.current.as_mut(), x, f);
     }
 
-    fn residual_along(
-        &mut self,
-        x: &[f64],
-        dx: &[f64],
-        t: f64,
-        lambda: f64,
-        trial: &mut [f64],
-        f: &mut [f64],
-    ) {
-        let omega = self.omega;
-        match self.system_at(lambda) {
-            Some(s) => s.residual_along(x, dx, t, omega, trial, f),
-            None => {
-                point_on_ray(x, dx, t, trial);
-                f.fill(f64::NAN);
-            }
-        }
-    }
-
-    fn jacobian(&mut self, x: &[f64], lambda: f64, jac: &mut DenseMatrix) {
-        let (omega, n) = (self.omega, self.dimension);
-        match self.system_at(lambda) {
-            Some(s) => s.jacobian(x, omega, jac),
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        let n = self.dimension;
+        match self.current.as_mut() {
+            Some(s) => s.jacobian(x, jac),
             None => {
                 jac.reset(n, n);
                 jac[(0, 0)] = f64::NAN;
@@ -154,40 +142,31 @@ impl<F: SystemFamily> ContinuationProblem for ParameterFamily<F> {
         }
     }
 
-    fn parameter_derivative(&mut self, x: &[f64], lambda: f64, df: &mut [f64]) {
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        self.current.as_mut().map(|s| s as &mut dyn Structured)
+    }
+}
+
+impl<F: SystemFamily> ContinuationProblem for ParameterFamily<F> {
+    fn parameter(&self) -> f64 {
+        self.value
+    }
+
+    fn set_parameter(&mut self, value: f64) {
+        if value != self.value || self.current.is_none() {
+            self.current = self.build(value);
+            self.value = value;
+        }
+    }
+
+    fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
+        let lambda = self.value;
         let h = 1e-6 * lambda.abs().max(1e-300);
         let mut minus = vec![0.0; df.len()];
-        self.residual(x, lambda + h, df);
-        self.residual(x, lambda - h, &mut minus);
+        residual_or_nan(self.build(lambda + h).as_mut(), x, df);
+        residual_or_nan(self.build(lambda - h).as_mut(), x, &mut minus);
         for (d, m) in df.iter_mut().zip(&minus) {
             *d = (*d - m) / (2.0 * h);
         }
-        // Leave the cache on `lambda`, where the next residual is evaluated.
-        let _ = self.system_at(lambda);
-    }
-
-    fn residual_scale(&self) -> f64 {
-        match &self.current {
-            Some((_, Some(s))) => s.residual_scale(),
-            _ => 1.0,
-        }
-    }
-
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.smoothing = smoothing.max(0.0);
-        if let Some((_, Some(s))) = &mut self.current {
-            s.set_smoothing(self.smoothing);
-        }
-        true
-    }
-
-    fn state_weights(&mut self, lambda: f64) -> Option<Vec<f64>> {
-        let omega = self.omega;
-        self.system_at(lambda).and_then(|s| s.state_weights(omega))
-    }
-
-    fn active_set(&mut self, x: &[f64], lambda: f64) -> Option<Vec<usize>> {
-        let omega = self.omega;
-        self.system_at(lambda).and_then(|s| s.active_set(x, omega))
     }
 }

@@ -14,15 +14,18 @@
 //! (Toeplitz + Hankel for cosines: formulation §6). `dF/dOmega` at fixed `x` comes only through
 //! the wave numbers `k = n Omega / c` in the rows.
 
+mod step;
+
 use crate::bc::LawSamples;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
-use crate::linalg::{dot_lanes, DenseMatrix, Lu};
-use crate::solve::{point_on_ray, SingularStep};
-use crate::system::condense::{condense_into, CondenseScratch, Condensed};
+use crate::linalg::DenseMatrix;
+use crate::solve::{point_on_ray, Problem, SingularStep, Structured};
+use crate::system::condense::{CondenseScratch, Condensed};
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
 use crate::system::BarSystem;
+use step::Reduced;
 
 /// Harmonic-balance settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,12 +71,6 @@ impl HarmonicBalance {
 /// Relative singular-value threshold under which a harmonic's linear rows count as
 /// rank-deficient (see [`HarmonicRows::regularise`]).
 const RANK_TOLERANCE: f64 = 1e-9;
-/// Relative pivot threshold of the reduced LU of the structured Newton step. Stricter than the
-/// dense LU's (`1e-13`): the reduced matrix has fewer, better scaled unknowns, so the same
-/// near-singular steps (a harmonic on a part's natural frequency while the contact is open)
-/// show larger relative pivots; with `1e-13` they slipped through and derailed two-bar
-/// branches that the dense path steps over.
-const REDUCED_PIVOT_TOLERANCE: f64 = 1e-10;
 
 /// Time samples of the laws' observables and generalised gradients.
 #[derive(Debug, Clone, Default)]
@@ -88,7 +85,9 @@ struct Workspace {
     /// Samples of `d gap / d Omega` (scratch of `dF/dOmega`).
     d_samples: Vec<f64>,
     projection: Vec<f64>,
+    /// `G(w_gap)` of every law, `len x len` row-major each, one after the other.
     gram_gap: Vec<f64>,
+    /// `G(w_force)` of every law, laid out as `gram_gap`.
     gram_force: Vec<f64>,
     /// The unknowns the law samples (`values`, `w_gap`, `w_force`) were computed for, at the
     /// current `Omega`, smoothing and blend; `None` when they are stale. Newton evaluates the
@@ -117,6 +116,12 @@ impl Workspace {
     fn invalidate(&mut self) {
         self.sampled = None;
         self.along.start = None;
+    }
+
+    /// The Gram matrices `(G(w_gap), G(w_force))` of law `l` (`len x len` each).
+    fn grams(&self, l: usize, len: usize) -> (&[f64], &[f64]) {
+        let range = l * len * len..(l + 1) * len * len;
+        (&self.gram_gap[range.clone()], &self.gram_force[range])
     }
 }
 
@@ -153,14 +158,20 @@ fn set_key(key: &mut Option<Vec<f64>>, v: &[f64]) {
 
 /// A bar system under harmonic balance at a variable fundamental frequency `Omega`.
 ///
-/// It implements [`ContinuationProblem`] with parameter `Omega`: residual, generalised
-/// Jacobian and `dF/dOmega`, all analytic.
+/// It is a [`Problem`] at its current frequency (residual and generalised Jacobian, analytic),
+/// a [`ContinuationProblem`] in `Omega` (set with
+/// [`ContinuationProblem::set_parameter`]; `dF/dOmega` analytic), and offers every
+/// [`Structured`] capability: the condensed Newton step, cheap line searches, smoothing,
+/// energy weights and active sets.
 ///
 /// # Panics
-/// The [`ContinuationProblem`] methods panic if `x` (or an output slice) does not have length
-/// [`NonsmoothSystem::dimension`]: a programmer contract, which the solvers and drivers check
-/// before calling them (they return [`SolveError::Dimension`](crate::SolveError::Dimension) /
-/// [`ContinuationError::Dimension`](crate::ContinuationError::Dimension) instead).
+/// The [`Problem`] and [`ContinuationProblem`] methods panic if `x` (or an output slice) does
+/// not have length [`NonsmoothSystem::dimension`]: a programmer contract, which the solvers
+/// and drivers check before calling them (they return
+/// [`SolveError::Dimension`](crate::SolveError::Dimension) /
+/// [`ContinuationError::Dimension`](crate::ContinuationError::Dimension) instead). Before the
+/// first [`ContinuationProblem::set_parameter`] the frequency is NaN and so is the residual
+/// (solvers report it as [`SolveError::NonFinite`](crate::SolveError::NonFinite)).
 #[derive(Debug, Clone)]
 pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     system: BarSystem,
@@ -187,33 +198,6 @@ pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     /// `G(1)`, the Gram matrix of the unit weight (see [`affine_relation`]).
     unit_gram: Vec<f64>,
     ws: Workspace,
-}
-
-/// Scratch of the structured Newton step: the reduced matrix, its LU and vectors.
-#[derive(Default)]
-struct Reduced {
-    /// LU of the transposed reduced matrix, assembled in its storage.
-    lu: Lu,
-    rhs: Vec<f64>,
-    gap_z: Vec<f64>,
-    force_z: Vec<f64>,
-    gap_p: Vec<f64>,
-    force_p: Vec<f64>,
-}
-
-impl Clone for Reduced {
-    /// Scratch space is not shared between clones: a clone starts empty.
-    fn clone(&self) -> Self {
-        Self::default()
-    }
-}
-
-impl std::fmt::Debug for Reduced {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Reduced")
-            .field("size", &self.rhs.len())
-            .finish_non_exhaustive()
-    }
 }
 
 impl NonsmoothSystem<CosineBasis> {
@@ -267,8 +251,8 @@ impl<B: Basis> NonsmoothSystem<B> {
             scratch: vec![0.0; n],
             d_samples: vec![0.0; n],
             projection: vec![0.0; len],
-            gram_gap: vec![0.0; len * len],
-            gram_force: vec![0.0; len * len],
+            gram_gap: vec![0.0; laws * len * len],
+            gram_force: vec![0.0; laws * len * len],
             sampled: None,
             along: LineSamples {
                 gap: vec![0.0; laws * n],
@@ -341,7 +325,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         i * self.unknowns + 2 * bar + which
     }
 
-    /// The per-harmonic rows at fundamental frequency `omega` (cached).
+    /// The per-harmonic rows at fundamental frequency `omega` (the problem moves to `omega`).
     pub fn rows_at(&mut self, omega: f64) -> &[HarmonicRows] {
         self.prepare(omega);
         &self.rows
@@ -485,27 +469,31 @@ impl<B: Basis> NonsmoothSystem<B> {
     }
 
     /// The Gram matrices `G(w_gap)` and `G(w_force)` of law `l` (after [`Self::sample_laws`]),
-    /// into the workspace: the two halves of the law's Jacobian block.
+    /// into the workspace ([`Workspace::grams`]): the two halves of the law's Jacobian block.
     ///
     /// When the force weight is an affine function of the gap weight (complementarity laws),
     /// `G(w_force)` is formed from `G(w_gap)` and `G(1)` instead of by a transform.
     fn law_grams(&self, ws: &mut Workspace, l: usize) {
-        let n = self.basis.folded_samples();
+        let (n, len) = (self.basis.folded_samples(), self.basis.len());
         let range = l * n..(l + 1) * n;
         let (w_gap, w_force) = (&ws.w_gap[range.clone()], &ws.w_force[range]);
-        self.basis.weighted_gram_folded(w_gap, &mut ws.gram_gap);
+        let grams = l * len * len..(l + 1) * len * len;
+        let gram_gap = &mut ws.gram_gap[grams.clone()];
+        let gram_force = &mut ws.gram_force[grams];
+        self.basis.weighted_gram_folded(w_gap, gram_gap);
         match affine_relation(w_gap, w_force) {
             Some((alpha, beta)) => {
-                let terms = self.unit_gram.iter().zip(&ws.gram_gap);
-                for (g, (u, w)) in ws.gram_force.iter_mut().zip(terms) {
+                let terms = self.unit_gram.iter().zip(gram_gap.iter());
+                for (g, (u, w)) in gram_force.iter_mut().zip(terms) {
                     *g = alpha * u + beta * w;
                 }
             }
-            None => self.basis.weighted_gram_folded(w_force, &mut ws.gram_force),
+            None => self.basis.weighted_gram_folded(w_force, gram_force),
         }
     }
 
-    /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid).
+    /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid); the
+    /// problem moves to `omega`.
     ///
     /// # Panics
     /// If `l` is not below the number of unilateral conditions or `x` has the wrong length
@@ -570,20 +558,119 @@ impl<B: Basis> NonsmoothSystem<B> {
     }
 }
 
-impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
+impl<B: Basis> Problem for NonsmoothSystem<B> {
     fn dimension(&self) -> usize {
         self.dimension()
     }
 
-    /// Samples `x` afresh even when a line-search trial left samples of the same point (they
-    /// differ from a synthesis in the last bits): the value depends on `x` alone, so clones
-    /// of the problem (speculative retries) report the same residuals.
-    fn residual(&mut self, x: &[f64], omega: f64, f: &mut [f64]) {
-        self.prepare(omega);
+    /// Samples `x` afresh: the value depends on `x` and `Omega` alone.
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
         self.linear_block(x, false, f);
         self.ws.sampled = None;
         self.sample_laws(x);
         self.project_laws(f);
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
+        jac.reset(self.dimension(), self.dimension());
+        for i in 0..len {
+            let rows = &self.rows[self.basis.harmonic(i)];
+            for r in 0..rpc {
+                for (c, &v) in rows.linear_row(r).iter().enumerate() {
+                    jac[(i * rpc + r, i * un + c)] = v;
+                }
+            }
+        }
+        self.sample_laws(x);
+        let base = len * rpc;
+        let mut ws = std::mem::take(&mut self.ws);
+        for l in 0..self.laws {
+            self.law_grams(&mut ws, l);
+            let (gram_gap, gram_force) = ws.grams(l, len);
+            // Column by column (the matrix is column-major): contiguous writes.
+            for i in 0..len {
+                let rows = &self.rows[self.basis.harmonic(i)];
+                let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
+                for c in 0..un {
+                    let (gc, fc) = (grow[c], frow[c]);
+                    for j in 0..len {
+                        let (gg, gf) = (gram_gap[j * len + i], gram_force[j * len + i]);
+                        if gg == 0.0 && gf == 0.0 {
+                            continue;
+                        }
+                        jac[(base + l * len + j, i * un + c)] = gg * gc + gf * fc;
+                    }
+                }
+            }
+        }
+        self.ws = ws;
+    }
+
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        Some(self)
+    }
+}
+
+impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
+    /// The fundamental frequency `Omega` (NaN before the first [`Self::set_parameter`]).
+    fn parameter(&self) -> f64 {
+        self.omega
+    }
+
+    /// Moves to fundamental frequency `omega`: the per-harmonic rows are rebuilt when it
+    /// changes.
+    fn set_parameter(&mut self, omega: f64) {
+        self.prepare(omega);
+    }
+
+    fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
+        self.linear_block(x, true, df);
+        self.sample_laws(x);
+        let (len, n) = (self.basis.len(), self.basis.folded_samples());
+        let base = len * self.linear_count;
+        let mut ws = std::mem::take(&mut self.ws);
+        for l in 0..self.laws {
+            let dg = &mut ws.d_samples;
+            self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
+            self.basis.synthesize_folded(&ws.coefficients, dg);
+            self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
+            self.basis
+                .synthesize_folded(&ws.coefficients, &mut ws.scratch);
+            let (w_gap, w_force) = (
+                &ws.w_gap[l * n..(l + 1) * n],
+                &ws.w_force[l * n..(l + 1) * n],
+            );
+            for (((s, d), wg), wf) in ws.scratch.iter_mut().zip(dg.iter()).zip(w_gap).zip(w_force) {
+                *s = wg * d + wf * *s;
+            }
+            self.basis.project_folded(&ws.scratch, &mut ws.projection);
+            df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
+        }
+        self.ws = ws;
+    }
+}
+
+impl<B: Basis> Structured for NonsmoothSystem<B> {
+    /// The largest gap of the unilateral laws: residual entries are gaps and forces of that
+    /// order.
+    fn residual_scale(&self) -> f64 {
+        self.offsets
+            .iter()
+            .map(|o| o.0.abs())
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE)
+    }
+
+    /// The Newton step with the linear rows condensed (formulation §5): only a dense LU of
+    /// size `len * n_contacts` is factorised, once for all right-hand sides.
+    fn solve_jacobian(
+        &mut self,
+        x: &[f64],
+        rhs: &mut [f64],
+        columns: usize,
+    ) -> Option<Result<(), SingularStep>> {
+        self.condensed_solve(x, rhs, columns)
     }
 
     /// Along a line search the observables are affine in `t`: the samples of `x` (kept from
@@ -594,11 +681,9 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         x: &[f64],
         dx: &[f64],
         t: f64,
-        omega: f64,
         trial: &mut [f64],
         f: &mut [f64],
-    ) {
-        self.prepare(omega);
+    ) -> bool {
         point_on_ray(x, dx, t, trial);
         let mut ws = std::mem::take(&mut self.ws);
         let same = |v: &Option<Vec<f64>>, w: &[f64]| v.as_deref() == Some(w);
@@ -653,82 +738,26 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         self.evaluate_laws(&mut ws, trial);
         self.ws = ws;
         self.project_laws(f);
+        true
     }
 
-    fn jacobian(&mut self, x: &[f64], omega: f64, jac: &mut DenseMatrix) {
-        self.prepare(omega);
-        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
-        jac.reset(self.dimension(), self.dimension());
-        for i in 0..len {
-            let rows = &self.rows[self.basis.harmonic(i)];
-            for r in 0..rpc {
-                for (c, &v) in rows.linear_row(r).iter().enumerate() {
-                    jac[(i * rpc + r, i * un + c)] = v;
-                }
-            }
-        }
-        self.sample_laws(x);
-        let base = len * rpc;
-        let mut ws = std::mem::take(&mut self.ws);
-        for l in 0..self.laws {
-            self.law_grams(&mut ws, l);
-            // Column by column (the matrix is column-major): contiguous writes.
-            for i in 0..len {
-                let rows = &self.rows[self.basis.harmonic(i)];
-                let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
-                for c in 0..un {
-                    let (gc, fc) = (grow[c], frow[c]);
-                    for j in 0..len {
-                        let (gg, gf) = (ws.gram_gap[j * len + i], ws.gram_force[j * len + i]);
-                        if gg == 0.0 && gf == 0.0 {
-                            continue;
-                        }
-                        jac[(base + l * len + j, i * un + c)] = gg * gc + gf * fc;
-                    }
-                }
-            }
-        }
-        self.ws = ws;
-    }
-
-    fn parameter_derivative(&mut self, x: &[f64], omega: f64, df: &mut [f64]) {
-        self.prepare(omega);
-        self.linear_block(x, true, df);
-        self.sample_laws(x);
-        let (len, n) = (self.basis.len(), self.basis.folded_samples());
-        let base = len * self.linear_count;
-        let mut ws = std::mem::take(&mut self.ws);
-        for l in 0..self.laws {
-            let dg = &mut ws.d_samples;
-            self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
-            self.basis.synthesize_folded(&ws.coefficients, dg);
-            self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
-            self.basis
-                .synthesize_folded(&ws.coefficients, &mut ws.scratch);
-            let (w_gap, w_force) = (
-                &ws.w_gap[l * n..(l + 1) * n],
-                &ws.w_force[l * n..(l + 1) * n],
-            );
-            for (((s, d), wg), wf) in ws.scratch.iter_mut().zip(dg.iter()).zip(w_gap).zip(w_force) {
-                *s = wg * d + wf * *s;
-            }
-            self.basis.project_folded(&ws.scratch, &mut ws.projection);
-            df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
-        }
-        self.ws = ws;
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.smoothing = smoothing.max(0.0);
+        self.ws.invalidate();
+        true
     }
 
     /// Energy weights: a harmonic `A cos(kx) + B sin(kx)/k` of bar `b` stores about
     /// `EA l (A^2 k^2 + B^2) / 4` of strain energy, so `w_A = EA l (k^2 + 1/l^2)` (the `1/l^2`
     /// keeps rigid displacements weighted) and `w_B = EA l`.
-    fn state_weights(&mut self, omega: f64) -> Option<Vec<f64>> {
+    fn state_weights(&mut self) -> Option<Vec<f64>> {
         let bars = self.system.bars();
         let mut w = Vec::with_capacity(self.dimension());
         for i in 0..self.basis.len() {
             let n = self.basis.harmonic(i) as f64;
             for bar in bars {
                 let (l, ea) = (bar.length(), bar.stiffness());
-                let k = bar.wavenumber(n * omega);
+                let k = bar.wavenumber(n * self.omega);
                 w.push(ea * l * (k * k + 1.0 / (l * l)));
                 w.push(ea * l);
             }
@@ -736,8 +765,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
         Some(w)
     }
 
-    fn active_set(&mut self, x: &[f64], omega: f64) -> Option<Vec<usize>> {
-        self.prepare(omega);
+    fn active_set(&mut self, x: &[f64]) -> Option<Vec<usize>> {
         self.sample_laws(x);
         let n = self.basis.folded_samples();
         Some(
@@ -752,148 +780,6 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
                 })
                 .collect(),
         )
-    }
-
-    fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.smoothing = smoothing.max(0.0);
-        self.ws.invalidate();
-        true
-    }
-
-    /// The Newton step with the linear rows condensed (formulation §5): per coefficient,
-    /// `dx_i = -L_i^+ F_lin,i + Z_i b_i`, where `Z_i` spans the null space of the harmonic's
-    /// linear rows; only the law block `(N Z) b = -F_law - N dx_p` is factorised, a dense LU of
-    /// size `len * n_contacts` instead of `len * 2 n_bars` (8 times cheaper for one bar, 64 for
-    /// two). Falls back to the dense path (`None`) where a harmonic's rows are rank-deficient.
-    fn newton_step(
-        &mut self,
-        x: &[f64],
-        omega: f64,
-        f: &[f64],
-        dx: &mut [f64],
-    ) -> Option<Result<(), SingularStep>> {
-        self.prepare(omega);
-        if self.condensed_state.is_none() {
-            self.condensed
-                .resize_with(self.rows.len(), Condensed::default);
-            let scratch = &mut self.condense_scratch;
-            let all = self
-                .rows
-                .iter()
-                .zip(self.condensed.iter_mut())
-                .fold(true, |ok, (rows, out)| {
-                    condense_into(rows, out, scratch) && ok
-                });
-            self.condensed_state = Some(all);
-        }
-        if self.condensed_state != Some(true) {
-            return None;
-        }
-        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
-        let c = un - rpc;
-        let base = len * rpc;
-        // Particular part from the linear rows.
-        for i in 0..len {
-            let cd = &self.condensed[self.basis.harmonic(i)];
-            let fi = &f[i * rpc..(i + 1) * rpc];
-            let dxi = &mut dx[i * un..(i + 1) * un];
-            dxi.fill(0.0);
-            for (r, fr) in fi.iter().enumerate() {
-                for (d, p) in dxi.iter_mut().zip(&cd.pinv[r * un..(r + 1) * un]) {
-                    *d -= p * fr;
-                }
-            }
-        }
-        self.sample_laws(x);
-        let size = len * c;
-        let mut red = std::mem::take(&mut self.reduced);
-        let mut ws = std::mem::take(&mut self.ws);
-        // Every entry of the transposed reduced matrix is written below, straight into the
-        // LU's storage (one column per law row).
-        let matrix = red.lu.storage(size);
-        red.rhs.clear();
-        red.rhs.resize(size, 0.0);
-        red.gap_z.resize(len * c, 0.0);
-        red.force_z.resize(len * c, 0.0);
-        red.gap_p.resize(len, 0.0);
-        red.force_p.resize(len, 0.0);
-        for l in 0..self.laws {
-            self.law_grams(&mut ws, l);
-            for i in 0..len {
-                let h = self.basis.harmonic(i);
-                let cd = &self.condensed[h];
-                let rows = &self.rows[h];
-                let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
-                let dxi = &dx[i * un..(i + 1) * un];
-                red.gap_p[i] = dot(grow, dxi);
-                red.force_p[i] = dot(frow, dxi);
-                for k in 0..c {
-                    let z = &cd.null[k * un..(k + 1) * un];
-                    red.gap_z[i * c + k] = dot(grow, z);
-                    red.force_z[i * c + k] = dot(frow, z);
-                }
-            }
-            for j in 0..len {
-                let row = l * len + j;
-                let (gg, gf) = (
-                    &ws.gram_gap[j * len..(j + 1) * len],
-                    &ws.gram_force[j * len..(j + 1) * len],
-                );
-                red.rhs[row] =
-                    -f[base + row] - dot_lanes(gg, &red.gap_p) - dot_lanes(gf, &red.force_p);
-            }
-            // The transpose is stored (column `l len + j` of the column-major storage is
-            // row `j` of the law's block): reads of the row-major Gram matrices and writes
-            // are both contiguous.
-            for j in 0..len {
-                let (gg, gf) = (
-                    &ws.gram_gap[j * len..(j + 1) * len],
-                    &ws.gram_force[j * len..(j + 1) * len],
-                );
-                let column = (l * len + j) * size;
-                let out = &mut matrix[column..column + size];
-                let zs = red.gap_z.iter().zip(&red.force_z);
-                if c == 1 {
-                    // One bar end per law (the common case): a plain vectorisable loop.
-                    for ((m, (gz, fz)), (g, f)) in out.iter_mut().zip(zs).zip(gg.iter().zip(gf)) {
-                        *m = g * gz + f * fz;
-                    }
-                } else {
-                    for (col, (m, (gz, fz))) in out.iter_mut().zip(zs).enumerate() {
-                        *m = gg[col / c] * gz + gf[col / c] * fz;
-                    }
-                }
-            }
-        }
-        self.ws = ws;
-        if let Err(p) = red.lu.factor_stored(REDUCED_PIVOT_TOLERANCE) {
-            self.reduced = red;
-            return Some(Err(SingularStep {
-                pivot: p.pivot,
-                ratio: p.ratio,
-            }));
-        }
-        red.lu.solve_transpose_in_place(&mut red.rhs);
-        for i in 0..len {
-            let cd = &self.condensed[self.basis.harmonic(i)];
-            let dxi = &mut dx[i * un..(i + 1) * un];
-            for k in 0..c {
-                let b = red.rhs[i * c + k];
-                for (d, z) in dxi.iter_mut().zip(&cd.null[k * un..(k + 1) * un]) {
-                    *d += b * z;
-                }
-            }
-        }
-        self.reduced = red;
-        Some(Ok(()))
-    }
-
-    fn residual_scale(&self) -> f64 {
-        self.offsets
-            .iter()
-            .map(|o| o.0.abs())
-            .fold(0.0, f64::max)
-            .max(f64::MIN_POSITIVE)
     }
 }
 
