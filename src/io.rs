@@ -16,21 +16,86 @@ pub const BACKBONE_CSV_HEADER: &str =
 pub fn write_backbone_csv(points: &[BackbonePoint], mut out: impl Write) -> io::Result<()> {
     writeln!(out, "{BACKBONE_CSV_HEADER}")?;
     for p in points {
-        let events: Vec<&str> = p.events.iter().map(Event::label).collect();
-        writeln!(
-            out,
-            "{},{:.12},{:.12},{:.12e},{:.12e},{},{:.4e},{},{:.6e},{}",
-            p.step,
-            p.period,
-            p.omega,
-            p.energy,
-            p.energy_normalized,
-            p.converged,
-            p.residual_norm,
-            p.iterations,
-            p.step_size,
-            events.join(";")
-        )?;
+        write_point_cells(p, &mut out)?;
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+/// The cells of [`BACKBONE_CSV_HEADER`] for one point, without the line end.
+fn write_point_cells(p: &BackbonePoint, mut out: impl Write) -> io::Result<()> {
+    let events: Vec<&str> = p.events.iter().map(Event::label).collect();
+    write!(
+        out,
+        "{},{:.12},{:.12},{:.12e},{:.12e},{},{:.4e},{},{:.6e},{}",
+        p.step,
+        p.period,
+        p.omega,
+        p.energy,
+        p.energy_normalized,
+        p.converged,
+        p.residual_norm,
+        p.iterations,
+        p.step_size,
+        events.join(";")
+    )
+}
+
+/// Header of [`write_branches_csv`]: `branch,harmonics`, the columns of
+/// [`BACKBONE_CSV_HEADER`], then `omega_ratio,exact_energy_normalized`.
+pub const BRANCHES_CSV_HEADER: &str = "branch,harmonics,step,period,omega,energy,\
+     energy_normalized,converged,residual_norm,iterations,step_size,event,omega_ratio,\
+     exact_energy_normalized";
+
+/// One branch of a table written by [`write_branches_csv`].
+#[derive(Clone, Copy)]
+pub struct LabelledBranch<'a> {
+    /// Name written in the `branch` column (a comma in it is written as `;`).
+    pub label: &'a str,
+    /// Number of harmonics `m` the branch was computed with (the `harmonics` column).
+    pub harmonics: usize,
+    /// The points, one row each.
+    pub points: &'a [BackbonePoint],
+    /// Exact `E / E_g` as a function of the period, for the `exact_energy_normalized` column
+    /// (left empty when `None`).
+    pub exact: Option<&'a dyn Fn(f64) -> f64>,
+}
+
+impl std::fmt::Debug for LabelledBranch<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LabelledBranch")
+            .field("label", &self.label)
+            .field("harmonics", &self.harmonics)
+            .field("points", &self.points.len())
+            .field("exact", &self.exact.is_some())
+            .finish()
+    }
+}
+
+/// Writes several labelled branches as one CSV table: [`BRANCHES_CSV_HEADER`], then one row
+/// per point, branch after branch: the branch label and its number of harmonics, the cells of
+/// [`write_backbone_csv`], `Omega / omega_1` and the exact `E / E_g` at the point's period
+/// (an empty cell for a branch without one).
+///
+/// # Errors
+/// Any I/O error of `out`.
+pub fn write_branches_csv(
+    branches: &[LabelledBranch<'_>],
+    omega_1: f64,
+    mut out: impl Write,
+) -> io::Result<()> {
+    writeln!(out, "{BRANCHES_CSV_HEADER}")?;
+    for b in branches {
+        let label = b.label.replace(',', ";");
+        for p in b.points {
+            write!(out, "{label},{},", b.harmonics)?;
+            write_point_cells(p, &mut out)?;
+            write!(out, ",{:.12},", p.omega / omega_1)?;
+            if let Some(exact) = b.exact {
+                write!(out, "{:.12e}", exact(p.period))?;
+            }
+            writeln!(out)?;
+        }
     }
     Ok(())
 }
@@ -101,6 +166,52 @@ mod tests {
         assert!(lines[1].ends_with(",fold"));
         let mut bad = Vec::new();
         assert!(write_columns_csv(&["a", "b"], &[&[1.0], &[1.0, 2.0]], &mut bad).is_err());
+    }
+
+    #[test]
+    fn branches_csv_labels_rows_and_leaves_missing_exact_values_empty() {
+        let points = [point(), point()];
+        let exact = |t: f64| 2.0 * t;
+        let branches = [
+            LabelledBranch {
+                label: "NSM1, m = 20",
+                harmonics: 20,
+                points: &points,
+                exact: Some(&exact),
+            },
+            LabelledBranch {
+                label: "NSM2",
+                harmonics: 40,
+                points: &points[..1],
+                exact: None,
+            },
+        ];
+        let mut out = Vec::new();
+        write_branches_csv(&branches, 0.5, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4);
+        assert_eq!(lines[0], BRANCHES_CSV_HEADER);
+        assert!(BRANCHES_CSV_HEADER.contains(BACKBONE_CSV_HEADER));
+        let header: Vec<&str> = lines[0].split(',').collect();
+        let mut single = Vec::new();
+        write_backbone_csv(&points[..1], &mut single).unwrap();
+        let single = String::from_utf8(single).unwrap();
+        let backbone_row = single.lines().nth(1).unwrap();
+        for line in &lines[1..] {
+            let cells: Vec<&str> = line.split(',').collect();
+            assert_eq!(cells.len(), header.len());
+            assert_eq!(cells[2..12].join(","), backbone_row);
+        }
+        let cells: Vec<&str> = lines[1].split(',').collect();
+        assert_eq!(cells[..2], ["NSM1; m = 20", "20"]);
+        let ratio: f64 = cells[12].parse().unwrap();
+        assert!((ratio - point().omega / 0.5).abs() < 1e-11);
+        assert_eq!(cells[13].parse::<f64>().unwrap(), 7.0);
+        let cells: Vec<&str> = lines[3].split(',').collect();
+        assert_eq!(cells[..2], ["NSM2", "40"]);
+        assert_eq!(cells[13], "");
+        assert!(format!("{:?}", branches[0]).contains("points: 2"));
     }
 
     #[cfg(feature = "serde")]

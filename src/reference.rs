@@ -177,7 +177,116 @@ impl ClampedFirstMode {
     }
 }
 
+/// The `i`-th exact family of nonsmooth modes of the clamped bar against an obstacle at gap
+/// `g0 > 0` (the paper's exact solutions; family 1 is [`ClampedFirstMode`]): it exists for
+/// periods `T in ((2i + 1)/i^2, 4/(2i - 1))`, where its energy is
+/// `E = g0^2 / (2 (i^2 T - 2i - 1)^2)` and, with the grazing energy
+/// `E_g = pi^2 g0^2 / 16` ([`clamped_grazing_energy`]),
+/// `E / E_g = 8 / (pi^2 (i^2 T - 2i - 1)^2)`.
+///
+/// Its `k`-th subharmonic branch (period `k T`, frequency `Omega / k`) has the same energy at
+/// the same motion: evaluate the family at `T / k`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClampedFamily {
+    /// Gap at rest `g0`.
+    pub gap: f64,
+    /// Family index `i >= 1`.
+    pub index: usize,
+}
+
+impl ClampedFamily {
+    /// Family `index` for the gap `gap`.
+    ///
+    /// # Panics
+    /// If `index` is 0.
+    pub fn new(gap: f64, index: usize) -> Self {
+        assert!(index >= 1, "exact families are numbered from 1");
+        Self { gap, index }
+    }
+
+    /// `i^2 T - 2i - 1`, the factor the energy is built on.
+    fn factor(&self, period: f64) -> f64 {
+        let i = self.index as f64;
+        i * i * period - 2.0 * i - 1.0
+    }
+
+    /// Open interval of periods `((2i + 1)/i^2, 4/(2i - 1))` on which the family exists.
+    pub fn periods(&self) -> (f64, f64) {
+        let i = self.index as f64;
+        ((2.0 * i + 1.0) / (i * i), 4.0 / (2.0 * i - 1.0))
+    }
+
+    /// Energy `g0^2 / (2 (i^2 T - 2i - 1)^2)` at period `T`.
+    pub fn energy(&self, period: f64) -> f64 {
+        self.gap * self.gap / (2.0 * self.factor(period).powi(2))
+    }
+
+    /// `E / E_g = 8 / (pi^2 (i^2 T - 2i - 1)^2)` at period `T` (independent of `g0`).
+    pub fn energy_normalized(&self, period: f64) -> f64 {
+        8.0 / (PI * PI * self.factor(period).powi(2))
+    }
+
+    /// The exact backbone `(Omega / omega_1, E / E_g)` on `points` periods spaced evenly from
+    /// `from` to `to` (both included, in that order; one point at `from` if `points` is 1),
+    /// with `omega_1 = pi / 2` the first natural frequency of the clamped-free unit bar, so
+    /// that `Omega / omega_1 = 4 / T`.
+    pub fn backbone(&self, from: f64, to: f64, points: usize) -> Vec<(f64, f64)> {
+        let last = points.saturating_sub(1).max(1) as f64;
+        (0..points)
+            .map(|k| {
+                let t = from + (to - from) * k as f64 / last;
+                (4.0 / t, self.energy_normalized(t))
+            })
+            .collect()
+    }
+}
+
 /// `t` brought into `[-T/2, T/2)`.
 fn wrap(t: f64, period: f64) -> f64 {
     (t + 0.5 * period).rem_euclid(period) - 0.5 * period
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn family_one_is_the_first_mode() {
+        let (gap, family) = (1e-3, ClampedFamily::new(1e-3, 1));
+        assert_eq!(family.periods(), (3.0, 4.0));
+        for period in [3.04, 3.2, 3.5, 3.55, 3.9, 3.99] {
+            let first = ClampedFirstMode::new(gap, period);
+            assert_eq!(family.energy_normalized(period), first.energy_normalized());
+            assert!((family.energy(period) / first.energy() - 1.0).abs() < 1e-14);
+            let ratio = family.energy(period) / clamped_grazing_energy(gap);
+            assert!((ratio / family.energy_normalized(period) - 1.0).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn higher_families_and_their_backbones() {
+        let family = ClampedFamily::new(1e-3, 2);
+        let (lo, hi) = family.periods();
+        assert!((lo - 1.25).abs() < 1e-15 && (hi - 4.0 / 3.0).abs() < 1e-15);
+        // At the upper end i^2 T - 2i - 1 = 1/(2i - 1): E/E_g = 8 (2i - 1)^2 / pi^2.
+        let at_hi = 8.0 * 9.0 / (PI * PI);
+        assert!((family.energy_normalized(hi) / at_hi - 1.0).abs() < 1e-12);
+        assert!((family.energy(hi) / (9.0 * 1e-6 / 2.0) - 1.0).abs() < 1e-12);
+        let curve = family.backbone(1.26, 1.33, 8);
+        assert_eq!(curve.len(), 8);
+        assert_eq!(curve[0], (4.0 / 1.26, family.energy_normalized(1.26)));
+        assert!((curve[7].0 - 4.0 / 1.33).abs() < 1e-12);
+        // The energy grows as the period shrinks towards (2i + 1)/i^2.
+        assert!(curve.windows(2).all(|w| w[1].1 < w[0].1));
+        assert_eq!(
+            family.backbone(1.3, 1.2, 1),
+            vec![(4.0 / 1.3, family.energy_normalized(1.3))]
+        );
+    }
+
+    #[test]
+    #[should_panic(expected = "numbered from 1")]
+    fn family_zero_is_rejected() {
+        let _ = ClampedFamily::new(1e-3, 0);
+    }
 }

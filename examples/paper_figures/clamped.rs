@@ -1,0 +1,234 @@
+//! Figs. 7-9: backbones of the clamped bar against the exact families, sequential against
+//! arclength continuation, and the internally resonant solutions of the first mode.
+
+use crate::common::{marked, settings};
+use crate::common::{
+    omega_1, pick, point_map, reference_line, run, series, Branch, Ctx, Exact, Res, Run, Stats,
+    BLUE, GAP, GREEN, RED, YELLOW,
+};
+use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, StallEscape};
+use nonsmooth_modes::modal::{arclength_backbone, ArclengthBackboneOptions, BackbonePoint};
+use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::BarSystem;
+use std::f64::consts::PI;
+use std::ops::ControlFlow;
+
+/// The exact first mode `(Omega/omega_1, E/E_g)` for `T` from 3.99 down to 3.04.
+fn first_mode_curve() -> Vec<(f64, f64)> {
+    ClampedFamily::new(GAP, 1).backbone(3.99, 3.04, 201)
+}
+
+/// The first nonsmooth mode from `T = 3.95` down to 3.05 with `m` harmonics, labelled `label`.
+fn nsm1(ctx: &Ctx, system: &BarSystem, label: &str, m: usize) -> Res<Run> {
+    let branch = Branch::new(label, 1, (3.95, 3.05), ctx.steps(181));
+    Ok(run(system, m, &branch)?.with_exact(Exact::new(1, 1)))
+}
+
+/// Fig. 7: clamped-bar backbones (NSM1, NSM2, NSM2 sub2) with m = 20 and three fields.
+pub fn fig07(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let system = clamped_bar_with_obstacle(GAP)?;
+    let w1 = omega_1(&system)?;
+    let m = 20;
+    let nsm2 = Branch::new("NSM2", 2, (1.3317, 1.2525), ctx.steps(81));
+    let sub2 = Branch::new("NSM2 sub2", 2, (2.6633, 2.505), ctx.steps(81)).subharmonic(2);
+    let runs = [
+        nsm1(ctx, &system, "NSM1", m)?,
+        run(&system, m, &nsm2)?.with_exact(Exact::new(2, 1)),
+        run(&system, m, &sub2)?.with_exact(Exact::new(2, 2)),
+    ];
+    stats.count(&runs);
+    let branches: Vec<Series> = runs
+        .iter()
+        .zip([GREEN, RED, YELLOW])
+        .map(|(r, c)| series(r, w1, c, Marker::Circle))
+        .collect();
+    let mut bb = backbone_panel("backbones, m = 20", &branches, Some(&first_mode_curve()));
+    let exact_nsm2 = ClampedFamily::new(GAP, 2).backbone(1.2525, 1.3330, 101);
+    let exact_sub2: Vec<(f64, f64)> = exact_nsm2.iter().map(|&(w, e)| (w / 2.0, e)).collect();
+    bb.series
+        .push(reference_line("exact NSM2, NSM2 sub2", exact_nsm2));
+    bb.series.push(reference_line("", exact_sub2));
+    bb.legend = LegendPosition::UpperRight;
+    let basis = settings(m).cosine_basis()?;
+    let picks = [
+        ("a", pick(&runs[0], 3.6, 0.05)),
+        ("c", pick(&runs[1], 1.29, 0.05)),
+        ("d", pick(&runs[2], 2.58, 0.05)),
+    ];
+    let mut panels = Vec::new();
+    let mut marks = Vec::new();
+    for ((name, p), r) in picks.into_iter().zip(&runs) {
+        if let Some(p) = p {
+            marks.push(p);
+            let title = format!(
+                "point {name}: {}, T = {:.3}, E/Eg = {:.2}",
+                r.label, p.period, p.energy_normalized
+            );
+            panels.push(point_map(&system, &basis, p, 60, title)?);
+        }
+    }
+    let all = marked(bb, "points a, c, d", &marks, w1, panels);
+    let refs: Vec<&Run> = runs.iter().collect();
+    ctx.backbone_figure(
+        &mut stats,
+        "fig07_clamped_backbones",
+        &Figure::new("Fig. 7: Dirichlet-Signorini bar, m = 20", 2, all),
+        &refs,
+        w1,
+    )?;
+    Ok(stats)
+}
+
+/// The first nonsmooth mode by arclength continuation from `T = 3.95` with `m` harmonics.
+fn arclength_nsm1(ctx: &Ctx, system: &BarSystem, m: usize, w1: f64) -> Res<Run> {
+    let mut points = Vec::new();
+    let options = ArclengthBackboneOptions {
+        start_period: 3.95,
+        omega_range: (2.0 * PI / 3.96, 2.0 * PI / 3.05),
+        arclength: ArclengthOptions {
+            max_steps: if ctx.quick { 150 } else { 2000 },
+            escape: Some(StallEscape::default()),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let (_, branch) = arclength_backbone(
+        system,
+        settings(m),
+        &options,
+        SemismoothNewton::default(),
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )?;
+    let reached = points
+        .iter()
+        .map(|p| p.omega / w1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!(
+        "    arclength m = {m}: {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
+        points.len(),
+        branch.rejections,
+        branch.end.as_ref().map(|e| match e {
+            EndReason::ParameterOutOfRange { .. } => "range".to_string(),
+            other => format!("{other:?}"),
+        })
+    );
+    Ok(Run {
+        label: format!("arclength m={m}"),
+        m,
+        points,
+        exact: Some(Exact::new(1, 1)),
+    })
+}
+
+/// Fig. 8: first NSM by sequential and arclength continuation, m = 20 and 40.
+pub fn fig08(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let system = clamped_bar_with_obstacle(GAP)?;
+    let w1 = omega_1(&system)?;
+    let mut panels = Vec::new();
+    let mut runs = Vec::new();
+    let exact = first_mode_curve();
+    for m in [20usize, 40] {
+        let seq = nsm1(ctx, &system, "sequential", m)?;
+        let arc = arclength_nsm1(ctx, &system, m, w1)?;
+        stats.count([&seq, &arc]);
+        let arc_line: Vec<(f64, f64)> = arc
+            .points
+            .iter()
+            .map(|p| (p.omega / w1, p.energy_normalized))
+            .collect();
+        let branches = [
+            series(&seq, w1, GREEN, Marker::Circle),
+            Series::line("arclength", arc_line)
+                .with_color(BLUE)
+                .with_marker(Marker::Circle)
+                .with_size(1),
+        ];
+        let mut p = backbone_panel(format!("NSM1, m = {m}"), &branches, Some(&exact));
+        p.y_range = Some((0.5, 400.0));
+        panels.push(Panel::Lines(p));
+        runs.push(Run {
+            label: format!("sequential m={m}"),
+            ..seq
+        });
+        runs.push(arc);
+    }
+    let refs: Vec<&Run> = runs.iter().collect();
+    ctx.backbone_figure(
+        &mut stats,
+        "fig08_sequential_arclength",
+        &Figure::new("Fig. 8: first NSM, sequential vs arclength", 2, panels),
+        &refs,
+        w1,
+    )?;
+    Ok(stats)
+}
+
+/// Spikes of `run`: converged points above the exact curve by more than 15%, local maxima of
+/// the ratio, at least 0.04 apart in T; the three largest, by decreasing period.
+fn spikes(run: &Run, exact: Exact) -> Vec<&BackbonePoint> {
+    let ratio = |p: &BackbonePoint| p.energy_normalized / exact.at(p.period);
+    let mut spikes: Vec<&BackbonePoint> = Vec::new();
+    let mut candidates: Vec<&BackbonePoint> = run.converged().filter(|p| ratio(p) > 1.15).collect();
+    candidates.sort_by(|a, b| ratio(b).total_cmp(&ratio(a)));
+    for c in candidates {
+        if spikes.iter().all(|s| (s.period - c.period).abs() > 0.04) {
+            spikes.push(c);
+        }
+        if spikes.len() == 3 {
+            break;
+        }
+    }
+    spikes.sort_by(|a, b| b.period.total_cmp(&a.period));
+    spikes
+}
+
+/// Fig. 9: internally resonant solutions of the first NSM with m = 40 (points on spikes).
+pub fn fig09(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let system = clamped_bar_with_obstacle(GAP)?;
+    let w1 = omega_1(&system)?;
+    let m = 40;
+    let r = nsm1(ctx, &system, "NSM1", m)?;
+    stats.count([&r]);
+    let exact = Exact::new(1, 1);
+    let ratio = |p: &BackbonePoint| p.energy_normalized / exact.at(p.period);
+    let spikes = spikes(&r, exact);
+    let basis = settings(m).cosine_basis()?;
+    let bb = backbone_panel(
+        "NSM1, m = 40",
+        &[series(&r, w1, GREEN, Marker::Circle)],
+        Some(&first_mode_curve()),
+    );
+    let mut panels = Vec::new();
+    let mut notes = Vec::new();
+    for (p, name) in spikes.iter().zip(["a", "b", "c"]) {
+        notes.push(format!("{name}: T={:.3} x{:.2}", p.period, ratio(p)));
+        let title = format!(
+            "({name}) T = {:.3}, Omega/omega_1 = {:.3}, E/E_exact = {:.2}",
+            p.period,
+            p.omega / w1,
+            ratio(p)
+        );
+        panels.push(point_map(&system, &basis, p, 80, title)?);
+    }
+    stats.note = notes.join("; ");
+    ctx.backbone_figure(
+        &mut stats,
+        "fig09_internal_resonances",
+        &Figure::new(
+            "Fig. 9: internally resonant NSM1 solutions, m = 40",
+            2,
+            marked(bb, "resonant points", &spikes, w1, panels),
+        ),
+        &[&r],
+        w1,
+    )?;
+    Ok(stats)
+}

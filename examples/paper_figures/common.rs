@@ -1,0 +1,427 @@
+//! What every figure group uses: the run context and its output files, the harmonic-balance
+//! settings, backbone runs, point selection and the panels built from points.
+
+use nonsmooth_modes::fourier::CosineBasis;
+use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
+use nonsmooth_modes::modal::diagnostics::EndHistory;
+use nonsmooth_modes::modal::{
+    backbone, displacement_grid, end_history, grazing_energy, BackboneOptions, BackbonePoint,
+    PeriodGrid,
+};
+use nonsmooth_modes::plot::{
+    render_svg, space_time_panel, Figure, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
+    SpaceTimeField, PALETTE,
+};
+use nonsmooth_modes::reference::ClampedFamily;
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::{BarSystem, HarmonicBalance};
+use std::io::Write as _;
+use std::path::PathBuf;
+
+/// Result of a figure: any error ends that figure only.
+pub type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Gap at rest `g0` of every system.
+pub const GAP: f64 = 1e-3;
+/// Colour of the first branch.
+pub const GREEN: Rgb = PALETTE[0];
+/// Colour of the second branch.
+pub const RED: Rgb = PALETTE[1];
+/// Colour of the third branch.
+pub const YELLOW: Rgb = PALETTE[2];
+/// Colour of the fourth branch.
+pub const BLUE: Rgb = PALETTE[3];
+
+/// What one figure produced.
+#[derive(Default)]
+pub struct Stats {
+    /// Points computed.
+    pub points: usize,
+    /// Points converged.
+    pub converged: usize,
+    /// Files written, in order.
+    pub files: Vec<String>,
+    /// A one-line remark for the progress line.
+    pub note: String,
+}
+
+impl Stats {
+    /// Counts the points of `runs`.
+    pub fn count<'a>(&mut self, runs: impl IntoIterator<Item = &'a Run>) {
+        for run in runs {
+            self.points += run.points.len();
+            self.converged += run.points.iter().filter(|p| p.converged).count();
+        }
+    }
+}
+
+/// Output folder and run mode, shared by all figures.
+pub struct Ctx {
+    /// Folder receiving the files.
+    pub out: PathBuf,
+    /// Coarser grids and fewer harmonics.
+    pub quick: bool,
+}
+
+impl Ctx {
+    fn path(&self, name: &str) -> PathBuf {
+        self.out.join(name)
+    }
+
+    /// Steps of a period grid: `full` normally, about a third in quick mode.
+    pub fn steps(&self, full: usize) -> usize {
+        if self.quick {
+            (full / 3).max(8)
+        } else {
+            full
+        }
+    }
+
+    /// Writes the SVG `name`.
+    pub fn svg(&self, stats: &mut Stats, name: &str, figure: &Figure) -> Res<()> {
+        render_svg(self.path(name), figure)?;
+        stats.files.push(name.to_string());
+        Ok(())
+    }
+
+    /// Writes `stem.svg` and `stem.csv` (the backbone table of `runs`), the files of a
+    /// backbone figure.
+    pub fn backbone_figure(
+        &self,
+        stats: &mut Stats,
+        stem: &str,
+        figure: &Figure,
+        runs: &[&Run],
+        omega_1: f64,
+    ) -> Res<()> {
+        self.svg(stats, &format!("{stem}.svg"), figure)?;
+        self.branches(stats, &format!("{stem}.csv"), runs, omega_1)
+    }
+
+    /// Writes the backbone table of `runs` (with the exact energies of the runs that have
+    /// one) as the CSV `name`.
+    fn branches(&self, stats: &mut Stats, name: &str, runs: &[&Run], omega_1: f64) -> Res<()> {
+        let exact: Vec<_> = runs
+            .iter()
+            .map(|r| r.exact.map(|e| move |t: f64| e.at(t)))
+            .collect();
+        let branches: Vec<LabelledBranch<'_>> = runs
+            .iter()
+            .zip(&exact)
+            .map(|(r, e)| LabelledBranch {
+                label: &r.label,
+                harmonics: r.m,
+                points: &r.points,
+                exact: e.as_ref().map(|f| f as &dyn Fn(f64) -> f64),
+            })
+            .collect();
+        self.write(stats, name, |w| write_branches_csv(&branches, omega_1, w))
+    }
+
+    /// Writes named columns as the CSV `name`.
+    pub fn columns(
+        &self,
+        stats: &mut Stats,
+        name: &str,
+        names: &[&str],
+        cols: &[&[f64]],
+    ) -> Res<()> {
+        self.write(stats, name, |w| write_columns_csv(names, cols, w))
+    }
+
+    /// Writes `table` as the CSV `name`.
+    pub fn table(&self, stats: &mut Stats, name: &str, table: &Table) -> Res<()> {
+        let names: Vec<&str> = table.names.iter().map(|s| s.as_str()).collect();
+        let cols: Vec<&[f64]> = table.columns.iter().map(|c| c.as_slice()).collect();
+        self.columns(stats, name, &names, &cols)
+    }
+
+    fn write(
+        &self,
+        stats: &mut Stats,
+        name: &str,
+        body: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+    ) -> Res<()> {
+        let f = std::fs::File::create(self.path(name))?;
+        let mut w = std::io::BufWriter::new(f);
+        body(&mut w)?;
+        w.flush()?;
+        stats.files.push(name.to_string());
+        Ok(())
+    }
+}
+
+/// Named columns gathered while a figure is computed.
+#[derive(Default)]
+pub struct Table {
+    names: Vec<String>,
+    columns: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// Appends a column.
+    pub fn push(&mut self, name: impl Into<String>, column: Vec<f64>) {
+        self.names.push(name.into());
+        self.columns.push(column);
+    }
+
+    /// Puts a column first.
+    pub fn push_front(&mut self, name: impl Into<String>, column: Vec<f64>) {
+        self.names.insert(0, name.into());
+        self.columns.insert(0, column);
+    }
+}
+
+/// Harmonic-balance settings with `m` harmonics, 30 samples per harmonic, `a_c = 4`.
+pub fn settings(m: usize) -> HarmonicBalance {
+    HarmonicBalance {
+        harmonics: m,
+        samples_per_harmonic: 30,
+        penalty: 4.0,
+        ..Default::default()
+    }
+}
+
+/// First open-contact natural frequency (the one the grazing energy is built on).
+pub fn omega_1(system: &BarSystem) -> Res<f64> {
+    Ok(grazing_energy(system)?.1.omega)
+}
+
+/// Exact `E/E_g` of a clamped-bar branch: an exact family, on its `subharmonic`-th branch.
+#[derive(Clone, Copy)]
+pub struct Exact {
+    family: ClampedFamily,
+    subharmonic: f64,
+}
+
+impl Exact {
+    /// Family `index` of the clamped bar, followed on its `subharmonic`-th branch.
+    pub fn new(index: usize, subharmonic: usize) -> Self {
+        Self {
+            family: ClampedFamily::new(GAP, index),
+            subharmonic: subharmonic as f64,
+        }
+    }
+
+    /// `E/E_g` at the branch's period `period`.
+    pub fn at(&self, period: f64) -> f64 {
+        self.family.energy_normalized(period / self.subharmonic)
+    }
+}
+
+/// A backbone computed by sequential continuation in the period.
+pub struct Run {
+    /// Branch name (legend and CSV).
+    pub label: String,
+    /// Number of harmonics.
+    pub m: usize,
+    /// All points, converged or not.
+    pub points: Vec<BackbonePoint>,
+    /// The exact branch it approximates, when known.
+    pub exact: Option<Exact>,
+}
+
+impl Run {
+    /// The run with the exact branch `exact`.
+    pub fn with_exact(self, exact: Exact) -> Self {
+        Self {
+            exact: Some(exact),
+            ..self
+        }
+    }
+
+    /// Its converged points.
+    pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
+        self.points.iter().filter(|p| p.converged)
+    }
+}
+
+/// What to continue: mode and subharmonic of the seed, and the period grid.
+pub struct Branch<'a> {
+    /// Branch name.
+    pub label: &'a str,
+    /// Open-contact mode the branch starts from (1-based).
+    pub mode: usize,
+    /// Subharmonic order.
+    pub subharmonic: usize,
+    /// First and last period.
+    pub periods: (f64, f64),
+    /// Steps of the period grid.
+    pub steps: usize,
+}
+
+impl<'a> Branch<'a> {
+    /// The branch of `mode` (subharmonic 1) over `periods` in `steps` steps.
+    pub fn new(label: &'a str, mode: usize, periods: (f64, f64), steps: usize) -> Self {
+        Self {
+            label,
+            mode,
+            subharmonic: 1,
+            periods,
+            steps,
+        }
+    }
+
+    /// The same branch on subharmonic `order`.
+    pub fn subharmonic(self, order: usize) -> Self {
+        Self {
+            subharmonic: order,
+            ..self
+        }
+    }
+}
+
+/// Follows `branch` of `system` with `m` harmonics, visiting the whole grid.
+pub fn run(system: &BarSystem, m: usize, branch: &Branch<'_>) -> Res<Run> {
+    let (start, end) = branch.periods;
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start,
+            end,
+            steps: branch.steps,
+        },
+        mode: branch.mode,
+        subharmonic: branch.subharmonic,
+        // Visit the whole grid: failed stretches (near resonances) are reported, not fatal.
+        max_consecutive_failures: usize::MAX,
+        ..Default::default()
+    };
+    let points = backbone(system, settings(m), &options, SemismoothNewton::default())?;
+    let ok = points.iter().filter(|p| p.converged).count();
+    println!(
+        "    {:<28} m = {m:<3} T {start:.4} -> {end:.4}: {ok}/{} converged",
+        branch.label,
+        points.len()
+    );
+    Ok(Run {
+        label: branch.label.to_string(),
+        m,
+        points,
+        exact: None,
+    })
+}
+
+/// The converged points of `run` as `(Omega/omega_1, E/E_g)` markers.
+pub fn series(run: &Run, omega_1: f64, color: Rgb, marker: Marker) -> Series {
+    let pts = run
+        .converged()
+        .map(|p| (p.omega / omega_1, p.energy_normalized))
+        .collect();
+    Series::markers(run.label.clone(), pts)
+        .with_color(color)
+        .with_marker(marker)
+}
+
+/// A thin dashed black line: a reference curve.
+pub fn reference_line(label: &str, points: Vec<(f64, f64)>) -> Series {
+    Series::line(label, points)
+        .with_color(Rgb::BLACK)
+        .dashed()
+        .with_size(1)
+}
+
+/// History of the right end (`x = l`) of bar `bar` over one period.
+pub fn right_end(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    p: &BackbonePoint,
+    bar: usize,
+    samples: usize,
+) -> Res<EndHistory> {
+    let end = system
+        .bar_id(bar)
+        .ok_or_else(|| format!("no bar {bar}"))?
+        .right();
+    Ok(end_history(system, basis, &p.x, p.omega, end, samples))
+}
+
+/// `v / g0` for every value.
+pub fn over_gap(values: &[f64]) -> Vec<f64> {
+    values.iter().map(|v| v / GAP).collect()
+}
+
+/// `u(x, t)` of bar `bar` on 41 positions and `instants` instants over the period of `p`.
+pub fn field(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    p: &BackbonePoint,
+    bar: usize,
+    instants: usize,
+) -> SpaceTimeField {
+    let g = displacement_grid(system, basis, &p.x, p.omega, bar, 41, instants);
+    SpaceTimeField {
+        position: g.position,
+        time: g.time,
+        values: g.displacement,
+    }
+}
+
+/// The converged point whose period is closest to `target`, preferring points whose energy
+/// is within `tolerance` of the run's exact branch if it has one (low-energy, non-resonant
+/// solutions).
+pub fn pick(run: &Run, target: f64, tolerance: f64) -> Option<&BackbonePoint> {
+    let near_exact = |p: &&BackbonePoint| {
+        run.exact
+            .is_none_or(|e| (p.energy_normalized / e.at(p.period) - 1.0).abs() < tolerance)
+    };
+    let by_distance = |a: &&BackbonePoint, b: &&BackbonePoint| {
+        (a.period - target)
+            .abs()
+            .total_cmp(&(b.period - target).abs())
+    };
+    run.converged()
+        .filter(near_exact)
+        .min_by(by_distance)
+        .or_else(|| run.converged().min_by(by_distance))
+}
+
+/// The backbone panel `bb` with `points` marked (black rings, one legend entry `label`),
+/// followed by `panels`.
+pub fn marked(
+    mut bb: LinePanel,
+    label: &str,
+    points: &[&BackbonePoint],
+    omega_1: f64,
+    panels: Vec<Panel>,
+) -> Vec<Panel> {
+    let p: Vec<(f64, f64)> = points
+        .iter()
+        .map(|p| (p.omega / omega_1, p.energy_normalized))
+        .collect();
+    bb.series.push(
+        Series::markers(label, p)
+            .with_color(Rgb::BLACK)
+            .with_marker(Marker::Ring)
+            .with_size(7),
+    );
+    let mut all = vec![Panel::Lines(bb)];
+    all.extend(panels);
+    all
+}
+
+/// Space-time map of `f` in units of `g0`.
+pub fn map_panel(title: String, f: &SpaceTimeField) -> Res<Panel> {
+    let mut p: MapPanel = space_time_panel(title, f, "u / g0")?;
+    p.values.iter_mut().for_each(|v| *v /= GAP);
+    Ok(p.into())
+}
+
+/// Map panel of bar 1 of `system` at `p` on `instants` instants.
+pub fn point_map(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    p: &BackbonePoint,
+    instants: usize,
+    title: String,
+) -> Res<Panel> {
+    map_panel(title, &field(system, basis, p, 0, instants))
+}
+
+/// `Omega/omega_1 = ..., E/Eg = ...` of a point.
+pub fn frequency_energy(p: &BackbonePoint, omega_1: f64) -> String {
+    format!(
+        "Omega/omega_1 = {:.3}, E/Eg = {:.2}",
+        p.omega / omega_1,
+        p.energy_normalized
+    )
+}

@@ -1,0 +1,240 @@
+//! Figs. 10-13: the Robin-Signorini bar (ground spring `k_s = 0.5`): first mode and its
+//! fields, second mode, and the third subharmonic of the second mode.
+
+use crate::common::{
+    field, frequency_energy, map_panel, marked, omega_1, pick, point_map, run, series, settings,
+    Branch, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+};
+use nonsmooth_modes::modal::{law_history, BackbonePoint};
+use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker};
+use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
+use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
+use std::f64::consts::PI;
+
+/// Ground spring stiffness `k_s` of the paper's Robin bar.
+const ROBIN_K: f64 = 0.5;
+
+/// Second natural frequency `omega_2` of the open-contact Robin bar.
+const OMEGA_2: f64 = ROBIN_FREE_FREQUENCIES[1];
+
+/// Figs. 10 and 11: Robin bar NSM1 backbones (m = 20, 40) and three fields (m = 40).
+pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
+    let (mut s10, mut s11) = (Stats::default(), Stats::default());
+    let system = robin_bar_with_obstacle(ROBIN_K, GAP)?;
+    let w1 = omega_1(&system)?;
+    let nsm1 = |m: usize| {
+        let label = format!("NSM1 m = {m}");
+        run(
+            &system,
+            m,
+            &Branch::new(&label, 1, (9.5, 6.0), ctx.steps(176)),
+        )
+    };
+    let (r20, r40) = (nsm1(20)?, nsm1(40)?);
+    s10.count([&r20, &r40]);
+    let mut bb = backbone_panel(
+        "Robin bar (k = 0.5): NSM1",
+        &[
+            series(&r20, w1, GREEN, Marker::Circle),
+            series(&r40, w1, BLUE, Marker::Triangle).with_size(2),
+        ],
+        None,
+    );
+    bb.x_guides = vec![OMEGA_2 / 4.0 / w1];
+    // Points a, b, c on the m = 40 branch: low energy, around omega_2/4, high energy.
+    let targets = [
+        (8.8, "a"),
+        (2.0 * PI / (OMEGA_2 / 4.0) * 0.985, "b"),
+        (6.6, "c"),
+    ];
+    let picks: Vec<(&str, &BackbonePoint)> = targets
+        .iter()
+        .filter_map(|&(t, n)| pick(&r40, t, 0.0).map(|p| (n, p)))
+        .collect();
+    bb.legend = LegendPosition::UpperLeft;
+    let marks: Vec<&BackbonePoint> = picks.iter().map(|(_, p)| *p).collect();
+    ctx.backbone_figure(
+        &mut s10,
+        "fig10_robin_nsm1",
+        &Figure::new(
+            "Fig. 10: NSM1 of the Robin-Signorini bar (dashed: omega_2/4)",
+            1,
+            marked(bb, "points a, b, c (m = 40)", &marks, w1, Vec::new()),
+        ),
+        &[&r20, &r40],
+        w1,
+    )?;
+
+    let basis = settings(40).cosine_basis()?;
+    let mut panels = Vec::new();
+    let (mut ct, mut cx, mut cu, mut cp) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (i, (name, p)) in picks.iter().enumerate() {
+        let f = field(&system, &basis, p, 0, 60);
+        s11.points += 1;
+        s11.converged += 1;
+        for (k, t) in f.time.iter().enumerate() {
+            for (j, x) in f.position.iter().enumerate() {
+                ct.push(*t);
+                cx.push(*x);
+                cu.push(f.values[k * f.position.len() + j]);
+                cp.push(i as f64);
+            }
+        }
+        panels.push(map_panel(
+            format!("point {name}: {}", frequency_energy(p, w1)),
+            &f,
+        )?);
+    }
+    ctx.svg(
+        &mut s11,
+        "fig11_robin_nsm1_fields.svg",
+        &Figure::new(
+            "Fig. 11: NSM1 of the Robin-Signorini bar, m = 40",
+            3,
+            panels,
+        ),
+    )?;
+    ctx.columns(
+        &mut s11,
+        "fig11_robin_nsm1_fields.csv",
+        &["point", "t", "x", "u"],
+        &[&cp, &ct, &cx, &cu],
+    )?;
+    Ok((s10, s11))
+}
+
+/// Fig. 12: Robin bar NSM2 backbone (m = 20) and two fields.
+pub fn fig12(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let system = robin_bar_with_obstacle(ROBIN_K, GAP)?;
+    let w1 = omega_1(&system)?;
+    let m = 20;
+    let r = run(
+        &system,
+        m,
+        &Branch::new("NSM2", 2, (1.90, 1.45), ctx.steps(91)),
+    )?;
+    stats.count([&r]);
+    let mut bb = backbone_panel(
+        "Robin bar: NSM2, m = 20",
+        &[series(&r, w1, RED, Marker::Circle)],
+        None,
+    );
+    let conv: Vec<&BackbonePoint> = r.converged().collect();
+    // e: low energy; d: the largest local excess over its neighbours (internal resonance).
+    let e = conv
+        .iter()
+        .find(|p| p.period < 1.86)
+        .or(conv.first())
+        .copied();
+    let d = conv
+        .windows(3)
+        .max_by(|a, b| {
+            let ex = |w: &[&BackbonePoint]| {
+                w[1].energy_normalized / (0.5 * (w[0].energy_normalized + w[2].energy_normalized))
+            };
+            ex(a).total_cmp(&ex(b))
+        })
+        .map(|w| w[1]);
+    let basis = settings(m).cosine_basis()?;
+    let mut panels = Vec::new();
+    let mut marks = Vec::new();
+    for (name, p) in [("e", e), ("d", d)] {
+        if let Some(p) = p {
+            marks.push(p);
+            let title = format!("point {name}: {}", frequency_energy(p, w1));
+            panels.push(point_map(&system, &basis, p, 60, title)?);
+        }
+    }
+    // The resonant point d sits at the top left, where the legend would hide it.
+    bb.legend = LegendPosition::LowerRight;
+    ctx.backbone_figure(
+        &mut stats,
+        "fig12_robin_nsm2",
+        &Figure::new(
+            "Fig. 12: NSM2 of the Robin-Signorini bar",
+            3,
+            marked(bb, "points e, d", &marks, w1, panels),
+        ),
+        &[&r],
+        w1,
+    )?;
+    Ok(stats)
+}
+
+/// Number of separate contact intervals per period (force above 2% of its maximum) and of
+/// near-grazings (gap minima below 5% of g0 without contact).
+fn contact_count(system: &BarSystem, m: usize, p: &BackbonePoint) -> Res<(usize, usize)> {
+    let problem = NonsmoothSystem::new(system, settings(m))?;
+    let h = law_history(&problem, &p.x, p.omega, 0, 1200)?;
+    let fmax = h.force.iter().cloned().fold(0.0, f64::max);
+    let on: Vec<bool> = h.force.iter().map(|&f| f > 0.02 * fmax).collect();
+    let n = on.len();
+    let contacts = (0..n).filter(|&k| on[k] && !on[(k + n - 1) % n]).count();
+    let mut grazings = 0;
+    for (k, &contact) in on.iter().enumerate() {
+        let (a, b, c) = (h.gap[(k + n - 1) % n], h.gap[k], h.gap[(k + 1) % n]);
+        if b < a && b <= c && b < 0.05 * GAP && !contact {
+            grazings += 1;
+        }
+    }
+    Ok((contacts, grazings))
+}
+
+/// Fig. 13: Robin bar NSM2 sub3 with m = 60, and points with one or two contacts.
+pub fn fig13(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let system = robin_bar_with_obstacle(ROBIN_K, GAP)?;
+    let w1 = omega_1(&system)?;
+    let m = if ctx.quick { 40 } else { 60 };
+    let t3 = 3.0 * 2.0 * PI / OMEGA_2;
+    let branch = Branch::new("NSM2 sub3", 2, (t3 - 0.02, 4.6), ctx.steps(113)).subharmonic(3);
+    let r = run(&system, m, &branch)?;
+    stats.count([&r]);
+    let bb = backbone_panel(
+        format!("Robin bar: NSM2 sub3, m = {m}"),
+        &[series(&r, w1, YELLOW, Marker::Circle)],
+        None,
+    );
+    let mut g = None;
+    let mut f = None;
+    for p in r.converged() {
+        let (c, gr) = contact_count(&system, m, p)?;
+        if c == 1 && g.is_none() && gr >= 1 {
+            g = Some((p, c, gr));
+        }
+        if c == 2 && f.is_none() {
+            f = Some((p, c, gr));
+        }
+    }
+    let basis = settings(m).cosine_basis()?;
+    let mut panels = Vec::new();
+    let mut marks = Vec::new();
+    let mut notes = Vec::new();
+    for (name, p) in [("g", g), ("f", f)] {
+        if let Some((p, c, gr)) = p {
+            marks.push(p);
+            notes.push(format!("{name}: {c} contact(s), {gr} grazing(s)"));
+            let title = format!(
+                "point {name}: {c} contact(s), {gr} near-grazing(s), Omega/omega_1 = {:.3}",
+                p.omega / w1
+            );
+            panels.push(point_map(&system, &basis, p, 90, title)?);
+        } else {
+            notes.push(format!("{name}: not found"));
+        }
+    }
+    stats.note = notes.join("; ");
+    ctx.backbone_figure(
+        &mut stats,
+        "fig13_robin_nsm2_sub3",
+        &Figure::new(
+            "Fig. 13: NSM2 sub3 of the Robin-Signorini bar",
+            3,
+            marked(bb, "points g, f", &marks, w1, panels),
+        ),
+        &[&r],
+        w1,
+    )?;
+    Ok(stats)
+}

@@ -1,0 +1,429 @@
+//! Figs. 14-18: two bars in contact, in the configurations `(l, c, alpha)` = (0.95, 1, 1),
+//! (3.8, 4, 4) and (0.95, 2, 1): backbones with snapshots of both bars, the contact
+//! interface, and a time-domain check of one point.
+
+use crate::common::{
+    field, frequency_energy, marked, omega_1, over_gap, pick, reference_line, right_end, run,
+    series, settings, Branch, Ctx, Res, Run, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
+};
+use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::fourier::CosineBasis;
+use nonsmooth_modes::modal::{law_history, BackbonePoint};
+use nonsmooth_modes::plot::{
+    backbone_panel, snapshots_panel, Figure, LegendPosition, LinePanel, Marker, Panel, PlacedBar,
+    Placement, Rgb, Series, SpaceTimeField, PALETTE,
+};
+use nonsmooth_modes::reference::two_bars_in_contact;
+use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
+use nonsmooth_modes::verify::{march, periodicity_check, MarchOptions, PeriodicityOptions, State};
+use std::f64::consts::PI;
+
+/// Harmonics of every two-bar run.
+const M: usize = 20;
+
+/// Samples of the interface histories of Figs. 15 and 16.
+const SAMPLES: usize = 600;
+
+/// First natural frequency `pi c / (2 l)` of bar 2 in configurations 1 and 2, where
+/// `l / c = 0.95`.
+const OMEGA_1_BAR_2: f64 = PI / (2.0 * 0.95);
+
+/// A two-bar system, its backbones and the first natural frequency `w1` of bar 1.
+pub struct TwoBar {
+    system: BarSystem,
+    runs: Vec<Run>,
+    w1: f64,
+}
+
+impl TwoBar {
+    /// Bar 2 `(l, c, alpha)` facing the unit bar, and its backbones along `branches`.
+    fn new((l, c, alpha): (f64, f64, f64), branches: &[Branch<'_>]) -> Res<Self> {
+        let system = two_bars_in_contact(Bar::new(l, c, alpha)?, GAP)?;
+        let w1 = omega_1(&system)?;
+        let runs = branches
+            .iter()
+            .map(|b| run(&system, M, b))
+            .collect::<Res<Vec<Run>>>()?;
+        Ok(Self { system, runs, w1 })
+    }
+
+    /// Configuration 1, `(0.95, 1, 1)`: NSM1 from `T = 3.95` down, and the NSM2 sub-branches
+    /// near the second modes of bar 1 (`3 pi / 2`) and of bar 2.
+    pub fn config1(ctx: &Ctx) -> Res<Self> {
+        // System modes (open contact): bar 1 first, bar 2 first, bar 1 second, bar 2 second.
+        let branches = [
+            nsm1(ctx),
+            Branch::new("NSM2 (bar 1)", 3, (1.33, 1.05), ctx.steps(141)),
+            Branch::new("NSM2 (bar 2)", 4, (1.26, 1.0), ctx.steps(131)),
+        ];
+        Self::new((0.95, 1.0, 1.0), &branches)
+    }
+
+    fn runs(&self) -> Vec<&Run> {
+        self.runs.iter().collect()
+    }
+}
+
+/// NSM1 of a two-bar system from `T = 3.95` down to 2.85.
+fn nsm1(ctx: &Ctx) -> Branch<'static> {
+    Branch::new("NSM1", 1, (3.95, 2.85), ctx.steps(221))
+}
+
+/// Snapshot panel of both bars, fields in units of `g0`: bar 1 from 0, bar 2 mirrored from
+/// `1 + l_2`.
+fn snapshots(
+    title: &str,
+    (one, two): (&SpaceTimeField, &SpaceTimeField),
+    l2: f64,
+    instants: usize,
+) -> Res<Panel> {
+    let placed = |name, field, origin, mirrored| PlacedBar {
+        name,
+        field,
+        placement: Placement { origin, mirrored },
+    };
+    let bars = [
+        placed("bar 1", one, 0.0, false),
+        placed("bar 2", two, 1.0 + l2, true),
+    ];
+    let mut panel = snapshots_panel(title, &bars, instants, &[1.0])?;
+    panel.y_label = "u / g0 (bar 1 solid, bar 2 dashed as -w)".into();
+    panel.x_label = "position (8 instants over T, blue -> red)".into();
+    panel.legend = LegendPosition::Hidden;
+    Ok(panel.into())
+}
+
+/// Snapshots of the harmonic-balance point `p` at 8 instants.
+fn snapshots_of(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    p: &BackbonePoint,
+    title: String,
+) -> Res<Panel> {
+    let [one, two] = [0, 1].map(|bar| {
+        let mut f = field(system, basis, p, bar, 8);
+        f.values.iter_mut().for_each(|v| *v /= GAP);
+        f
+    });
+    snapshots(&title, (&one, &two), system.bars()[1].length(), 8)
+}
+
+/// Snapshot panels of `points` (name, point), titled `point {name}: ...`.
+fn named_snapshots(tb: &TwoBar, points: &[(&str, &BackbonePoint)]) -> Res<Vec<Panel>> {
+    let basis = settings(M).cosine_basis()?;
+    points
+        .iter()
+        .map(|(name, p)| {
+            let title = format!("point {name}: {}", frequency_energy(p, tb.w1));
+            snapshots_of(&tb.system, &basis, p, title)
+        })
+        .collect()
+}
+
+/// Fig. 14 (and the data of 15 and 16): configuration 1.
+pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
+    let mut stats = Stats::default();
+    stats.count(&tb.runs);
+    let branches: Vec<Series> = tb
+        .runs
+        .iter()
+        .zip([GREEN, RED, PALETTE[5]])
+        .map(|(r, c)| series(r, tb.w1, c, Marker::Circle))
+        .collect();
+    let mut bb = backbone_panel("(0.95, 1, 1): backbones, m = 20", &branches, None);
+    let w12 = OMEGA_1_BAR_2;
+    bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1, 3.0];
+    bb.legend = LegendPosition::UpperLeft;
+    let conv: Vec<&BackbonePoint> = tb.runs[0].converged().collect();
+    // b, c, e: NSM1 points nearest Omega/omega_1 = 1.07, 1.2, 1.33; f: NSM2 (bar 1).
+    let near = |target: f64| {
+        conv.iter()
+            .min_by(|x, y| {
+                (x.omega / tb.w1 - target)
+                    .abs()
+                    .total_cmp(&(y.omega / tb.w1 - target).abs())
+            })
+            .copied()
+    };
+    let f = tb.runs.get(1).and_then(|r| r.converged().nth(5));
+    let picks: Vec<(&str, &BackbonePoint)> = [
+        ("b", near(1.07)),
+        ("c", near(1.2)),
+        ("e", near(1.33)),
+        ("f", f),
+    ]
+    .into_iter()
+    .filter_map(|(name, p)| p.map(|p| (name, p)))
+    .collect();
+    let marks: Vec<&BackbonePoint> = picks.iter().map(|(_, p)| *p).collect();
+    let panels = named_snapshots(tb, &picks)?;
+    ctx.backbone_figure(
+        &mut stats,
+        "fig14_two_bar_config1",
+        &Figure::new(
+            "Fig. 14: two bars (l, c, alpha) = (0.95, 1, 1) (dashed: omega_1^(2), 4/3 omega_1^(2), omega_2^(1))",
+            3,
+            marked(bb, "points b, c, e, f", &marks, tb.w1, panels),
+        ),
+        &tb.runs(),
+        tb.w1,
+    )?;
+    Ok((stats, marks.into_iter().cloned().collect()))
+}
+
+/// Interface positions from `x = 1` in units of `g0`: bar 1 at `u(1)`, bar 2 at `g0 - w(l)`.
+fn interface_positions(u: &[f64], w: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    (over_gap(u), w.iter().map(|w| (GAP - w) / GAP).collect())
+}
+
+/// Fig. 15: interface position and strain of both bars for two points of Fig. 14.
+pub fn fig15(ctx: &Ctx, tb: &TwoBar, points: &[BackbonePoint]) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let basis = settings(M).cosine_basis()?;
+    let mut panels = Vec::new();
+    let mut table = Table::default();
+    for (p, tag) in points.iter().zip(["a", "b"]) {
+        stats.points += 1;
+        stats.converged += 1;
+        let h1 = right_end(&tb.system, &basis, p, 0, SAMPLES)?;
+        let h2 = right_end(&tb.system, &basis, p, 1, SAMPLES)?;
+        let (pos1, pos2) = interface_positions(&h1.displacement, &h2.displacement);
+        let (e1, e2) = (over_gap(&h1.strain), over_gap(&h2.strain));
+        let mut panel = LinePanel::new(
+            format!("({tag}) {}", frequency_energy(p, tb.w1)),
+            "t",
+            "position - 1 and strain, / g0",
+        );
+        panel.series = vec![
+            Series::from_columns("bar 1 position", &h1.time, &pos1).with_color(GREEN),
+            Series::from_columns("bar 2 position", &h1.time, &pos2).with_color(YELLOW),
+            Series::from_columns("bar 1 strain", &h1.time, &e1)
+                .with_color(GREEN)
+                .dashed(),
+            Series::from_columns("bar 2 strain", &h1.time, &e2)
+                .with_color(YELLOW)
+                .dashed(),
+        ];
+        panel.legend = LegendPosition::LowerRight;
+        panels.push(Panel::Lines(panel));
+        table.push(format!("t_{tag}"), h1.time);
+        for (n, c) in [
+            ("pos1", pos1),
+            ("pos2", pos2),
+            ("strain1", e1),
+            ("strain2", e2),
+        ] {
+            table.push(format!("{n}_over_g0_{tag}"), c);
+        }
+    }
+    ctx.svg(
+        &mut stats,
+        "fig15_two_bar_interface.svg",
+        &Figure::new(
+            "Fig. 15: contact interface, strain (dashed) and position (solid)",
+            2,
+            panels,
+        ),
+    )?;
+    ctx.table(&mut stats, "fig15_two_bar_interface.csv", &table)?;
+    Ok(stats)
+}
+
+/// A thin dashed line of the harmonic-balance solution, `(t, y)` pairs.
+fn hb_line(label: &str, t: &[f64], y: &[f64], color: Rgb) -> Series {
+    reference_line(label, t.iter().copied().zip(y.iter().copied()).collect()).with_color(color)
+}
+
+/// Fig. 16: time-domain check of point b of Fig. 14: exact d'Alembert march over one period
+/// from the HB state at t = 0, compared with the HB motion.
+pub fn fig16(ctx: &Ctx, tb: &TwoBar, p: &BackbonePoint) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let basis = settings(M).cosine_basis()?;
+    let options = PeriodicityOptions {
+        dt: 0.01,
+        ..Default::default()
+    };
+    let report = periodicity_check(&tb.system, &basis, &p.x, p.omega, &options)?;
+    let period = 2.0 * PI / p.omega;
+    let initial = State::from_harmonic_balance(&tb.system, &basis, &p.x, p.omega, 0.0, 0.01)?;
+    let steps = (period / 0.01).round() as usize;
+    let traj = march(
+        &initial,
+        period,
+        &MarchOptions {
+            snapshot_every: (steps / 8).max(1),
+            ..Default::default()
+        },
+    )?;
+    stats.points = 1;
+    stats.converged = 1;
+    stats.note = format!(
+        "defect {:.3} (energy norm), displacement defect {:.3}, energy drift {:.1e}",
+        report.defect, report.displacement_defect, report.energy_drift
+    );
+    println!("    {}", stats.note);
+    // Interface positions from the march: ends are [bar0 left, bar0 right, bar1 left, ...].
+    let t = &traj.times;
+    let (u1, u2) = interface_positions(&traj.ends[1].displacement, &traj.ends[3].displacement);
+    let tm: Vec<f64> = t.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    let force = over_gap(&traj.contacts[0].force);
+    let h1 = right_end(&tb.system, &basis, p, 0, SAMPLES)?;
+    let h2 = right_end(&tb.system, &basis, p, 1, SAMPLES)?;
+    let (hb1, hb2) = interface_positions(&h1.displacement, &h2.displacement);
+    let problem = NonsmoothSystem::new(&tb.system, settings(M))?;
+    let law = law_history(&problem, &p.x, p.omega, 0, SAMPLES)?;
+    let mut pos = LinePanel::new("interface positions - 1", "t", "/ g0");
+    pos.series = vec![
+        Series::from_columns("bar 1, time domain", t, &u1).with_color(GREEN),
+        Series::from_columns("bar 2, time domain", t, &u2).with_color(YELLOW),
+        hb_line("bar 1, FD-BEM", &h1.time, &hb1, Rgb::BLACK),
+        hb_line("bar 2, FD-BEM", &h2.time, &hb2, PALETTE[7]),
+    ];
+    pos.legend = LegendPosition::LowerRight;
+    let mut frc = LinePanel::new("contact force", "t", "lambda / g0");
+    frc.series = vec![
+        Series::from_columns("time domain (step mean)", &tm, &force).with_color(BLUE),
+        hb_line("FD-BEM", &law.time, &over_gap(&law.force), Rgb::BLACK),
+    ];
+    frc.legend = LegendPosition::UpperRight;
+    // Snapshots of the marched field.
+    let l2 = tb.system.bars()[1].length();
+    let marched = |bar: usize| -> SpaceTimeField {
+        let snaps = &traj.snapshots;
+        let nx = snaps.first().map_or(0, |s| s.bars[bar].displacement.len());
+        let length = if bar == 0 { 1.0 } else { l2 };
+        SpaceTimeField {
+            position: (0..nx)
+                .map(|i| length * i as f64 / (nx.max(2) - 1) as f64)
+                .collect(),
+            time: snaps.iter().map(|s| s.time).collect(),
+            values: snaps
+                .iter()
+                .flat_map(|s| s.bars[bar].displacement.iter().map(|v| v / GAP))
+                .collect(),
+        }
+    };
+    let (f1, f2) = (marched(0), marched(1));
+    let instants = f1.time.len().min(8);
+    let snap = snapshots("time-domain field, 8 instants", (&f1, &f2), l2, instants)?;
+    ctx.svg(
+        &mut stats,
+        "fig16_time_domain_check.svg",
+        &Figure::new(
+            format!(
+                "Fig. 16: time-domain march of point b (T = {period:.3}): periodicity defect {:.1}% (displacement {:.1}%)",
+                100.0 * report.defect,
+                100.0 * report.displacement_defect
+            ),
+            3,
+            vec![snap, pos.into(), frc.into()],
+        ),
+    )?;
+    let n = tm.len();
+    ctx.columns(
+        &mut stats,
+        "fig16_time_domain_check.csv",
+        &[
+            "t_mid",
+            "contact_force_over_g0",
+            "pos1_over_g0",
+            "pos2_over_g0",
+        ],
+        &[&tm, &force, &u1[1..=n], &u2[1..=n]],
+    )?;
+    Ok(stats)
+}
+
+/// Fig. 17: configuration 2 (3.8, 4, 4), NSM1 and one field.
+pub fn fig17(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let tb = TwoBar::new((3.8, 4.0, 4.0), &[nsm1(ctx)])?;
+    stats.count(&tb.runs);
+    let mut bb = backbone_panel(
+        "(3.8, 4, 4): NSM1, m = 20",
+        &[series(&tb.runs[0], tb.w1, GREEN, Marker::Circle)],
+        None,
+    );
+    let w12 = OMEGA_1_BAR_2;
+    bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1];
+    let basis = settings(M).cosine_basis()?;
+    let lowest = tb.runs[0]
+        .converged()
+        .min_by(|x, y| x.energy_normalized.total_cmp(&y.energy_normalized));
+    let mut panels = Vec::new();
+    let mut marks = Vec::new();
+    if let Some(p) = lowest {
+        marks.push(p);
+        panels.push(snapshots_of(
+            &tb.system,
+            &basis,
+            p,
+            frequency_energy(p, tb.w1),
+        )?);
+    }
+    // Without a converged point the legend entry "point" is left out altogether.
+    let all = if marks.is_empty() {
+        vec![Panel::Lines(bb)]
+    } else {
+        marked(bb, "point", &marks, tb.w1, panels)
+    };
+    ctx.backbone_figure(
+        &mut stats,
+        "fig17_two_bar_config2",
+        &Figure::new("Fig. 17: two bars (3.8, 4, 4)", 2, all),
+        &tb.runs(),
+        tb.w1,
+    )?;
+    Ok(stats)
+}
+
+/// Fig. 18: configuration 3 (0.95, 2, 1): the two families and a few fields.
+pub fn fig18(ctx: &Ctx) -> Res<Stats> {
+    let mut stats = Stats::default();
+    let w12 = 2.0 * PI / (2.0 * 0.95);
+    let tb = TwoBar::new(
+        (0.95, 2.0, 1.0),
+        &[
+            Branch::new("family 1 (mode 1)", 1, (3.95, 3.45), ctx.steps(101)),
+            Branch::new(
+                "family 2 (mode 2)",
+                2,
+                (2.0 * PI / w12 - 0.01, 1.45),
+                ctx.steps(91),
+            ),
+        ],
+    )?;
+    let (runs, w1) = (&tb.runs, tb.w1);
+    stats.count(runs);
+    let mut bb = backbone_panel(
+        "(0.95, 2, 1): backbones, m = 20",
+        &[
+            series(&runs[0], w1, Rgb::BLACK, Marker::Circle),
+            series(&runs[1], w1, PALETTE[7], Marker::Square).with_size(2),
+        ],
+        None,
+    );
+    bb.x_guides = vec![1.0, 1.13, 0.5 * w12 / w1, w12 / w1, 1.25 * w12 / w1];
+    let mut picks = Vec::new();
+    for (r, targets) in runs.iter().zip([[3.8, 3.6], [1.8, 1.6]]) {
+        picks.extend(targets.into_iter().filter_map(|t| pick(r, t, 0.0)));
+    }
+    bb.legend = LegendPosition::UpperLeft;
+    let named: Vec<(&str, &BackbonePoint)> = ["a", "b", "c", "d"]
+        .into_iter()
+        .zip(picks.iter().copied())
+        .collect();
+    let panels = named_snapshots(&tb, &named)?;
+    ctx.backbone_figure(
+        &mut stats,
+        "fig18_two_bar_config3",
+        &Figure::new(
+            "Fig. 18: two bars (0.95, 2, 1) (dashed: omega_1^(1), 1.13 omega_1^(1), omega_1^(2)/2, omega_1^(2), 1.25 omega_1^(2))",
+            3,
+            marked(bb, "points a-d", &picks, w1, panels),
+        ),
+        &tb.runs(),
+        w1,
+    )?;
+    Ok(stats)
+}
