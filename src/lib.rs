@@ -82,8 +82,6 @@ pub mod fourier;
 pub mod io;
 pub mod linalg;
 pub mod modal;
-/// SVG plots of backbones, space-time fields, two-bar snapshots and time histories, from
-/// plain data (feature `plot`, backed by `plotters` without fonts or bitmaps).
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod reference;
