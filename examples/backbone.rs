@@ -46,8 +46,8 @@
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
-    linspace, Arclength, ArclengthOptions, ArclengthOutcome, Event, Point, Selection, Sequential,
-    SequentialOptions, Speculation, StallEscape,
+    linspace, Arclength, ArclengthOptions, Event, Point, Selection, Sequential, SequentialOptions,
+    Speculation, StallEscape, Step,
 };
 use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
 use nonsmooth_modes::modal::{
@@ -515,17 +515,15 @@ fn run_parameter(
             escape: None,
             ..a.driver
         };
-        let (mut driver, first) = Arclength::new(problem, solver, start.x, value, options)?;
-        if report(&first).is_continue() {
-            let branch = driver.run(None, |o| match o {
-                ArclengthOutcome::Accepted(p) => report(p),
-                _ => ControlFlow::Continue(()),
-            });
-            eprintln!(
-                "backbone: arclength ended: {:?}; {} rejected steps",
-                branch.end, branch.rejections
-            );
-        }
+        let mut driver = Arclength::new(problem, solver, start.x, value, options)?;
+        let branch = driver.run(&mut |step: &Step| match step {
+            Step::Accepted(p) => report(p),
+            _ => ControlFlow::Continue(()),
+        });
+        eprintln!(
+            "backbone: arclength ended: {:?}; {} rejected steps",
+            branch.end, branch.rejections
+        );
     } else {
         // Sequential parameter runs go from the current value to the far end of the range.
         let far = if (hi - value).abs() >= (value - lo).abs() {
@@ -544,7 +542,11 @@ fn run_parameter(
                 ..Default::default()
             },
         )?;
-        driver.run(|p| report(p))?;
+        let branch = driver
+            .run(&mut |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report));
+        if let Some(e) = branch.end.error() {
+            return Err(e.into());
+        }
     }
     Ok(())
 }

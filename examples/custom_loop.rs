@@ -1,23 +1,75 @@
 //! A hand-written continuation loop, as a downstream crate would write it.
 //!
 //! Sequential continuation in the period of the clamped bar's first nonsmooth mode, driven
-//! step by step with `Sequential::step`; at the first failed step (a fold or a resonance the
+//! step by step with `Sequential::step`; at the first rejected step (a fold or a resonance the
 //! natural parameter cannot pass) the loop switches to pseudo-arclength from the last
-//! converged point, and it stops as soon as the energy exceeds a threshold.
+//! converged point, and it stops as soon as the energy exceeds a threshold. Both drivers
+//! return the same `Step`, so one loop (`follow`) serves both.
 //!
 //! ```text
 //! cargo run --release --example custom_loop -- [E_OVER_EG_THRESHOLD (default 20)]
 //! ```
 
 use nonsmooth_modes::continuation::{
-    Arclength, ArclengthOptions, ArclengthOutcome, PeriodParametrised, Point, Sequential,
-    SequentialOptions, StallEscape, StepOutcome,
+    Arclength, ArclengthOptions, PeriodParametrised, Point, Sequential, SequentialOptions,
+    StallEscape, Step,
 };
 use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
 use std::f64::consts::PI;
+
+/// How a phase of the loop ended.
+enum Phase {
+    /// The energy threshold was crossed.
+    Threshold,
+    /// A step was rejected after the last accepted point `Some(p)`.
+    Rejected(Option<Point>),
+    /// The driver ended by itself.
+    Ended,
+}
+
+/// The loop itself, the same for both drivers: step until the threshold, a rejection (when
+/// `stop_on_rejection`) or the end.
+fn follow(
+    label: &str,
+    mut step: impl FnMut() -> Step,
+    normalized: impl Fn(&Point) -> f64,
+    threshold: f64,
+    stop_on_rejection: bool,
+) -> Phase {
+    let (mut last, mut rejected) = (None, 0);
+    loop {
+        match step() {
+            Step::Accepted(p) => {
+                let (e, exact) = (normalized(&p), ClampedFirstMode::new(1e-3, p.lambda));
+                let events: Vec<&str> = p.events.iter().map(|e| e.label()).collect();
+                println!(
+                    "{label}  T {:.4}  E/Eg {:9.4}  exact {:9.4}  {}",
+                    p.lambda,
+                    e,
+                    exact.energy_normalized(),
+                    events.join(",")
+                );
+                if e > threshold {
+                    println!("energy threshold {threshold} reached ({rejected} rejected steps)");
+                    return Phase::Threshold;
+                }
+                last = Some(p);
+            }
+            Step::Rejected(r) if stop_on_rejection => {
+                println!("{label}  T {:.4}  rejected: {:?}", r.lambda, r.reason);
+                return Phase::Rejected(last);
+            }
+            Step::Rejected(_) => rejected += 1,
+            Step::Finished(end) => {
+                println!("{label} ended: {end:?} ({rejected} rejected steps)");
+                return Phase::Ended;
+            }
+        }
+    }
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let threshold: f64 = match std::env::args().nth(1) {
@@ -32,7 +84,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (e_g, _) = grazing_energy(&system)?;
     let normalized = |p: &Point| energy(&system, &basis, &p.x, 2.0 * PI / p.lambda) / e_g;
 
-    // Phase 1: sequential in the period, one call of `step()` at a time.
+    // Phase 1: sequential in the period, one call of `step()` at a time; it hands over at
+    // the first rejected step.
     let start = branch_seed(&mut problem, 1, 1, 2.0 * PI / 3.95)?;
     let periods: Vec<f64> = (0..=180).map(|i| 3.95 - 0.005 * i as f64).collect();
     let mut sequential = Sequential::new(
@@ -42,42 +95,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         periods,
         SequentialOptions::default(),
     )?;
-    let mut last: Option<Point> = None;
-    loop {
-        match sequential.step() {
-            StepOutcome::Converged(p) => {
-                let e = normalized(&p);
-                println!(
-                    "sequential  T {:.4}  E/Eg {:9.4}  exact {:9.4}",
-                    p.lambda,
-                    e,
-                    ClampedFirstMode::new(gap, p.lambda).energy_normalized()
-                );
-                if e > threshold {
-                    println!("energy threshold {threshold} reached");
-                    return Ok(());
-                }
-                last = Some(p);
-            }
-            StepOutcome::Failed(p) => {
-                println!(
-                    "sequential  T {:.4}  failed: {:?}: switching to arclength",
-                    p.lambda, p.error
-                );
-                break;
-            }
-            StepOutcome::Finished => {
-                println!("sequential run finished without failure");
-                return Ok(());
-            }
-            StepOutcome::Stalled(e) => return Err(e.into()),
-        }
-    }
-
-    // Phase 2: pseudo-arclength from the last converged point, towards shorter periods.
-    let Some(from) = last else {
-        return Err("no converged point to switch from".into());
+    let from = match follow(
+        "sequential",
+        || sequential.step(),
+        normalized,
+        threshold,
+        true,
+    ) {
+        Phase::Rejected(Some(p)) => p,
+        Phase::Rejected(None) => return Err("no converged point to switch from".into()),
+        Phase::Threshold | Phase::Ended => return Ok(()),
     };
+
+    // Phase 2: pseudo-arclength from the last converged point, towards shorter periods, with
+    // the same loop.
+    println!("switching to arclength");
     let problem = PeriodParametrised::new(NonsmoothSystem::new(&system, settings)?);
     let options = ArclengthOptions {
         direction: -1.0,
@@ -85,31 +117,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         escape: Some(StallEscape::default()),
         ..Default::default()
     };
-    let (mut arclength, _) =
-        Arclength::restart(problem, SemismoothNewton::default(), &from, options)?;
-    let mut rejected = 0;
-    loop {
-        match arclength.step() {
-            ArclengthOutcome::Accepted(p) => {
-                let e = normalized(&p);
-                let events: Vec<&str> = p.events.iter().map(|e| e.label()).collect();
-                println!(
-                    "arclength   T {:.4}  E/Eg {:9.4}  ds {:.3e} {}",
-                    p.lambda,
-                    e,
-                    p.step_size,
-                    events.join(",")
-                );
-                if e > threshold {
-                    println!("energy threshold {threshold} reached ({rejected} rejected steps)");
-                    return Ok(());
-                }
-            }
-            ArclengthOutcome::Rejected(_) => rejected += 1,
-            ArclengthOutcome::Finished(end) => {
-                println!("arclength ended: {end:?}");
-                return Ok(());
-            }
-        }
-    }
+    let mut arclength = Arclength::restart(problem, SemismoothNewton::default(), &from, options)?;
+    follow(
+        "arclength ",
+        || arclength.step(),
+        normalized,
+        threshold,
+        false,
+    );
+    Ok(())
 }

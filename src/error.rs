@@ -280,6 +280,15 @@ pub enum ContinuationError {
         /// Parameter value of the last failure.
         parameter: f64,
     },
+    /// The step of a pseudo-arclength run fell below its minimum: the branch cannot be
+    /// followed further.
+    #[error("step {step_size:e} below its minimum at parameter {parameter}")]
+    StepBelowMinimum {
+        /// The last step tried.
+        step_size: f64,
+        /// Parameter value of the last rejected step.
+        parameter: f64,
+    },
     /// The solver failed at the starting point.
     #[error("the solver failed at the starting point: {0}")]
     Start(SolveError),

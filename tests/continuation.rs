@@ -1,8 +1,8 @@
 //! Continuation drivers on the paper's systems (issue: pseudo-arclength, parameters, loops).
 
 use nonsmooth_modes::continuation::{
-    Arclength, ArclengthOptions, ArclengthOutcome, ContinuationProblem, EndReason, Event,
-    PeriodParametrised, Point, StallEscape,
+    Arclength, ArclengthOptions, ContinuationProblem, EndReason, Event, PeriodParametrised, Point,
+    Sequential, StallEscape, Step,
 };
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, branch_seed, energy, ArclengthBackboneOptions, BackboneOptions,
@@ -73,7 +73,7 @@ fn clamped_bar_arclength_reaches_short_periods_without_manual_restarts() {
             .fold(f64::INFINITY, f64::min);
         assert!(shortest <= 3.1, "m = {m}: stopped at T = {shortest}");
         assert!(
-            matches!(branch.end, Some(EndReason::ParameterOutOfRange { .. })),
+            matches!(branch.end, EndReason::ParameterOutOfRange { .. }),
             "m = {m}: {:?}",
             branch.end
         );
@@ -99,10 +99,7 @@ fn robin_bar_arclength_crosses_the_figure_10_range() {
         ..Default::default()
     };
     let (points, branch) = run_backbone(&system, 20, &options);
-    assert!(matches!(
-        branch.end,
-        Some(EndReason::ParameterOutOfRange { .. })
-    ));
+    assert!(matches!(branch.end, EndReason::ParameterOutOfRange { .. }));
     assert!(points.iter().any(|p| p.period < 6.7));
     assert_all_converged(&system, 20, &points);
 }
@@ -139,15 +136,15 @@ fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
         parameter_range: (5e-4, 4e-3),
         ..Default::default()
     };
-    let (mut driver, first) = Arclength::new(family, solver, x, 1e-3, options).unwrap();
+    let mut driver = Arclength::new(family, solver, x, 1e-3, options).unwrap();
     let per_gap2 = |p: &Point| {
         let s = clamped_bar_with_obstacle(p.lambda).unwrap();
         energy(&s, &basis, &p.x, omega) / (p.lambda * p.lambda)
     };
-    let reference = per_gap2(&first);
+    let branch = driver.run(&mut nonsmooth_modes::continuation::quiet);
+    let reference = per_gap2(&branch.points[0]);
     let exact = ClampedFirstMode::new(1.0, period).energy();
     assert!((reference / exact - 1.0).abs() < 0.05);
-    let branch = driver.run(Some(first), |_| ControlFlow::Continue(()));
     assert!(branch.points.len() > 5);
     assert!(branch.points.iter().any(|p| p.lambda > 3.5e-3));
     for p in &branch.points {
@@ -174,7 +171,7 @@ fn iterator_restart_and_reverse_direction() {
         escape: Some(StallEscape::default()),
         ..Default::default()
     };
-    let (driver, _) = Arclength::new(
+    let driver = Arclength::new(
         PeriodParametrised::new(problem.clone()),
         SemismoothNewton::default(),
         x0,
@@ -182,12 +179,12 @@ fn iterator_restart_and_reverse_direction() {
         options,
     )
     .unwrap();
-    let forward: Vec<Point> = driver.take(15).collect();
+    let forward: Vec<Point> = driver.take(15).map(Result::unwrap).collect();
     assert_eq!(forward.len(), 15);
     assert!(forward.last().unwrap().lambda < 3.9);
     // Restart from a stored point in the other direction: the period grows again.
     let pivot = &forward[10];
-    let (mut back, _) = Arclength::restart(
+    let mut back = Arclength::restart(
         PeriodParametrised::new(problem),
         SemismoothNewton::default(),
         pivot,
@@ -199,7 +196,7 @@ fn iterator_restart_and_reverse_direction() {
     .unwrap();
     let mut grew = false;
     for _ in 0..20 {
-        if let ArclengthOutcome::Accepted(p) = back.step() {
+        if let Step::Accepted(p) = back.step() {
             grew |= p.lambda > pivot.lambda;
             assert!(p.residual_norm <= 1e-12);
             assert!(p
@@ -299,23 +296,25 @@ impl nonsmooth_modes::solve::NonlinearSolver for Local {
 /// the branch goes on from there; without the retry it is lost.
 #[test]
 fn sequential_retry_steps_back_over_a_spike() {
-    use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
+    use nonsmooth_modes::continuation::SequentialOptions;
     let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
     let run = |retry_depth| {
         let options = SequentialOptions {
             retry_depth,
             ..Default::default()
         };
-        Sequential::new(
+        let mut driver = Sequential::new(
             Spiky::default(),
             Local::default(),
             vec![0.0],
             values.clone(),
             options,
         )
-        .unwrap()
-        .map(|p| (p.converged, p.x[0]))
-        .collect::<Vec<_>>()
+        .unwrap();
+        reported(|| driver.step())
+            .into_iter()
+            .map(|p| (p.converged, p.x[0]))
+            .collect::<Vec<_>>()
     };
     let with = run(1);
     assert_eq!(
@@ -341,7 +340,7 @@ fn sequential_retry_steps_back_over_a_spike() {
 /// handed-over retry is accounted for.
 #[test]
 fn speculative_retries_give_the_serial_points() {
-    use nonsmooth_modes::continuation::{Sequential, SequentialOptions, Speculation};
+    use nonsmooth_modes::continuation::{SequentialOptions, Speculation};
     let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
     let driver = |patience| {
         let solver = Local { patience };
@@ -354,21 +353,27 @@ fn speculative_retries_give_the_serial_points() {
         )
         .unwrap()
     };
-    let serial: Vec<_> = driver(Default::default()).collect();
+    let mut serial_driver = driver(Default::default());
+    let serial = reported(|| serial_driver.step());
     assert!(!serial.is_empty() && serial.iter().all(|p| p.converged));
+    // The iterator yields the same converged points.
+    let iterated: Vec<Point> = driver(Default::default()).map(Result::unwrap).collect();
+    assert_eq!(iterated, serial);
     let every_step = Speculation {
         after_evaluations: 0,
     };
     for patience_ms in [0, 300] {
         let mut speculative = driver(std::time::Duration::from_millis(patience_ms));
         let mut points = Vec::new();
-        speculative
-            .run_speculative(every_step, |p| {
+        let branch = speculative.run_speculative(every_step, &mut |step: &Step| {
+            if let Step::Accepted(p) = step {
                 points.push(p.clone());
-                ControlFlow::Continue(())
-            })
-            .unwrap();
+            }
+            ControlFlow::Continue(())
+        });
+        assert_eq!(branch.end, EndReason::Completed);
         assert_eq!(points, serial);
+        assert_eq!(branch.points, serial);
         let stats = speculative.speculation_stats();
         // One job per step with a history (steps 1 to 4); only lambda = 0.3 fails first.
         assert_eq!(stats.launched, 4);
@@ -424,12 +429,7 @@ where
     P: ContinuationProblem + Clone + Send + 'static,
     S: nonsmooth_modes::solve::NonlinearSolver + Clone + Send + 'static,
 {
-    use nonsmooth_modes::continuation::StepOutcome;
-    std::iter::from_fn(|| match driver.step_speculative(speculation) {
-        StepOutcome::Converged(p) | StepOutcome::Failed(p) => Some(p),
-        _ => None,
-    })
-    .collect()
+    reported(|| driver.step_speculative(speculation))
 }
 
 /// On the clamped bar at m = 40 (16 first attempts fail, 5 retries converge) the speculative
@@ -493,10 +493,29 @@ impl ContinuationProblem for TwoBranches {
 }
 
 /// `x` of every point of a run, rounded, with its convergence flag.
-fn rounded(points: impl Iterator<Item = Point>) -> Vec<(bool, f64)> {
+fn rounded(points: Vec<Point>) -> Vec<(bool, f64)> {
     points
+        .into_iter()
         .map(|p| (p.converged, (p.x[0] * 1e9).round() / 1e9))
         .collect()
+}
+
+/// Every point a run reports, converged or failed, in order (what a backbone writes): the
+/// accepted points and the solver's last iterates of rejected steps.
+fn reported(mut step: impl FnMut() -> Step) -> Vec<Point> {
+    std::iter::from_fn(|| match step() {
+        Step::Finished(_) => None,
+        step => Some(step.point().cloned()),
+    })
+    .flatten()
+    .collect()
+}
+
+/// [`reported`] of a driver run with `step`.
+fn run_points<P: ContinuationProblem, S: nonsmooth_modes::solve::NonlinearSolver>(
+    mut driver: Sequential<P, S>,
+) -> Vec<Point> {
+    reported(|| driver.step())
 }
 
 /// After a spike, the last point leads to the high branch and the point before it back to the
@@ -504,7 +523,7 @@ fn rounded(points: impl Iterator<Item = Point>) -> Vec<(bool, f64)> {
 /// high one. A NaN measure ranks last, and without a measure the rule is `FirstConverged`.
 #[test]
 fn sequential_lowest_measure_leaves_a_spike_for_the_low_branch() {
-    use nonsmooth_modes::continuation::{Selection, Sequential, SequentialOptions};
+    use nonsmooth_modes::continuation::{Selection, SequentialOptions};
     let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
     let driver = |selection| {
         let options = SequentialOptions {
@@ -524,16 +543,20 @@ fn sequential_lowest_measure_leaves_a_spike_for_the_low_branch() {
     let on = |xs: [f64; 5]| xs.iter().map(|&x| (true, x)).collect::<Vec<_>>();
     let high = on([0.0, 0.45, 0.6, 0.7, 0.8]);
     let low = on([0.0, 0.45, 0.2, 0.3, 0.4]);
-    let first = rounded(driver(Selection::FirstConverged).with_measure(|x, _| x[0]));
+    let first = rounded(run_points(
+        driver(Selection::FirstConverged).with_measure(|x, _| x[0]),
+    ));
     assert_eq!(first, high);
-    let lowest = rounded(driver(Selection::LowestMeasure).with_measure(|x, _| x[0]));
+    let lowest = rounded(run_points(
+        driver(Selection::LowestMeasure).with_measure(|x, _| x[0]),
+    ));
     assert_eq!(lowest, low);
     // NaN on the low branch ranks it last.
     let nan_low =
         driver(Selection::LowestMeasure)
             .with_measure(|x, _| if x[0] < 0.5 { f64::NAN } else { x[0] });
-    assert_eq!(rounded(nan_low), high);
-    assert_eq!(rounded(driver(Selection::LowestMeasure)), high);
+    assert_eq!(rounded(run_points(nan_low)), high);
+    assert_eq!(rounded(run_points(driver(Selection::LowestMeasure))), high);
     assert_eq!(
         SequentialOptions::default().selection,
         Selection::FirstConverged
@@ -544,7 +567,7 @@ fn sequential_lowest_measure_leaves_a_spike_for_the_low_branch() {
 /// speculative retry.
 #[test]
 fn speculative_lowest_measure_gives_the_serial_points() {
-    use nonsmooth_modes::continuation::{Selection, Sequential, SequentialOptions, Speculation};
+    use nonsmooth_modes::continuation::{Selection, SequentialOptions, Speculation};
     let values = vec![0.0, 0.1, 0.2, 0.3, 0.4];
     for retry_depth in [1, 2] {
         let driver = || {
@@ -566,14 +589,14 @@ fn speculative_lowest_measure_gives_the_serial_points() {
             .unwrap()
             .with_measure(|x, _| x[0])
         };
-        let serial: Vec<_> = driver().collect();
+        let serial = run_points(driver());
         let mut speculative = driver();
         let every_step = Speculation {
             after_evaluations: 0,
         };
         let points = speculative_points(&mut speculative, every_step);
         assert_eq!(points, serial);
-        assert_eq!(rounded(points.into_iter())[2], (true, 0.2));
+        assert_eq!(rounded(points)[2], (true, 0.2));
         assert_eq!(speculative.speculation_stats(), Default::default());
     }
 }

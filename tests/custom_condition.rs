@@ -8,7 +8,7 @@ use nonsmooth_modes::bc::{
     UnilateralLaw,
 };
 use nonsmooth_modes::continuation::{
-    ContinuationProblem, PeriodParametrised, Sequential, SequentialOptions,
+    ContinuationProblem, PeriodParametrised, Sequential, SequentialOptions, Step,
 };
 use nonsmooth_modes::modal::{
     backbone, branch_seed, energy, grazing_energy, natural_frequencies, BackboneOptions,
@@ -349,15 +349,21 @@ fn compliant_backbone(
     .with_acceptance(move |x, t| {
         energy(&accept_system, &accept_basis, x, 2.0 * PI / t) > 1e-6 * e_g
     });
-    driver
-        .map(|p| {
-            (
-                p.lambda,
-                p.converged,
-                energy(&system, &basis, &p.x, 2.0 * PI / p.lambda) / e_g,
-            )
-        })
-        .collect()
+    // Converged points and the last iterates of failed steps alike.
+    let mut driver = driver;
+    std::iter::from_fn(|| match driver.step() {
+        Step::Finished(_) => None,
+        step => Some(step.point().cloned()),
+    })
+    .flatten()
+    .map(|p| {
+        (
+            p.lambda,
+            p.converged,
+            energy(&system, &basis, &p.x, 2.0 * PI / p.lambda) / e_g,
+        )
+    })
+    .collect()
 }
 
 /// The compliant obstacle's backbone converges (from the sixth period on at least: the first

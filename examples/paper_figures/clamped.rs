@@ -113,10 +113,10 @@ fn arclength_nsm1(ctx: &Ctx, system: &BarSystem, m: usize, w1: f64) -> Res<Run> 
         "    arclength m = {m}: {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
         points.len(),
         branch.rejections,
-        branch.end.as_ref().map(|e| match e {
+        match &branch.end {
             EndReason::ParameterOutOfRange { .. } => "range".to_string(),
             other => format!("{other:?}"),
-        })
+        }
     );
     Ok(Run {
         label: format!("arclength m={m}"),

@@ -31,13 +31,15 @@
 //! Reference: E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*,
 //! SIAM Classics in Applied Mathematics 45 (2003), chapter 2.
 
-use super::{ContinuationProblem, Event, Point};
-use crate::error::{ContinuationError, SolveError};
+use super::driver::{next_point, run_with, Acceptance};
+use super::{
+    Branch, ContinuationProblem, EndReason, Event, Observer, Point, RejectReason, Rejection, Step,
+};
+use crate::error::ContinuationError;
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::{
     residual_scale, NonlinearSolver, Problem, SingularStep, SolveInfo, Structured, PIVOT_TOLERANCE,
 };
-use std::ops::ControlFlow;
 
 /// How the predictor direction is formed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -215,100 +217,6 @@ impl ArclengthOptions {
             }
         }
         Ok(())
-    }
-}
-
-/// Why a run ended.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub enum EndReason {
-    /// `max_steps` points were accepted.
-    MaxSteps,
-    /// The corrected parameter left the allowed range (the point is not kept).
-    ParameterOutOfRange {
-        /// The parameter value reached.
-        lambda: f64,
-    },
-    /// The step fell below `ds_min`.
-    StepBelowMinimum {
-        /// The last rejection.
-        last: Box<Rejection>,
-    },
-    /// An observer returned `ControlFlow::Break`.
-    StoppedByObserver,
-    /// The parameter stopped progressing and every escape attempt failed.
-    Stalled {
-        /// Parameter where the run stalled.
-        lambda: f64,
-    },
-}
-
-/// Why a step was rejected.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub enum RejectReason {
-    /// The corrector failed.
-    Solver(SolveError),
-    /// The corrected point is far from the prediction.
-    Jump {
-        /// `|y - y_p|_W / ds`.
-        ratio: f64,
-    },
-    /// The tangent turned too sharply.
-    Turn {
-        /// Angle between successive tangents, radians.
-        angle: f64,
-    },
-    /// The bordered Jacobian for the tangent is singular.
-    SingularTangent,
-    /// The acceptance test of [`Arclength::with_acceptance`] failed.
-    NotAccepted,
-}
-
-/// A rejected step: the branch stays at its last accepted point and `ds` shrinks.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct Rejection {
-    /// Step size tried.
-    pub ds: f64,
-    /// Predicted parameter.
-    pub lambda: f64,
-    /// Why.
-    pub reason: RejectReason,
-}
-
-/// What one call of [`Arclength::step`] did.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ArclengthOutcome {
-    /// A point was accepted.
-    Accepted(Point),
-    /// A step was rejected; call again to retry with a smaller `ds`.
-    Rejected(Rejection),
-    /// The run is over.
-    Finished(EndReason),
-}
-
-/// The points of a branch with their diagnostics.
-#[derive(Debug, Clone, PartialEq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct Branch {
-    /// Accepted points in order.
-    pub points: Vec<Point>,
-    /// Number of rejected steps.
-    pub rejections: usize,
-    /// Why the run ended (None while it runs).
-    pub end: Option<EndReason>,
-}
-
-impl Branch {
-    /// Points carrying an event of the given kind (by predicate).
-    pub fn with_event(
-        &self,
-        mut which: impl FnMut(&Event) -> bool,
-    ) -> impl Iterator<Item = &Point> {
-        self.points
-            .iter()
-            .filter(move |p| p.events.iter().any(&mut which))
     }
 }
 
@@ -510,18 +418,20 @@ pub struct Arclength<P, S> {
     active: Option<Vec<usize>>,
     ds: f64,
     accepted: usize,
+    /// The corrected start, handed out by the first step.
+    start: Option<Point>,
     finished: Option<EndReason>,
+    /// Whether the iterator has handed out the end.
+    done: bool,
     history: std::collections::VecDeque<(f64, Vec<f64>)>,
     frontier: Option<(f64, Vec<f64>)>,
     accept: Option<Acceptance>,
     border: BorderScratch,
 }
 
-/// A test that a converged solution `(x, lambda)` belongs to the branch.
-type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
-
 impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
-    /// Starts from a solution `x0` at `lambda0` (it is corrected at fixed `lambda0` first).
+    /// Starts from a solution `x0` at `lambda0` (it is corrected at fixed `lambda0` first;
+    /// the first [`Arclength::step`] returns that corrected start as step 0).
     ///
     /// # Errors
     /// Invalid options, a wrong-sized `x0`, a start where the solver fails
@@ -532,7 +442,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         x0: Vec<f64>,
         lambda0: f64,
         options: ArclengthOptions,
-    ) -> Result<(Self, Point), ContinuationError> {
+    ) -> Result<Self, ContinuationError> {
         options.validate()?;
         let n = problem.dimension();
         if x0.len() != n {
@@ -591,7 +501,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             previous: None,
             active: None,
             accepted: 0,
+            start: None,
             finished: None,
+            done: false,
             history: Default::default(),
             frontier: None,
             accept: None,
@@ -601,8 +513,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             .tangent_at(&driver.y.clone(), &seed)
             .ok_or(ContinuationError::SingularTangent { lambda: lambda0 })?;
         driver.active = driver.active_set();
-        let point = driver.point(0, &info, Vec::new());
-        Ok((driver, point))
+        driver.start = Some(driver.point(0, &info, Vec::new()));
+        Ok(driver)
     }
 
     /// Adds a test every accepted point must pass (for instance "not the state of rest"); a
@@ -621,7 +533,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         solver: S,
         point: &Point,
         options: ArclengthOptions,
-    ) -> Result<(Self, Point), ContinuationError> {
+    ) -> Result<Self, ContinuationError> {
         Self::new(problem, solver, point.x.clone(), point.lambda, options)
     }
 
@@ -695,11 +607,13 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         }
     }
 
-    fn reject(&mut self, lambda: f64, reason: RejectReason) -> ArclengthOutcome {
+    fn reject(&mut self, lambda: f64, reason: RejectReason) -> Step {
         let rejection = Rejection {
-            ds: self.ds,
+            step: self.accepted + 1,
             lambda,
+            step_size: self.ds,
             reason,
+            point: None,
         };
         self.ds *= self.options.shrink;
         if self.ds < self.options.ds_min {
@@ -712,19 +626,22 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 last: Box::new(rejection),
             };
             self.finished = Some(end.clone());
-            return ArclengthOutcome::Finished(end);
+            return Step::Finished(end);
         }
-        ArclengthOutcome::Rejected(rejection)
+        Step::Rejected(rejection)
     }
 
-    /// One predictor–corrector attempt.
-    pub fn step(&mut self) -> ArclengthOutcome {
+    /// One predictor–corrector attempt (the first call returns the corrected start).
+    pub fn step(&mut self) -> Step {
+        if let Some(start) = self.start.take() {
+            return Step::Accepted(start);
+        }
         if let Some(end) = &self.finished {
-            return ArclengthOutcome::Finished(end.clone());
+            return Step::Finished(end.clone());
         }
         if self.accepted >= self.options.max_steps {
             self.finished = Some(EndReason::MaxSteps);
-            return ArclengthOutcome::Finished(EndReason::MaxSteps);
+            return Step::Finished(EndReason::MaxSteps);
         }
         let n = self.problem.dimension();
         let direction = match (self.options.predictor, &self.previous) {
@@ -786,7 +703,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         if y[n] < lo || y[n] > hi {
             let end = EndReason::ParameterOutOfRange { lambda: y[n] };
             self.finished = Some(end.clone());
-            return ArclengthOutcome::Finished(end);
+            return Step::Finished(end);
         }
         if tangent[n] * self.tangent[n] < 0.0 {
             events.push(Event::Fold { lambda: y[n] });
@@ -830,7 +747,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 return self.escape(&escape, point.lambda);
             }
         }
-        ArclengthOutcome::Accepted(point)
+        Step::Accepted(point)
     }
 
     /// Parameter scale `s_lambda`.
@@ -850,7 +767,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     }
 
     /// Jumps past a stall: see [`StallEscape`].
-    fn escape(&mut self, escape: &StallEscape, now: f64) -> ArclengthOutcome {
+    fn escape(&mut self, escape: &StallEscape, now: f64) -> Step {
         let n = self.problem.dimension();
         let dir = self.options.direction;
         let scale = self.lambda_scale();
@@ -877,7 +794,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             if target < lo || target > hi {
                 let end = EndReason::ParameterOutOfRange { lambda: target };
                 self.finished = Some(end.clone());
-                return ArclengthOutcome::Finished(end);
+                return Step::Finished(end);
             }
             for from in &anchors {
                 let from_norm = self.metric.norm(&from.1);
@@ -906,61 +823,42 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                         let mut point =
                             self.point(self.accepted, &info, vec![Event::Jump { ratio }]);
                         point.step_size = target - now;
-                        return ArclengthOutcome::Accepted(point);
+                        return Step::Accepted(point);
                     }
                 }
             }
             distance *= 2.0;
         }
-        let end = EndReason::Stalled { lambda: now };
+        let end = EndReason::Stalled {
+            failures: escape.max_attempts,
+            lambda: now,
+        };
         self.finished = Some(end.clone());
-        ArclengthOutcome::Finished(end)
+        Step::Finished(end)
     }
 
-    /// Runs until the end, handing every outcome (accepted and rejected) to `observer`,
-    /// which may stop the run. Returns the branch (the start point is not included; pass it
-    /// in `start` to have it first).
-    pub fn run(
-        &mut self,
-        start: Option<Point>,
-        mut observer: impl FnMut(&ArclengthOutcome) -> ControlFlow<()>,
-    ) -> Branch {
-        let mut branch = Branch {
-            points: start.into_iter().collect(),
-            ..Default::default()
-        };
-        loop {
-            let outcome = self.step();
-            let stop = observer(&outcome).is_break();
-            match outcome {
-                ArclengthOutcome::Accepted(p) => branch.points.push(p),
-                ArclengthOutcome::Rejected(_) => branch.rejections += 1,
-                ArclengthOutcome::Finished(end) => {
-                    branch.end = Some(end);
-                    return branch;
-                }
-            }
-            if stop {
-                branch.end = Some(EndReason::StoppedByObserver);
-                self.finished = Some(EndReason::StoppedByObserver);
-                return branch;
-            }
-        }
+    /// Runs until the end, handing every step (the start, accepted points and rejections) to
+    /// `observer`, which may stop the run; returns the branch.
+    pub fn run(&mut self, observer: &mut (impl Observer + ?Sized)) -> Branch {
+        run_with(
+            self,
+            Self::step,
+            |d| d.finished = Some(EndReason::StoppedByObserver),
+            observer,
+        )
     }
 }
 
 impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<P, S> {
-    type Item = Point;
+    type Item = Result<Point, ContinuationError>;
 
-    /// Accepted points only (rejections are retried internally); ends with the run.
-    fn next(&mut self) -> Option<Point> {
-        loop {
-            match self.step() {
-                ArclengthOutcome::Accepted(p) => return Some(p),
-                ArclengthOutcome::Rejected(_) => continue,
-                ArclengthOutcome::Finished(_) => return None,
-            }
-        }
+    /// The accepted points (rejections are retried internally); then, if the run failed
+    /// ([`EndReason::error`]), its error; then `None`.
+    fn next(&mut self) -> Option<Self::Item> {
+        let mut done = self.done;
+        let item = next_point(&mut done, || self.step());
+        self.done = done;
+        item
     }
 }
 
@@ -1009,7 +907,7 @@ mod tests {
             scale: ArclengthScale::Fixed(1.0, 1.0),
             ..Default::default()
         };
-        let (mut driver, start) = Arclength::new(
+        let mut driver = Arclength::new(
             Circle { lambda: 0.0 },
             SemismoothNewton::default(),
             vec![0.9],
@@ -1017,10 +915,13 @@ mod tests {
             options,
         )
         .unwrap();
-        let branch = driver.run(Some(start), |_| ControlFlow::Continue(()));
+        let branch = driver.run(&mut crate::continuation::quiet);
         // Leaves through lambda < -0.5 on the lower half after turning at lambda = 1.
+        assert!(matches!(branch.end, EndReason::ParameterOutOfRange { lambda } if lambda < -0.5));
+        assert_eq!(branch.points[0].step, 0);
         assert!(
-            matches!(branch.end, Some(EndReason::ParameterOutOfRange { lambda }) if lambda < -0.5)
+            (branch.points[0].x[0] - 1.0).abs() < 1e-9,
+            "the corrected start"
         );
         let folds: Vec<_> = branch
             .with_event(|e| matches!(e, Event::Fold { .. }))
@@ -1049,7 +950,7 @@ mod tests {
             scale: ArclengthScale::Fixed(1.0, 1.0),
             ..Default::default()
         };
-        let (mut driver, _) = Arclength::new(
+        let mut driver = Arclength::new(
             Circle { lambda: 0.0 },
             SemismoothNewton::default(),
             vec![1.0],
@@ -1058,20 +959,22 @@ mod tests {
         )
         .unwrap();
         let mut seen = 0;
-        let branch = driver.run(None, |o| {
-            seen += usize::from(matches!(o, ArclengthOutcome::Accepted(_)));
+        let branch = driver.run(&mut |o: &Step| {
+            seen += usize::from(matches!(o, Step::Accepted(_)));
             if seen == 5 {
-                ControlFlow::Break(())
+                std::ops::ControlFlow::Break(())
             } else {
-                ControlFlow::Continue(())
+                std::ops::ControlFlow::Continue(())
             }
         });
         assert_eq!(branch.points.len(), 5);
-        assert_eq!(branch.end, Some(EndReason::StoppedByObserver));
+        assert_eq!(branch.end, EndReason::StoppedByObserver);
         assert!(matches!(
             driver.step(),
-            ArclengthOutcome::Finished(EndReason::StoppedByObserver)
+            Step::Finished(EndReason::StoppedByObserver)
         ));
+        // The iterator ends at once, without an error.
+        assert!(driver.next().is_none());
     }
 
     #[test]

@@ -1,25 +1,30 @@
 //! Numerical continuation of solution families `F(x, lambda) = 0`.
 //!
-//! The drivers know nothing about bars: they see a [`ContinuationProblem`] (residual,
-//! Jacobian in `x`, derivative in `lambda`) and a [`NonlinearSolver`](crate::solve::NonlinearSolver).
+//! The drivers know nothing about bars: they see a [`ContinuationProblem`] (a
+//! [`Problem`] at its current parameter, plus the parameter and the derivative in it) and a
+//! [`NonlinearSolver`](crate::solve::NonlinearSolver).
 //! [`NonsmoothSystem`](crate::system::NonsmoothSystem) is one in `lambda = Omega`;
 //! [`PeriodParametrised`] turns any problem in a frequency into one in the period.
 //!
-//! Three ways in, for the [`Sequential`] driver: [`Sequential::step`] (the caller owns the
-//! loop), `Iterator<Item = Point>`, and [`Sequential::run`] with an observer closure that can
-//! stop the run.
+//! Both drivers, natural-parameter ([`Sequential`]) and pseudo-arclength ([`Arclength`]),
+//! have one shape: `step()` returns a [`Step`] (the caller owns the loop); as an
+//! `Iterator<Item = Result<Point, ContinuationError>>` they yield the accepted points and
+//! then the error of a run that failed; `run(&mut observer)` returns a [`Branch`] whose end
+//! reason is always set, and the [`Observer`] (any closure `FnMut(&Step) -> ControlFlow<()>`)
+//! sees every step, accepted or rejected, and may stop the run.
+//!
+//! [`ContinuationError`]: crate::ContinuationError
 
 mod arclength;
+mod driver;
 mod progress;
 mod sequential;
 mod speculative;
 
-pub use arclength::{
-    Arclength, ArclengthOptions, ArclengthOutcome, ArclengthScale, Branch, EndReason, RejectReason,
-    Rejection, StallEscape, TangentPredictor,
-};
+pub use arclength::{Arclength, ArclengthOptions, ArclengthScale, StallEscape, TangentPredictor};
+pub use driver::{Branch, EndReason, Observer, RejectReason, Rejection, Step};
 pub use progress::{quiet, Progress};
-pub use sequential::{linspace, Predictor, Selection, Sequential, SequentialOptions, StepOutcome};
+pub use sequential::{linspace, Predictor, Selection, Sequential, SequentialOptions};
 pub use speculative::{Speculation, SpeculationStats};
 
 use crate::error::SolveError;

@@ -1,6 +1,6 @@
 //! Observers for long runs: a progress printer and the quiet default.
 
-use super::{ArclengthOutcome, Point};
+use super::{Observer, Point, Step};
 use std::io::Write;
 use std::ops::ControlFlow;
 
@@ -9,8 +9,9 @@ pub fn quiet<T: ?Sized>(_: &T) -> ControlFlow<()> {
     ControlFlow::Continue(())
 }
 
-/// Prints `step, parameter, measure, step size` every `every` accepted points (and every
-/// rejection with its reason) to a writer, standard error by default.
+/// An [`Observer`] that prints `step, parameter, measure, step size` every `every` accepted
+/// points, every rejection with its reason, and the end of the run, to a writer (standard
+/// error by default). Write errors are ignored: progress is advisory.
 ///
 /// ```
 /// use nonsmooth_modes::continuation::Progress;
@@ -60,8 +61,8 @@ impl<W: Write> Progress<W> {
         &self.writer
     }
 
-    /// Observes an accepted point. Write errors are ignored: progress is advisory.
-    pub fn point(&mut self, p: &Point) -> ControlFlow<()> {
+    /// Prints an accepted point if it is the `every`-th.
+    fn point(&mut self, p: &Point) {
         self.accepted += 1;
         if self.accepted % self.every == 0 {
             let measure = match &mut self.measure {
@@ -80,26 +81,25 @@ impl<W: Write> Progress<W> {
                 events.join(",")
             );
         }
-        ControlFlow::Continue(())
     }
+}
 
-    /// Observes an arclength outcome (accepted points, rejections and the end).
-    pub fn outcome(&mut self, outcome: &ArclengthOutcome) -> ControlFlow<()> {
-        match outcome {
-            ArclengthOutcome::Accepted(p) => self.point(p),
-            ArclengthOutcome::Rejected(r) => {
+impl<W: Write> Observer for Progress<W> {
+    fn observe(&mut self, step: &Step) -> ControlFlow<()> {
+        match step {
+            Step::Accepted(p) => self.point(p),
+            Step::Rejected(r) => {
                 let _ = writeln!(
                     self.writer,
-                    "rejected  parameter {:.8}  ds {:.3e}  {:?}",
-                    r.lambda, r.ds, r.reason
+                    "rejected  parameter {:.8}  step {:.3e}  {:?}",
+                    r.lambda, r.step_size, r.reason
                 );
-                ControlFlow::Continue(())
             }
-            ArclengthOutcome::Finished(end) => {
+            Step::Finished(end) => {
                 let _ = writeln!(self.writer, "finished: {end:?}");
-                ControlFlow::Continue(())
             }
         }
+        ControlFlow::Continue(())
     }
 }
 
@@ -122,11 +122,14 @@ mod tests {
                 step_size: 1.0,
                 events: Vec::new(),
             };
-            assert!(progress.point(&p).is_continue());
+            assert!(progress.observe(&Step::Accepted(p)).is_continue());
         }
+        let end = Step::Finished(super::super::EndReason::Completed);
+        assert!(progress.observe(&end).is_continue());
         let text = String::from_utf8(progress.writer().clone()).unwrap();
-        assert_eq!(text.lines().count(), 2);
+        assert_eq!(text.lines().count(), 3);
         assert!(text.lines().nth(1).unwrap().contains("x0 6.0"));
+        assert!(text.lines().nth(2).unwrap().contains("Completed"));
         assert!(quiet(&0).is_continue());
     }
 }

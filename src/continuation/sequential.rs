@@ -1,10 +1,12 @@
 //! Sequential (natural-parameter) continuation.
 
-use super::{ContinuationProblem, Point};
+use super::driver::{next_point, run_with, Acceptance};
+use super::{
+    Branch, ContinuationProblem, EndReason, Observer, Point, RejectReason, Rejection, Step,
+};
 use crate::error::{ContinuationError, SolveError};
 use crate::solve::{norm, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
-use std::ops::ControlFlow;
 
 /// How the next starting guess is formed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -49,7 +51,7 @@ pub enum Selection {
 pub struct SequentialOptions {
     /// Predictor (default [`Predictor::Constant`]).
     pub predictor: Predictor,
-    /// Stop with [`ContinuationError::Stalled`] after this many consecutive failed steps
+    /// End the run with [`EndReason::Stalled`] after this many consecutive failed steps
     /// (default 40; `usize::MAX` never stops).
     pub max_consecutive_failures: usize,
     /// When a step fails from the prediction, solve it again from up to `retry_depth` earlier
@@ -76,25 +78,12 @@ impl Default for SequentialOptions {
     }
 }
 
-/// What one call of [`Sequential::step`] did.
-#[derive(Debug, Clone, PartialEq)]
-pub enum StepOutcome {
-    /// The solver converged at the next parameter value.
-    Converged(Point),
-    /// The solver failed there; the branch goes on from the last converged point.
-    Failed(Point),
-    /// Every parameter value has been visited.
-    Finished,
-    /// Too many consecutive failures.
-    Stalled(ContinuationError),
-}
-
 /// Sequential continuation over a fixed list of parameter values: at each value, solve
 /// `F(x, lambda) = 0` from the predicted guess (and, if that fails and
 /// [`SequentialOptions::retry_depth`] allows, from earlier converged points; with
 /// [`Selection::LowestMeasure`] and a measure, from all of them, keeping the lowest measure).
-/// Failed steps are reported and skipped; the next step starts again from the last
-/// converged solution.
+/// Failed steps are reported ([`Step::Rejected`], with the solver's last iterate as a point)
+/// and skipped; the next step starts again from the last converged solution.
 pub struct Sequential<P, S> {
     pub(super) problem: P,
     pub(super) solver: S,
@@ -111,7 +100,10 @@ pub struct Sequential<P, S> {
     /// Converged points before `last`, the most recent first (at most `max(retry_depth, 1)`).
     pub(super) history: VecDeque<(Vec<f64>, f64)>,
     failures: usize,
-    stalled: bool,
+    /// Why the run ended, once it has.
+    finished: Option<EndReason>,
+    /// Whether the iterator has handed out the end.
+    done: bool,
     pub(super) accept: Option<Acceptance>,
     measure: Option<Measure>,
 }
@@ -132,9 +124,6 @@ impl Attempt {
         self.result.is_ok() && self.accepted
     }
 }
-
-/// A test that a converged solution `(x, lambda)` belongs to the branch.
-pub(super) type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
 
 /// A scalar ranking accepted solutions `(x, lambda)` for [`Selection::LowestMeasure`].
 type Measure = Box<dyn FnMut(&[f64], f64) -> f64>;
@@ -197,7 +186,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             last: start,
             history: VecDeque::new(),
             failures: 0,
-            stalled: false,
+            finished: None,
+            done: false,
             accept: None,
             measure: None,
         })
@@ -292,15 +282,18 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
         }
     }
 
-    /// The index and value of the next parameter, advancing the driver; `None` when the
-    /// values are exhausted or the run stalled.
-    pub(super) fn next_value(&mut self) -> Option<(usize, f64)> {
-        if self.stalled {
-            return None;
+    /// The index and value of the next parameter, advancing the driver; the end reason when
+    /// the values are exhausted or the run has ended.
+    pub(super) fn next_value(&mut self) -> Result<(usize, f64), EndReason> {
+        if let Some(end) = &self.finished {
+            return Err(end.clone());
         }
-        let lambda = *self.values.get(self.next)?;
+        let Some(&lambda) = self.values.get(self.next) else {
+            self.finished = Some(EndReason::Completed);
+            return Err(EndReason::Completed);
+        };
         self.next += 1;
-        Some((self.next - 1, lambda))
+        Ok((self.next - 1, lambda))
     }
 
     /// The number of earlier converged points a failed step may be retried from.
@@ -348,9 +341,10 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     }
 
     /// Solves at the next parameter value.
-    pub fn step(&mut self) -> StepOutcome {
-        let Some((step, lambda)) = self.next_value() else {
-            return StepOutcome::Finished;
+    pub fn step(&mut self) -> Step {
+        let (step, lambda) = match self.next_value() {
+            Ok(next) => next,
+            Err(end) => return Step::Finished(end),
         };
         let prediction = self.predict(lambda);
         let first = self.attempt_from(lambda, prediction, None);
@@ -363,11 +357,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     }
 
     /// Records the outcome of the step at `lambda`: on success the point joins the branch
-    /// (and the history), on failure the failure count grows. With
+    /// (and the history), on failure the failure count grows (and the run ends once it
+    /// reaches [`SequentialOptions::max_consecutive_failures`]). With
     /// [`Selection::FirstConverged`] a retry from `history[d]` drops the `d` points it stepped
     /// over; with [`Selection::LowestMeasure`] the history is a rolling window of the last
     /// converged points.
-    pub(super) fn conclude(&mut self, step: usize, lambda: f64, chosen: Attempt) -> StepOutcome {
+    pub(super) fn conclude(&mut self, step: usize, lambda: f64, chosen: Attempt) -> Step {
         let Attempt {
             x,
             result,
@@ -387,7 +382,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                     }
                 }
                 self.last_lambda = lambda;
-                StepOutcome::Converged(Point {
+                Step::Accepted(Point {
                     step,
                     lambda,
                     x,
@@ -425,6 +420,11 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                     ) => *iteration,
                     _ => 0,
                 };
+                let step_size = lambda - self.last_lambda;
+                let reason = match &error {
+                    Some(e) => RejectReason::Solver(e.clone()),
+                    None => RejectReason::NotAccepted,
+                };
                 let point = Point {
                     step,
                     lambda,
@@ -433,64 +433,47 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                     iterations,
                     converged: false,
                     error,
-                    step_size: lambda - self.last_lambda,
+                    step_size,
                     events: Vec::new(),
                 };
                 if self.failures >= self.options.max_consecutive_failures {
-                    self.stalled = true;
-                    return StepOutcome::Stalled(ContinuationError::Stalled {
+                    self.finished = Some(EndReason::Stalled {
                         failures: self.failures,
-                        parameter: lambda,
+                        lambda,
                     });
                 }
-                StepOutcome::Failed(point)
+                Step::Rejected(Rejection {
+                    step,
+                    lambda,
+                    step_size,
+                    reason,
+                    point: Some(point),
+                })
             }
         }
     }
 
-    /// Runs to the end, handing every point to `observer`; the observer stops the run by
-    /// returning `ControlFlow::Break(())`. Returns the number of steps taken.
-    ///
-    /// # Errors
-    /// [`ContinuationError::Stalled`] if too many consecutive steps failed.
-    pub fn run(
-        &mut self,
-        observer: impl FnMut(&Point) -> ControlFlow<()>,
-    ) -> Result<usize, ContinuationError> {
-        run_with(self, Self::step, observer)
+    /// Runs to the end, handing every step to `observer`, which may stop the run. The
+    /// branch holds the converged points; the failed ones were shown to the observer.
+    pub fn run(&mut self, observer: &mut (impl Observer + ?Sized)) -> Branch {
+        run_with(self, Self::step, Self::stop, observer)
     }
-}
 
-/// Steps `driver` with `step` until the values run out, the run stalls or `observer` stops
-/// it; returns the number of steps taken.
-pub(super) fn run_with<D>(
-    driver: &mut D,
-    mut step: impl FnMut(&mut D) -> StepOutcome,
-    mut observer: impl FnMut(&Point) -> ControlFlow<()>,
-) -> Result<usize, ContinuationError> {
-    let mut taken = 0;
-    loop {
-        let point = match step(driver) {
-            StepOutcome::Converged(p) | StepOutcome::Failed(p) => p,
-            StepOutcome::Finished => return Ok(taken),
-            StepOutcome::Stalled(e) => return Err(e),
-        };
-        taken += 1;
-        if observer(&point).is_break() {
-            return Ok(taken);
-        }
+    /// Ends the run at the observer's request.
+    pub(super) fn stop(&mut self) {
+        self.finished = Some(EndReason::StoppedByObserver);
     }
 }
 
 impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<P, S> {
-    type Item = Point;
+    type Item = Result<Point, ContinuationError>;
 
-    /// Converged and failed points alike; ends when the values run out or the run stalls.
-    fn next(&mut self) -> Option<Point> {
-        match self.step() {
-            StepOutcome::Converged(p) | StepOutcome::Failed(p) => Some(p),
-            StepOutcome::Finished | StepOutcome::Stalled(_) => None,
-        }
+    /// The converged points; then, if the run stalled, its error; then `None`.
+    fn next(&mut self) -> Option<Self::Item> {
+        let mut done = self.done;
+        let item = next_point(&mut done, || self.step());
+        self.done = done;
+        item
     }
 }
 

@@ -8,9 +8,10 @@
 //! (a step that converges quickly never starts a thread), and it is cancelled as soon as the
 //! first attempt joins the branch.
 
-use super::sequential::{accepts, run_with, Attempt};
-use super::{ContinuationProblem, Sequential, StepOutcome};
-use crate::error::{ContinuationError, SolveError};
+use super::driver::run_with;
+use super::sequential::{accepts, Attempt};
+use super::{Branch, ContinuationProblem, Observer, Sequential, Step};
+use crate::error::SolveError;
 use crate::solve::{NonlinearSolver, SolveInfo, SolveMonitor};
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -193,12 +194,13 @@ where
     /// ([`Sequential::with_measure`]) this is [`Sequential::step`]: every start of every step
     /// is solved anyway, so a retry is never speculative, and the serial path is the one whose
     /// result is the reference.
-    pub fn step_speculative(&mut self, speculation: Speculation) -> StepOutcome {
+    pub fn step_speculative(&mut self, speculation: Speculation) -> Step {
         if self.selects_lowest() {
             return self.step();
         }
-        let Some((step, lambda)) = self.next_value() else {
-            return StepOutcome::Finished;
+        let (step, lambda) = match self.next_value() {
+            Ok(next) => next,
+            Err(end) => return Step::Finished(end),
         };
         let mut x = self.predict(lambda);
         if self.retry_count() > 0 && self.worker.is_none() {
@@ -285,19 +287,17 @@ where
         self.conclude(step, lambda, chosen)
     }
 
-    /// [`Sequential::run`] with [`Sequential::step_speculative`]: the same points, in less
+    /// [`Sequential::run`] with [`Sequential::step_speculative`]: the same branch, in less
     /// wall time when steps fail.
-    ///
-    /// # Errors
-    /// [`ContinuationError::Stalled`] if too many consecutive steps failed.
     pub fn run_speculative(
         &mut self,
         speculation: Speculation,
-        observer: impl FnMut(&super::Point) -> ControlFlow<()>,
-    ) -> Result<usize, ContinuationError> {
+        observer: &mut (impl Observer + ?Sized),
+    ) -> Branch {
         run_with(
             self,
             |driver| driver.step_speculative(speculation),
+            Self::stop,
             observer,
         )
     }

@@ -2,8 +2,8 @@
 //! period, with energies normalised by the first grazing energy.
 
 use crate::continuation::{
-    linspace, Arclength, ArclengthOptions, ArclengthOutcome, Branch, Event, PeriodParametrised,
-    Point, Predictor, Selection, Sequential, SequentialOptions, Speculation, StallEscape,
+    linspace, Arclength, ArclengthOptions, Branch, Event, Observer, PeriodParametrised, Point,
+    Predictor, Selection, Sequential, SequentialOptions, Speculation, StallEscape, Step,
 };
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
@@ -160,9 +160,7 @@ pub fn backbone_with<S: NonlinearSolver>(
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
-    let run = |driver: &mut Sequential<_, S>, see: &mut dyn FnMut(&Point) -> ControlFlow<()>| {
-        driver.run(see)
-    };
+    let run = |driver: &mut Sequential<_, S>, see: &mut dyn Observer| driver.run(see);
     drive_backbone(system, settings, options, solver, run, observer)
 }
 
@@ -182,7 +180,7 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
-    let run = |driver: &mut Sequential<_, S>, see: &mut dyn FnMut(&Point) -> ControlFlow<()>| {
+    let run = |driver: &mut Sequential<_, S>, see: &mut dyn Observer| {
         driver.run_speculative(speculation, see)
     };
     drive_backbone(system, settings, options, solver, run, observer)
@@ -197,8 +195,8 @@ fn drive_backbone<S: NonlinearSolver>(
     solver: S,
     run: impl FnOnce(
         &mut Sequential<PeriodParametrised<NonsmoothSystem>, S>,
-        &mut dyn FnMut(&Point) -> ControlFlow<()>,
-    ) -> Result<usize, ContinuationError>,
+        &mut dyn Observer,
+    ) -> Branch,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
@@ -265,7 +263,11 @@ fn drive_backbone<S: NonlinearSolver>(
             f64::NAN
         }
     });
-    run(&mut driver, &mut |p: &Point| {
+    // Converged points and the solver's last iterates of failed steps alike.
+    let branch = run(&mut driver, &mut |step: &Step| {
+        let Some(p) = step.point() else {
+            return ControlFlow::Continue(());
+        };
         let omega = 2.0 * PI / p.lambda;
         let known = {
             let last = last_energy.borrow();
@@ -273,8 +275,11 @@ fn drive_backbone<S: NonlinearSolver>(
         };
         let e = known.unwrap_or_else(|| energy(system, &basis, &p.x, omega));
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
-    })?;
-    Ok(e_g)
+    });
+    match branch.end.error() {
+        Some(e) => Err(e.into()),
+        None => Ok(e_g),
+    }
 }
 
 /// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
@@ -378,28 +383,15 @@ pub fn arclength_backbone<S: NonlinearSolver>(
     };
     let floor = options.trivial_energy * e_g;
     let (accept_system, accept_basis) = (system.clone(), basis.clone());
-    let (driver, first) = Arclength::new(problem, solver, start, omega0, arclength)?;
-    let mut driver = driver
+    let mut driver = Arclength::new(problem, solver, start, omega0, arclength)?
         .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
-    let mut report = |p: &Point| {
-        observer(&BackbonePoint::from_point(
+    let branch = driver.run(&mut |step: &Step| match step {
+        Step::Accepted(p) => observer(&BackbonePoint::from_point(
             p,
             p.lambda,
             energy(system, &basis, &p.x, p.lambda),
             e_g,
-        ))
-    };
-    if report(&first).is_break() {
-        return Ok((
-            e_g,
-            Branch {
-                points: vec![first],
-                ..Default::default()
-            },
-        ));
-    }
-    let branch = driver.run(Some(first), |outcome| match outcome {
-        ArclengthOutcome::Accepted(p) => report(p),
+        )),
         _ => ControlFlow::Continue(()),
     });
     Ok((e_g, branch))

@@ -136,9 +136,11 @@ pub(super) fn draw_map_panel(area: &Area<'_>, panel: &MapPanel) -> Result<(), Pl
         }))
         .map_err(draw_err)?;
     for (i, s) in panel.overlay.iter().enumerate() {
-        let color = s
-            .color
-            .unwrap_or(if i == 0 { Rgb::BLACK } else { PALETTE[i] });
+        let color = s.color.unwrap_or(if i == 0 {
+            Rgb::BLACK
+        } else {
+            PALETTE[i % PALETTE.len()]
+        });
         for run in clip_segments(segments(&s.points, false, false), xr, yr) {
             draw_run(&mut chart, &run, s, color.color(), false)?;
         }
