@@ -31,6 +31,7 @@
 //! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`], [`solve::SmoothingHomotopy`] |
 //! | [`continuation::ContinuationProblem`] | [`continuation::Sequential`], [`continuation::Arclength`] (with [`continuation::StallEscape`]), [`system::ParameterFamily`] for any system parameter |
 //! | [`modal::backbone()`], [`modal::arclength_backbone`] | one call: a backbone with `E / E_g` |
+//! | [`Solution`] | a computed motion (problem, unknowns, frequency): energy, `E/E_g`, fields, end and law histories, diagnostics, time-domain check |
 //! | [`modal::diagnose`], [`modal::FieldEvaluator`] | residual norm `R^(m)`, penetration, fields, histories of a point |
 //! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |
 //! | [`mod@reference`] | the paper's systems and exact solutions |
@@ -85,6 +86,7 @@ pub mod modal;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod reference;
+pub mod solution;
 pub mod solve;
 /// Proptest strategies for bars, frequencies, Helmholtz coefficients, the paper's systems and
 /// periods, for property tests of the crate's identities (feature `proptest`).
@@ -97,3 +99,4 @@ pub mod system;
 pub mod verify;
 
 pub use error::{ContinuationError, Error, ModelError, SettingsError, SolveError};
+pub use solution::Solution;

@@ -5,9 +5,11 @@ use crate::continuation::{
     linspace, Arclength, ArclengthOptions, Branch, Event, Observer, PeriodParametrised, Point,
     Predictor, Selection, Sequential, SequentialOptions, Speculation, StallEscape, Step,
 };
-use crate::error::{ContinuationError, Error};
+use crate::error::{ContinuationError, Error, SettingsError};
+use crate::fourier::Basis;
 use crate::modal::energy::energy;
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
+use crate::solution::Solution;
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
 use std::cell::RefCell;
@@ -127,6 +129,18 @@ pub struct BackbonePoint {
 }
 
 impl BackbonePoint {
+    /// The point as a [`Solution`] of `problem` (the problem the backbone was computed for),
+    /// to ask it for fields, histories, diagnostics and the time-domain check.
+    ///
+    /// # Errors
+    /// See [`Solution::new`]: a point whose unknowns do not fit `problem`.
+    pub fn solution<'a, B: Basis>(
+        &'a self,
+        problem: &'a NonsmoothSystem<B>,
+    ) -> Result<Solution<'a, B>, SettingsError> {
+        Solution::new(problem, &self.x, self.omega)
+    }
+
     /// The backbone view of a continuation point at fundamental frequency `omega`, with its
     /// energy `energy` and the grazing energy `e_g` used for normalisation.
     pub fn from_point(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {

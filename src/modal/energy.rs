@@ -26,7 +26,7 @@
 use crate::bar::{Bar, End, EndRef};
 use crate::bem::sinc;
 use crate::fourier::Basis;
-use crate::system::BarSystem;
+use crate::system::{BarSystem, Layout};
 
 /// Energy `E = sum_b EA_b/2 int (u_t^2/c_b^2 + u_x^2) dx + energy stored in conditions`,
 /// evaluated at `t = 0` (phase `theta = 0`) for the solution `x` of a system with basis
@@ -48,6 +48,7 @@ pub fn energy_at<B: Basis>(
 ) -> f64 {
     let len = basis.len();
     let nb = system.bars().len();
+    let layout = Layout::of(system);
     // Two allocations per call: the time weights `w_i = phi_i(theta)`,
     // `v_i = omega phi_i'(theta)` with the end displacements `u_b(0), u_b(l_b)` that the
     // conditions read, and the harmonics of one bar, refilled bar after bar.
@@ -65,7 +66,7 @@ pub fn energy_at<B: Basis>(
     let mut harmonics = Harmonics::new(len);
     let mut total = 0.0;
     for (b, bar) in system.bars().iter().enumerate() {
-        harmonics.fill(bar, basis, x, (b, nb), omega, (w, v));
+        harmonics.fill(bar, basis, x, (b, layout), omega, (w, v));
         let (strain, kinetic) = if moving {
             harmonics.quadratic_forms::<true>()
         } else {
@@ -140,22 +141,21 @@ impl Harmonics {
         }
     }
 
-    /// Fills in bar `b` of `nb` of the solution `x` at fundamental frequency `omega`, with
-    /// the time weights `(w, v)`.
+    /// Fills in bar `b` (laid out by `layout`) of the solution `x` at fundamental frequency
+    /// `omega`, with the time weights `(w, v)`.
     fn fill<B: Basis>(
         &mut self,
         bar: &Bar,
         basis: &B,
         x: &[f64],
-        (b, nb): (usize, usize),
+        (b, layout): (usize, Layout),
         omega: f64,
         (w, v): (&[f64], &[f64]),
     ) {
         let l = bar.length();
         self.l = l;
         for i in 0..self.len {
-            let j = (i * nb + b) * 2;
-            let (a, bi) = (x[j], x[j + 1]);
+            let (a, bi) = layout.pair(x, i, b);
             let k = bar.wavenumber(basis.harmonic(i) as f64 * omega);
             let z = k * l;
             let (s, c) = z.sin_cos();
@@ -371,8 +371,8 @@ mod tests {
         for (b, bar) in system.bars().iter().enumerate() {
             harmonics.clear();
             harmonics.extend((0..len).map(|i| {
-                let j = (i * nb + b) * 2;
-                OracleHarmonic::new(bar, basis.harmonic(i) as f64 * omega, x[j], x[j + 1])
+                let (a, bi) = Layout::of(system).pair(x, i, b);
+                OracleHarmonic::new(bar, basis.harmonic(i) as f64 * omega, a, bi)
             }));
             let c2 = bar.wave_speed() * bar.wave_speed();
             let (mut strain, mut kinetic) = (0.0, 0.0);

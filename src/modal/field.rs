@@ -2,7 +2,7 @@
 
 use crate::bem::sinc;
 use crate::fourier::Basis;
-use crate::system::BarSystem;
+use crate::system::{BarSystem, Layout};
 
 /// Displacement `u`, velocity `u_t` and strain `u_x` at one point and instant.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -65,12 +65,11 @@ impl<'a, B: Basis> FieldEvaluator<'a, B> {
         dphi: &[f64],
     ) -> FieldValue {
         let b = &self.system.bars()[bar];
-        let nb = self.system.bars().len();
+        let layout = Layout::of(self.system);
         let mut v = FieldValue::default();
         for i in 0..self.basis.len() {
             let k = b.wavenumber(self.basis.harmonic(i) as f64 * self.omega);
-            let j = (i * nb + bar) * 2;
-            let (a, bb) = (self.x[j], self.x[j + 1]);
+            let (a, bb) = layout.pair(self.x, i, bar);
             let (s, c) = (k * position).sin_cos();
             let u = a * c + bb * position * sinc(k * position);
             let ux = -a * k * s + bb * c;

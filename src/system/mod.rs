@@ -2,6 +2,7 @@
 //!
 //! - [`assembly`]: the builder and the validated [`BarSystem`].
 //! - [`family`]: continuation in any scalar parameter of the system.
+//! - [`Layout`]: where each unknown lives.
 //! - [`rows`]: per-harmonic linear rows and observables in the Helmholtz unknowns `(A, B)`.
 //! - [`problem`]: the square nonsmooth system `F(x; Omega) = 0`, its generalised Jacobian and
 //!   `dF/dOmega`.
@@ -9,9 +10,11 @@
 pub mod assembly;
 mod condense;
 pub mod family;
+mod layout;
 pub mod problem;
 pub mod rows;
 
 pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};
+pub use layout::Layout;
 pub use problem::{HarmonicBalance, NonsmoothSystem};

@@ -24,7 +24,7 @@ use crate::linalg::DenseMatrix;
 use crate::solve::{point_on_ray, Problem, SingularStep, Structured};
 use crate::system::condense::{CondenseScratch, Condensed};
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
-use crate::system::BarSystem;
+use crate::system::{BarSystem, Layout};
 use step::Reduced;
 
 /// Harmonic-balance settings.
@@ -320,9 +320,15 @@ impl<B: Basis> NonsmoothSystem<B> {
         self.basis.len() * self.unknowns
     }
 
-    /// Index in `x` of coefficient `i`, bar `bar`, Helmholtz component `which` (0: `A`, 1: `B`).
+    /// Index in `x` of coefficient `i`, bar `bar`, Helmholtz component `which` (0: `A`, 1: `B`),
+    /// as in [`Layout`].
     pub fn index(&self, i: usize, bar: usize, which: usize) -> usize {
-        i * self.unknowns + 2 * bar + which
+        self.layout().index(i, bar, which)
+    }
+
+    /// Where each unknown lives.
+    pub fn layout(&self) -> Layout {
+        Layout::of(&self.system)
     }
 
     /// The per-harmonic rows at fundamental frequency `omega` (the problem moves to `omega`).

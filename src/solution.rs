@@ -1,0 +1,222 @@
+//! A computed periodic motion as one value: the harmonic-balance problem it solves, its
+//! unknowns and its fundamental frequency, with the post-processing questions as methods.
+//!
+//! ```
+//! use nonsmooth_modes::continuation::ContinuationProblem;
+//! use nonsmooth_modes::modal::branch_seed;
+//! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+//! use nonsmooth_modes::solution::Solution;
+//! use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
+//! use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+//!
+//! let system = clamped_bar_with_obstacle(1e-3)?;
+//! let settings = HarmonicBalance { harmonics: 10, ..Default::default() };
+//! let mut problem = NonsmoothSystem::new(&system, settings)?;
+//! let omega = 2.0 * std::f64::consts::PI / 3.6;
+//! let mut x = branch_seed(&mut problem, 1, 1, omega)?;
+//! problem.set_parameter(omega);
+//! SemismoothNewton::default().solve(&mut problem, &mut x)?;
+//! let mode = Solution::new(&problem, &x, omega)?;
+//! assert!(mode.energy_normalized()? > 1.0);
+//! let tip = mode.field().at(0, 1.0, 0.0);
+//! assert!((tip.displacement - 1e-3).abs() < 1e-4); // at the obstacle at t = 0
+//! # Ok::<(), nonsmooth_modes::Error>(())
+//! ```
+
+use crate::bar::EndRef;
+use crate::error::SettingsError;
+use crate::fourier::{Basis, CosineBasis};
+use crate::modal::diagnostics::{
+    diagnose, displacement_grid, end_history, law_history, EndHistory, FieldGrid, LawHistory,
+    PointDiagnostics,
+};
+use crate::modal::energy::{energy, energy_at};
+use crate::modal::field::FieldEvaluator;
+use crate::modal::linear::grazing_energy;
+use crate::system::{BarSystem, NonsmoothSystem};
+use crate::verify::{periodicity_check, PeriodicityOptions, PeriodicityReport, VerifyError};
+
+/// A periodic motion `x` of `problem` at fundamental frequency `omega` (borrowed: build one
+/// from a branch point whenever a question is to be asked).
+#[derive(Debug, Clone, Copy)]
+pub struct Solution<'a, B: Basis = CosineBasis> {
+    problem: &'a NonsmoothSystem<B>,
+    x: &'a [f64],
+    omega: f64,
+}
+
+impl<'a, B: Basis> Solution<'a, B> {
+    /// The motion `x` of `problem` at `omega`.
+    ///
+    /// # Errors
+    /// [`SettingsError::Length`] if `x` does not have the problem's dimension, and
+    /// [`SettingsError::NotPositive`] for a non-positive or non-finite `omega` or unknowns
+    /// that are not finite.
+    pub fn new(
+        problem: &'a NonsmoothSystem<B>,
+        x: &'a [f64],
+        omega: f64,
+    ) -> Result<Self, SettingsError> {
+        if x.len() != problem.dimension() {
+            return Err(SettingsError::Length {
+                what: "unknowns",
+                got: x.len(),
+                expected: problem.dimension(),
+            });
+        }
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(SettingsError::NotPositive {
+                what: "fundamental frequency",
+                value: omega,
+            });
+        }
+        if let Some(v) = x.iter().find(|v| !v.is_finite()) {
+            return Err(SettingsError::NotPositive {
+                what: "unknowns (finite)",
+                value: *v,
+            });
+        }
+        Ok(Self { problem, x, omega })
+    }
+
+    /// The problem the motion solves.
+    pub fn problem(&self) -> &'a NonsmoothSystem<B> {
+        self.problem
+    }
+
+    /// The bar system.
+    pub fn system(&self) -> &'a BarSystem {
+        self.problem.system()
+    }
+
+    /// The unknowns (layout of [`NonsmoothSystem`]).
+    pub fn unknowns(&self) -> &'a [f64] {
+        self.x
+    }
+
+    /// The fundamental angular frequency `Omega`.
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// The period `T = 2 pi / Omega`.
+    pub fn period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.omega
+    }
+
+    /// The mechanical energy `E` at `t = 0` (formulation §7).
+    pub fn energy(&self) -> f64 {
+        energy(self.system(), self.problem.basis(), self.x, self.omega)
+    }
+
+    /// The energy at phase `theta = Omega t` (constant for an exact motion).
+    pub fn energy_at(&self, theta: f64) -> f64 {
+        energy_at(
+            self.system(),
+            self.problem.basis(),
+            self.x,
+            self.omega,
+            theta,
+        )
+    }
+
+    /// `E / E_g`, with `E_g` the system's first grazing energy
+    /// ([`grazing_energy`]: a linear modal analysis per call; divide [`Solution::energy`] by a
+    /// stored `E_g` in loops).
+    ///
+    /// # Errors
+    /// See [`grazing_energy`].
+    pub fn energy_normalized(&self) -> Result<f64, SettingsError> {
+        let (e_g, _) = grazing_energy(self.system())?;
+        Ok(self.energy() / e_g)
+    }
+
+    /// Displacement, velocity and strain anywhere in any bar.
+    pub fn field(&self) -> FieldEvaluator<'a, B> {
+        FieldEvaluator::new(self.system(), self.problem.basis(), self.x, self.omega)
+    }
+
+    /// Histories of one bar end over a period on `samples` instants.
+    ///
+    /// # Errors
+    /// [`SettingsError::Length`] if `end` names a bar the system does not have.
+    pub fn end_history(&self, end: EndRef, samples: usize) -> Result<EndHistory, SettingsError> {
+        self.check_bar(end.bar.index())?;
+        Ok(end_history(
+            self.system(),
+            self.problem.basis(),
+            self.x,
+            self.omega,
+            end,
+            samples,
+        ))
+    }
+
+    /// `u(x, t)` of bar `bar` on `positions x instants` points over a period.
+    ///
+    /// # Errors
+    /// [`SettingsError::Length`] if there is no bar `bar`.
+    pub fn displacement_grid(
+        &self,
+        bar: usize,
+        positions: usize,
+        instants: usize,
+    ) -> Result<FieldGrid, SettingsError> {
+        self.check_bar(bar)?;
+        Ok(displacement_grid(
+            self.system(),
+            self.problem.basis(),
+            self.x,
+            self.omega,
+            bar,
+            positions,
+            instants,
+        ))
+    }
+
+    /// Gap, force and pointwise residual of unilateral law `law` over a period.
+    ///
+    /// # Errors
+    /// See [`law_history`].
+    pub fn law_history(&self, law: usize, samples: usize) -> Result<LawHistory, SettingsError> {
+        law_history(self.problem, self.x, self.omega, law, samples)
+    }
+
+    /// Residual norms `R^(m)`, penetration, tensile force and energy drift.
+    ///
+    /// # Errors
+    /// See [`diagnose`].
+    pub fn diagnose(&self, refinement: usize) -> Result<PointDiagnostics, SettingsError> {
+        diagnose(self.problem, self.x, self.omega, refinement)
+    }
+
+    /// The exact time-domain march of the motion over its period and the periodicity defect.
+    ///
+    /// # Errors
+    /// See [`periodicity_check`].
+    pub fn periodicity_check(
+        &self,
+        options: &PeriodicityOptions,
+    ) -> Result<PeriodicityReport, VerifyError> {
+        periodicity_check(
+            self.system(),
+            self.problem.basis(),
+            self.x,
+            self.omega,
+            options,
+        )
+    }
+
+    fn check_bar(&self, bar: usize) -> Result<(), SettingsError> {
+        let bars = self.system().bars().len();
+        if bar < bars {
+            Ok(())
+        } else {
+            Err(SettingsError::Length {
+                what: "bar index (one past the last bar)",
+                got: bar + 1,
+                expected: bars,
+            })
+        }
+    }
+}
