@@ -1,10 +1,14 @@
 //! Typed errors. Every variant carries the numbers that explain it.
+//!
+//! Every enum here is `#[non_exhaustive]`: later versions may add variants, so a `match` on
+//! one outside the crate ends with a wildcard arm.
 
 use crate::end::EndRef;
 use thiserror::Error;
 
 /// Errors raised while describing a bar system (bars, boundary conditions, assembly).
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ModelError {
     /// A physical parameter is not strictly positive and finite.
     #[error("{what} must be positive and finite, got {value}")]
@@ -78,6 +82,7 @@ pub enum ModelError {
 
 /// Errors in harmonic-balance settings or evaluation points.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum SettingsError {
     /// The number of harmonics is zero.
     #[error("the number of harmonics must be at least 1, got 0")]
@@ -160,6 +165,7 @@ pub enum SettingsError {
 /// Errors of a nonlinear solve.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub enum SolveError {
     /// The iteration budget ran out before the tolerance was met.
     #[error("no convergence after {iterations} iterations: residual norm {residual_norm:e} > tolerance {tolerance:e}")]
@@ -253,6 +259,7 @@ pub enum SolveError {
 
 /// Errors of a continuation run.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ContinuationError {
     /// An option is invalid (non-finite, empty range, zero steps...).
     #[error("invalid continuation option {what}: {value}")]
@@ -293,6 +300,7 @@ pub enum ContinuationError {
 
 /// Errors of the time-domain integrator and of the periodicity check ([`crate::verify`]).
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum VerifyError {
     /// A boundary condition has a form the integrator cannot advance exactly.
     #[error("condition `{condition}` is not supported by the time-domain integrator: {reason}")]
@@ -380,6 +388,7 @@ pub enum VerifyError {
 
 /// Any error of the crate.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum Error {
     /// See [`ModelError`].
     #[error(transparent)]
