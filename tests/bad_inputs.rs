@@ -43,7 +43,10 @@ fn clamped() -> BarSystem {
 fn linear_only() -> BarSystem {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
-    b.dirichlet(bar.left()).neumann(bar.right());
+    b.dirichlet(bar.left())
+        .unwrap()
+        .neumann(bar.right())
+        .unwrap();
     b.build().unwrap()
 }
 
@@ -96,8 +99,11 @@ fn assembly_errors_name_the_end_or_condition() {
     let one = b.add_bar(Bar::unit());
     let two = b.add_bar(Bar::unit());
     b.dirichlet(one.left())
+        .unwrap()
         .dirichlet(one.right())
-        .neumann(two.right());
+        .unwrap()
+        .neumann(two.right())
+        .unwrap();
     assert_eq!(
         b.build().unwrap_err(),
         ModelError::UnconstrainedEnd { end: two.left() }
@@ -105,8 +111,12 @@ fn assembly_errors_name_the_end_or_condition() {
     let message = b.build().unwrap_err().to_string();
     assert!(message.contains("left (x = 0) of bar 1"), "{message}");
 
-    // An end with two conditions, named in order.
-    b.neumann(two.left()).signorini(two.left(), 0.1).unwrap();
+    // An end with two conditions, named in order: each is valid on its own, so the builder
+    // takes both and `build` rejects the pair.
+    b.neumann(two.left())
+        .unwrap()
+        .signorini(two.left(), 0.1)
+        .unwrap();
     match b.build().unwrap_err() {
         ModelError::OverconstrainedEnd { end, first, second } => {
             assert_eq!(end, two.left());
@@ -116,16 +126,18 @@ fn assembly_errors_name_the_end_or_condition() {
         other => panic!("expected OverconstrainedEnd, got {other:?}"),
     }
 
-    // A contact of an end with itself.
+    // A contact of an end with itself: rejected at the call, and not added.
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
-    b.dirichlet(bar.left())
-        .contact(bar.right(), bar.right(), 0.1)
-        .unwrap();
+    b.dirichlet(bar.left()).unwrap();
     assert!(matches!(
-        b.build(),
+        b.contact(bar.right(), bar.right(), 0.1),
         Err(ModelError::RepeatedEnd { end, .. }) if end == bar.right()
     ));
+    assert_eq!(
+        b.build().unwrap_err(),
+        ModelError::UnconstrainedEnd { end: bar.right() }
+    );
 }
 
 #[test]
@@ -138,9 +150,10 @@ fn unknown_bar_from_another_builder() {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
     b.dirichlet(bar.left())
+        .unwrap()
         .neumann(bar.right())
-        .dirichlet(foreign.left());
-    match b.build().unwrap_err() {
+        .unwrap();
+    match b.dirichlet(foreign.left()).unwrap_err() {
         ModelError::UnknownBar {
             condition,
             bar,
@@ -151,6 +164,8 @@ fn unknown_bar_from_another_builder() {
         }
         other => panic!("expected UnknownBar, got {other:?}"),
     }
+    // The rejected condition was not added.
+    assert!(b.build().is_ok());
 }
 
 /// A condition that gives `rows` linear rows on `ends.len()` ends.
@@ -180,15 +195,12 @@ fn wrong_equation_count() {
         let mut b = AssemblyBuilder::new();
         let bar = b.add_bar(Bar::unit());
         let all = [bar.left(), bar.right()];
-        b.add_condition(Miscounted {
+        let result = b.add_condition(Miscounted {
             ends: all[..ends].to_vec(),
             rows,
         });
-        if ends == 1 {
-            b.neumann(bar.right());
-        }
         assert_eq!(
-            b.build().unwrap_err(),
+            result.map(|_| ()).unwrap_err(),
             ModelError::EquationCount {
                 condition: "miscounted".into(),
                 ends,
