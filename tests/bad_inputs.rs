@@ -700,6 +700,59 @@ fn invalid_solver_options() {
     assert!(Dogleg::new(DoglegOptions::default()).is_ok());
 }
 
+/// The options' own `validate` gives the error of the constructor, and a solver keeps the
+/// options it was built with (the defaults for `Default`).
+#[test]
+fn solver_options_validate_and_read_back() {
+    let newton = NewtonOptions {
+        min_step: 1e-6,
+        ..NewtonOptions::fail_fast()
+    };
+    assert_eq!(newton.validate(), Ok(()));
+    assert_eq!(SemismoothNewton::new(newton).unwrap().options(), &newton);
+    assert_eq!(
+        SemismoothNewton::default().options(),
+        &NewtonOptions::default()
+    );
+    let bad = NewtonOptions {
+        max_evaluations: 0,
+        ..newton
+    };
+    assert_eq!(
+        bad.validate(),
+        SemismoothNewton::new(bad).map(|_| ()),
+        "max_evaluations"
+    );
+    assert!(bad.validate().is_err());
+
+    let dogleg = DoglegOptions {
+        initial_radius: 0.5,
+        ..DoglegOptions::default()
+    };
+    assert_eq!(dogleg.validate(), Ok(()));
+    assert_eq!(Dogleg::new(dogleg).unwrap().options(), &dogleg);
+    assert_eq!(Dogleg::default().options(), &DoglegOptions::default());
+    for min_radius in [0.0, f64::NAN] {
+        let bad = DoglegOptions {
+            min_radius,
+            ..dogleg
+        };
+        match (bad.validate(), Dogleg::new(bad)) {
+            (
+                Err(SolveError::InvalidOption {
+                    what: "min_radius",
+                    value,
+                }),
+                Err(SolveError::InvalidOption {
+                    what: "min_radius",
+                    value: again,
+                }),
+            ) => assert!(same(value, min_radius) && same(again, min_radius)),
+            other => panic!("min_radius = {min_radius}: {other:?}"),
+        }
+    }
+}
+
 type Driver = Sequential<NonsmoothSystem, SemismoothNewton>;
 
 #[test]
