@@ -1,7 +1,9 @@
 //! Bars and their ends.
 
-use crate::error::{positive, ModelError};
-use std::fmt;
+use crate::check::positive;
+use crate::error::ModelError;
+
+pub use crate::end::{BarId, End, EndRef};
 
 /// A homogeneous elastic bar: `u_tt = c^2 u_xx` on `x in [0, length]`.
 ///
@@ -59,72 +61,6 @@ impl Bar {
     /// Wave number `k = omega / c` of a harmonic of angular frequency `omega`.
     pub fn wavenumber(&self, omega: f64) -> f64 {
         omega / self.wave_speed
-    }
-}
-
-/// Identifies a bar inside one assembly; minted by
-/// [`AssemblyBuilder::add_bar`](crate::system::AssemblyBuilder::add_bar).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct BarId(pub(crate) usize);
-
-impl BarId {
-    /// Position of the bar in its assembly (0-based, in the order bars were added).
-    pub fn index(self) -> usize {
-        self.0
-    }
-
-    /// The end at `x = 0`.
-    pub fn left(self) -> EndRef {
-        EndRef {
-            bar: self,
-            end: End::Left,
-        }
-    }
-
-    /// The end at `x = l`.
-    pub fn right(self) -> EndRef {
-        EndRef {
-            bar: self,
-            end: End::Right,
-        }
-    }
-}
-
-/// One of the two ends of a bar.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum End {
-    /// The end at `x = 0`, outward normal `-1`.
-    Left,
-    /// The end at `x = l`, outward normal `+1`.
-    Right,
-}
-
-impl End {
-    /// Outward normal `n`: `-1` at `x = 0`, `+1` at `x = l`.
-    pub fn normal(self) -> f64 {
-        match self {
-            End::Left => -1.0,
-            End::Right => 1.0,
-        }
-    }
-}
-
-/// An end of a given bar.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct EndRef {
-    /// The bar.
-    pub bar: BarId,
-    /// Which end.
-    pub end: End,
-}
-
-impl fmt::Display for EndRef {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let side = match self.end {
-            End::Left => "left (x = 0)",
-            End::Right => "right (x = l)",
-        };
-        write!(f, "{} of bar {}", side, self.bar.0)
     }
 }
 

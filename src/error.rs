@@ -1,10 +1,14 @@
 //! Typed errors. Every variant carries the numbers that explain it.
+//!
+//! Every enum here is `#[non_exhaustive]`: later versions may add variants, so a `match` on
+//! one outside the crate ends with a wildcard arm.
 
-use crate::bar::EndRef;
+use crate::end::EndRef;
 use thiserror::Error;
 
 /// Errors raised while describing a bar system (bars, boundary conditions, assembly).
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ModelError {
     /// A physical parameter is not strictly positive and finite.
     #[error("{what} must be positive and finite, got {value}")]
@@ -78,6 +82,7 @@ pub enum ModelError {
 
 /// Errors in harmonic-balance settings or evaluation points.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum SettingsError {
     /// The number of harmonics is zero.
     #[error("the number of harmonics must be at least 1, got 0")]
@@ -160,6 +165,7 @@ pub enum SettingsError {
 /// Errors of a nonlinear solve.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub enum SolveError {
     /// The iteration budget ran out before the tolerance was met.
     #[error("no convergence after {iterations} iterations: residual norm {residual_norm:e} > tolerance {tolerance:e}")]
@@ -261,6 +267,7 @@ pub enum SolveError {
 
 /// Errors of a continuation run.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ContinuationError {
     /// An option is invalid (non-finite, empty range, zero steps...).
     #[error("invalid continuation option {what}: {value}")]
@@ -308,8 +315,97 @@ pub enum ContinuationError {
     },
 }
 
+/// Errors of the time-domain integrator and of the periodicity check ([`crate::verify`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum VerifyError {
+    /// A boundary condition has a form the integrator cannot advance exactly.
+    #[error("condition `{condition}` is not supported by the time-domain integrator: {reason}")]
+    Unsupported {
+        /// Name of the condition.
+        condition: String,
+        /// What is missing or unexpected.
+        reason: &'static str,
+    },
+    /// The time step is not positive and finite.
+    #[error("time step must be positive and finite, got {dt}")]
+    InvalidTimeStep {
+        /// The rejected step.
+        dt: f64,
+    },
+    /// A bar's travel time `l / c` is not an integer number of steps.
+    #[error(
+        "bar {bar} has l/c = {travel_time} = {cells} steps of dt = {dt}: not an integer number of cells"
+    )]
+    NonMatchingGrid {
+        /// Index of the bar.
+        bar: usize,
+        /// Its travel time `l / c`.
+        travel_time: f64,
+        /// The time step.
+        dt: f64,
+        /// `l / (c dt)`.
+        cells: f64,
+    },
+    /// No time step near the requested one gives every bar an integer number of cells.
+    #[error("no time step between {low} and {high} gives every bar an integer number of cells")]
+    NoAdmissibleGrid {
+        /// Smallest step searched.
+        low: f64,
+        /// Largest step searched.
+        high: f64,
+    },
+    /// A value of the initial state (or a parameter) is NaN or infinite.
+    #[error("non-finite {what} in bar {bar} at index {index}: {value}")]
+    NonFinite {
+        /// Which quantity.
+        what: &'static str,
+        /// Bar index.
+        bar: usize,
+        /// Index of the cell or node (0 for end values).
+        index: usize,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A vector of the initial state has the wrong length.
+    #[error("{what} of bar {bar} has length {got}, expected {expected}")]
+    Length {
+        /// Which vector.
+        what: &'static str,
+        /// Bar index.
+        bar: usize,
+        /// Its length.
+        got: usize,
+        /// The expected length.
+        expected: usize,
+    },
+    /// The number of bars of an input does not match the model.
+    #[error("input describes {got} bar(s), the model has {expected}")]
+    BarCount {
+        /// Bars given.
+        got: usize,
+        /// Bars of the model.
+        expected: usize,
+    },
+    /// A real parameter is out of its admissible range.
+    #[error("{what} is out of range: {value}")]
+    InvalidParameter {
+        /// Which parameter.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// Two states that should share a model and a grid do not.
+    #[error("the two states have different models or grids")]
+    MismatchedStates,
+    /// The model itself is inconsistent (an end without or with two conditions, a bad gap...).
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
 /// Any error of the crate.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum Error {
     /// See [`ModelError`].
     #[error(transparent)]
@@ -323,16 +419,7 @@ pub enum Error {
     /// See [`ContinuationError`].
     #[error(transparent)]
     Continuation(#[from] ContinuationError),
-    /// See [`VerifyError`](crate::verify::VerifyError).
+    /// See [`VerifyError`].
     #[error(transparent)]
-    Verify(#[from] crate::verify::VerifyError),
-}
-
-/// Checks that `value` is strictly positive and finite.
-pub(crate) fn positive(what: &'static str, value: f64) -> Result<f64, ModelError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(ModelError::NotPositive { what, value })
-    }
+    Verify(#[from] VerifyError),
 }

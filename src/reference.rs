@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 pub fn clamped_bar_with_obstacle(gap: f64) -> Result<BarSystem, ModelError> {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
-    b.dirichlet(bar.left()).signorini(bar.right(), gap)?;
+    b.dirichlet(bar.left())?.signorini(bar.right(), gap)?;
     b.build()
 }
 
@@ -44,8 +44,8 @@ pub fn two_bars_in_contact(second: Bar, gap: f64) -> Result<BarSystem, ModelErro
     let mut b = AssemblyBuilder::new();
     let one = b.add_bar(Bar::unit());
     let two = b.add_bar(second);
-    b.dirichlet(one.left())
-        .dirichlet(two.left())
+    b.dirichlet(one.left())?
+        .dirichlet(two.left())?
         .contact(one.right(), two.right(), gap)?;
     b.build()
 }

@@ -43,7 +43,10 @@ fn clamped() -> BarSystem {
 fn linear_only() -> BarSystem {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
-    b.dirichlet(bar.left()).neumann(bar.right());
+    b.dirichlet(bar.left())
+        .unwrap()
+        .neumann(bar.right())
+        .unwrap();
     b.build().unwrap()
 }
 
@@ -96,8 +99,11 @@ fn assembly_errors_name_the_end_or_condition() {
     let one = b.add_bar(Bar::unit());
     let two = b.add_bar(Bar::unit());
     b.dirichlet(one.left())
+        .unwrap()
         .dirichlet(one.right())
-        .neumann(two.right());
+        .unwrap()
+        .neumann(two.right())
+        .unwrap();
     assert_eq!(
         b.build().unwrap_err(),
         ModelError::UnconstrainedEnd { end: two.left() }
@@ -105,8 +111,12 @@ fn assembly_errors_name_the_end_or_condition() {
     let message = b.build().unwrap_err().to_string();
     assert!(message.contains("left (x = 0) of bar 1"), "{message}");
 
-    // An end with two conditions, named in order.
-    b.neumann(two.left()).signorini(two.left(), 0.1).unwrap();
+    // An end with two conditions, named in order: each is valid on its own, so the builder
+    // takes both and `build` rejects the pair.
+    b.neumann(two.left())
+        .unwrap()
+        .signorini(two.left(), 0.1)
+        .unwrap();
     match b.build().unwrap_err() {
         ModelError::OverconstrainedEnd { end, first, second } => {
             assert_eq!(end, two.left());
@@ -116,16 +126,18 @@ fn assembly_errors_name_the_end_or_condition() {
         other => panic!("expected OverconstrainedEnd, got {other:?}"),
     }
 
-    // A contact of an end with itself.
+    // A contact of an end with itself: rejected at the call, and not added.
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
-    b.dirichlet(bar.left())
-        .contact(bar.right(), bar.right(), 0.1)
-        .unwrap();
+    b.dirichlet(bar.left()).unwrap();
     assert!(matches!(
-        b.build(),
+        b.contact(bar.right(), bar.right(), 0.1),
         Err(ModelError::RepeatedEnd { end, .. }) if end == bar.right()
     ));
+    assert_eq!(
+        b.build().unwrap_err(),
+        ModelError::UnconstrainedEnd { end: bar.right() }
+    );
 }
 
 #[test]
@@ -138,9 +150,10 @@ fn unknown_bar_from_another_builder() {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
     b.dirichlet(bar.left())
+        .unwrap()
         .neumann(bar.right())
-        .dirichlet(foreign.left());
-    match b.build().unwrap_err() {
+        .unwrap();
+    match b.dirichlet(foreign.left()).unwrap_err() {
         ModelError::UnknownBar {
             condition,
             bar,
@@ -151,6 +164,8 @@ fn unknown_bar_from_another_builder() {
         }
         other => panic!("expected UnknownBar, got {other:?}"),
     }
+    // The rejected condition was not added.
+    assert!(b.build().is_ok());
 }
 
 /// A condition that gives `rows` linear rows on `ends.len()` ends.
@@ -180,15 +195,12 @@ fn wrong_equation_count() {
         let mut b = AssemblyBuilder::new();
         let bar = b.add_bar(Bar::unit());
         let all = [bar.left(), bar.right()];
-        b.add_condition(Miscounted {
+        let result = b.add_condition(Miscounted {
             ends: all[..ends].to_vec(),
             rows,
         });
-        if ends == 1 {
-            b.neumann(bar.right());
-        }
         assert_eq!(
-            b.build().unwrap_err(),
+            result.map(|_| ()).unwrap_err(),
             ModelError::EquationCount {
                 condition: "miscounted".into(),
                 ends,
@@ -682,6 +694,59 @@ fn invalid_solver_options() {
     }
     assert!(SemismoothNewton::new(NewtonOptions::default()).is_ok());
     assert!(Dogleg::new(DoglegOptions::default()).is_ok());
+}
+
+/// The options' own `validate` gives the error of the constructor, and a solver keeps the
+/// options it was built with (the defaults for `Default`).
+#[test]
+fn solver_options_validate_and_read_back() {
+    let newton = NewtonOptions {
+        min_step: 1e-6,
+        ..NewtonOptions::fail_fast()
+    };
+    assert_eq!(newton.validate(), Ok(()));
+    assert_eq!(SemismoothNewton::new(newton).unwrap().options(), &newton);
+    assert_eq!(
+        SemismoothNewton::default().options(),
+        &NewtonOptions::default()
+    );
+    let bad = NewtonOptions {
+        max_evaluations: 0,
+        ..newton
+    };
+    assert_eq!(
+        bad.validate(),
+        SemismoothNewton::new(bad).map(|_| ()),
+        "max_evaluations"
+    );
+    assert!(bad.validate().is_err());
+
+    let dogleg = DoglegOptions {
+        initial_radius: 0.5,
+        ..DoglegOptions::default()
+    };
+    assert_eq!(dogleg.validate(), Ok(()));
+    assert_eq!(Dogleg::new(dogleg).unwrap().options(), &dogleg);
+    assert_eq!(Dogleg::default().options(), &DoglegOptions::default());
+    for min_radius in [0.0, f64::NAN] {
+        let bad = DoglegOptions {
+            min_radius,
+            ..dogleg
+        };
+        match (bad.validate(), Dogleg::new(bad)) {
+            (
+                Err(SolveError::InvalidOption {
+                    what: "min_radius",
+                    value,
+                }),
+                Err(SolveError::InvalidOption {
+                    what: "min_radius",
+                    value: again,
+                }),
+            ) => assert!(same(value, min_radius) && same(again, min_radius)),
+            other => panic!("min_radius = {min_radius}: {other:?}"),
+        }
+    }
 }
 
 type Driver = Sequential<NonsmoothSystem, SemismoothNewton>;

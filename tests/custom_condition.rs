@@ -91,7 +91,10 @@ fn clamped_with(mut condition: MassOnSpring) -> BarSystem {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
     condition.end = bar.right();
-    b.dirichlet(bar.left()).add_condition(condition);
+    b.dirichlet(bar.left())
+        .unwrap()
+        .add_condition(condition)
+        .unwrap();
     b.build().unwrap()
 }
 
@@ -101,6 +104,7 @@ fn obstacle_with(mut condition: MassOnSpring) -> BarSystem {
     let bar = b.add_bar(Bar::unit());
     condition.end = bar.left();
     b.add_condition(condition)
+        .unwrap()
         .signorini(bar.right(), GAP)
         .unwrap();
     b.build().unwrap()
@@ -310,12 +314,15 @@ impl UnilateralLaw for CompliantObstacle {
 fn compliant_system(stiffness: f64, penalty_form: bool) -> BarSystem {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
-    b.dirichlet(bar.left()).add_condition(CompliantObstacle {
-        end: bar.right(),
-        gap: GAP,
-        stiffness,
-        penalty_form,
-    });
+    b.dirichlet(bar.left())
+        .unwrap()
+        .add_condition(CompliantObstacle {
+            end: bar.right(),
+            gap: GAP,
+            stiffness,
+            penalty_form,
+        })
+        .unwrap();
     b.build().unwrap()
 }
 

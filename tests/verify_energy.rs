@@ -2,10 +2,11 @@
 //! their energy to rounding over ten periods, never penetrate and never pull on a contact.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::system::AssemblyBuilder;
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem};
 use nonsmooth_modes::verify::{
     march, BarCells, Condition, Grid, MarchOptions, Model, SpringUpdate, State,
 };
+use nonsmooth_modes::ModelError;
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -26,45 +27,50 @@ impl Rng {
 /// Random assembly `kind` with bars of `cells[b]` cells and speeds `speeds[b]`; all gaps 1
 /// for now (set from the initial state later).
 fn assembly(kind: usize, cells: &[usize], speeds: &[f64], stiffness: &[f64], spring: f64) -> Model {
+    let system = system(kind, cells, speeds, stiffness, spring).unwrap();
+    Model::from_system(&system).unwrap()
+}
+
+/// The bar system of [`assembly`].
+fn system(
+    kind: usize,
+    cells: &[usize],
+    speeds: &[f64],
+    stiffness: &[f64],
+    spring: f64,
+) -> Result<BarSystem, ModelError> {
     let mut b = AssemblyBuilder::new();
     let bar =
         |i: usize| Bar::new(cells[i] as f64 * speeds[i] * DT, speeds[i], stiffness[i]).unwrap();
     match kind {
         0 => {
             let one = b.add_bar(bar(0));
-            b.dirichlet(one.left()).signorini(one.right(), 1.0).unwrap();
+            b.dirichlet(one.left())?.signorini(one.right(), 1.0)?;
         }
         1 => {
             let one = b.add_bar(bar(0));
-            b.signorini(one.left(), 1.0)
-                .unwrap()
-                .signorini(one.right(), 1.0)
-                .unwrap();
+            b.signorini(one.left(), 1.0)?.signorini(one.right(), 1.0)?;
         }
         2 => {
             let (one, two) = (b.add_bar(bar(0)), b.add_bar(bar(1)));
-            b.dirichlet(one.left())
-                .dirichlet(two.left())
-                .contact(one.right(), two.right(), 1.0)
-                .unwrap();
+            b.dirichlet(one.left())?.dirichlet(two.left())?.contact(
+                one.right(),
+                two.right(),
+                1.0,
+            )?;
         }
         3 => {
             let (one, two) = (b.add_bar(bar(0)), b.add_bar(bar(1)));
-            b.dirichlet(one.left())
-                .contact(one.right(), two.left(), 1.0)
-                .unwrap()
-                .signorini(two.right(), 1.0)
-                .unwrap();
+            b.dirichlet(one.left())?
+                .contact(one.right(), two.left(), 1.0)?
+                .signorini(two.right(), 1.0)?;
         }
         _ => {
             let one = b.add_bar(bar(0));
-            b.robin(one.left(), spring)
-                .unwrap()
-                .signorini(one.right(), 1.0)
-                .unwrap();
+            b.robin(one.left(), spring)?.signorini(one.right(), 1.0)?;
         }
     }
-    Model::from_system(&b.build().unwrap()).unwrap()
+    b.build()
 }
 
 /// Random cells (a smooth part and a rough part), clamped ends at zero displacement.

@@ -5,7 +5,8 @@ use super::{
     LinearRows, Observable, Quantity, Term, UnilateralLaw,
 };
 use crate::bar::EndRef;
-use crate::error::{positive, ModelError};
+use crate::check::positive;
+use crate::error::ModelError;
 
 /// Unilateral contact between two ends that face each other across a gap `g0`:
 /// `g = g0 - v_A - v_B`, the forces balance (`lambda_A = lambda_B`, one linear row per harmonic,

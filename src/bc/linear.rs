@@ -2,7 +2,8 @@
 
 use super::{BoundaryCondition, LinearRows, Quantity, Term};
 use crate::bar::EndRef;
-use crate::error::{positive, ModelError};
+use crate::check::positive;
+use crate::error::ModelError;
 
 /// Clamped end: `u = 0`.
 #[derive(Debug, Clone, Copy, PartialEq)]

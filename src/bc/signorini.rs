@@ -5,7 +5,8 @@ use super::{
     Observable, Quantity, Term, UnilateralLaw,
 };
 use crate::bar::EndRef;
-use crate::error::{positive, ModelError};
+use crate::check::positive;
+use crate::error::ModelError;
 
 /// Rigid obstacle at distance `g0` from an end: gap `g = g0 - v` (`v` the outward
 /// displacement), force `lambda = -EA u_x`, and `g >= 0, lambda >= 0, g lambda = 0`.

@@ -687,6 +687,7 @@ mod tests {
             .robin(one.left(), 0.8)
             .unwrap()
             .dirichlet(two.left())
+            .unwrap()
             .contact(one.right(), two.right(), 1e-3)
             .unwrap();
         let system = builder.build().unwrap();

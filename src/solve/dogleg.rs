@@ -32,6 +32,20 @@ impl Default for DoglegOptions {
     }
 }
 
+impl DoglegOptions {
+    /// Checks the options (what [`Dogleg::new`] requires).
+    ///
+    /// # Errors
+    /// [`SolveError::InvalidOption`] for a non-positive or non-finite tolerance, initial
+    /// radius or minimum radius.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        check_positive("tolerance", self.tolerance)?;
+        check_positive("initial_radius", self.initial_radius)?;
+        check_positive("min_radius", self.min_radius)?;
+        Ok(())
+    }
+}
+
 /// Powell's hybrid method: inside a trust region of radius `Delta`, take the Newton step if
 /// it fits, else the dogleg path from the Cauchy point towards it; grow or shrink `Delta` by
 /// the ratio of actual to predicted decrease of `|F|^2`. The paper's solver (Matlab's
@@ -39,22 +53,35 @@ impl Default for DoglegOptions {
 ///
 /// Reference: M. J. D. Powell, "A hybrid method for nonlinear equations", in Numerical
 /// Methods for Nonlinear Algebraic Equations, Gordon and Breach, 1970, pp. 87–114.
+///
+/// Built by [`Dogleg::new`], which validates the options, or by `Default` (the default
+/// options); the options are private, so no solver holds options that `new` would reject
+/// (a minimum radius that is zero or NaN would never give up):
+///
+/// ```compile_fail,E0451
+/// use nonsmooth_modes::solve::{Dogleg, DoglegOptions};
+///
+/// let options = DoglegOptions { min_radius: 0.0, ..Default::default() };
+/// let solver = Dogleg { options };
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Dogleg {
-    /// Options.
-    pub options: DoglegOptions,
+    options: DoglegOptions,
 }
 
 impl Dogleg {
     /// A solver with the given options.
     ///
     /// # Errors
-    /// [`SolveError::InvalidOption`] for non-positive or non-finite values.
+    /// The error of [`DoglegOptions::validate`].
     pub fn new(options: DoglegOptions) -> Result<Self, SolveError> {
-        check_positive("tolerance", options.tolerance)?;
-        check_positive("initial_radius", options.initial_radius)?;
-        check_positive("min_radius", options.min_radius)?;
+        options.validate()?;
         Ok(Self { options })
+    }
+
+    /// Its options.
+    pub fn options(&self) -> &DoglegOptions {
+        &self.options
     }
 }
 

@@ -64,6 +64,35 @@ impl Default for NewtonOptions {
 }
 
 impl NewtonOptions {
+    /// Checks the options (what [`SemismoothNewton::new`] requires).
+    ///
+    /// # Errors
+    /// [`SolveError::InvalidOption`] for a non-positive or non-finite tolerance, Armijo
+    /// constant or minimum step, a stagnation or plateau ratio outside `(0, 1]`, or a zero
+    /// evaluation budget.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        check_positive("tolerance", self.tolerance)?;
+        check_positive("armijo", self.armijo)?;
+        check_positive("min_step", self.min_step)?;
+        check_positive("stall_ratio", self.stall_ratio)?;
+        check_positive("plateau_ratio", self.plateau_ratio)?;
+        if self.max_evaluations == 0 {
+            return Err(SolveError::InvalidOption {
+                what: "max_evaluations",
+                value: 0.0,
+            });
+        }
+        for (what, ratio) in [
+            ("stall_ratio (at most 1)", self.stall_ratio),
+            ("plateau_ratio (at most 1)", self.plateau_ratio),
+        ] {
+            if ratio > 1.0 {
+                return Err(SolveError::InvalidOption { what, value: ratio });
+            }
+        }
+        Ok(())
+    }
+
     /// Settings for sequential continuation on a fine grid, where each step starts from a
     /// converged neighbour and a failed step is simply skipped: the line search gives up at
     /// step length `1e-4` (instead of `1e-10`), the stagnation test is on
@@ -97,40 +126,35 @@ impl NewtonOptions {
 ///
 /// Reference: L. Qi and J. Sun, "A nonsmooth version of Newton's method", Mathematical
 /// Programming 58 (1993) 353–367.
+///
+/// Built by [`SemismoothNewton::new`], which validates the options, or by `Default` (the
+/// default options); the options are private, so no solver holds options that `new` would
+/// reject:
+///
+/// ```compile_fail,E0451
+/// use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
+///
+/// let options = NewtonOptions { min_step: -1.0, ..Default::default() };
+/// let solver = SemismoothNewton { options };
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SemismoothNewton {
-    /// Options.
-    pub options: NewtonOptions,
+    options: NewtonOptions,
 }
 
 impl SemismoothNewton {
     /// A solver with the given options.
     ///
     /// # Errors
-    /// [`SolveError::InvalidOption`] for a non-positive or non-finite tolerance, Armijo
-    /// constant or minimum step, a stagnation or plateau ratio outside `(0, 1]`, or a zero
-    /// evaluation budget.
+    /// The error of [`NewtonOptions::validate`].
     pub fn new(options: NewtonOptions) -> Result<Self, SolveError> {
-        check_positive("tolerance", options.tolerance)?;
-        check_positive("armijo", options.armijo)?;
-        check_positive("min_step", options.min_step)?;
-        check_positive("stall_ratio", options.stall_ratio)?;
-        check_positive("plateau_ratio", options.plateau_ratio)?;
-        if options.max_evaluations == 0 {
-            return Err(SolveError::InvalidOption {
-                what: "max_evaluations",
-                value: 0.0,
-            });
-        }
-        for (what, ratio) in [
-            ("stall_ratio (at most 1)", options.stall_ratio),
-            ("plateau_ratio (at most 1)", options.plateau_ratio),
-        ] {
-            if ratio > 1.0 {
-                return Err(SolveError::InvalidOption { what, value: ratio });
-            }
-        }
+        options.validate()?;
         Ok(Self { options })
+    }
+
+    /// Its options.
+    pub fn options(&self) -> &NewtonOptions {
+        &self.options
     }
 }
 

@@ -77,6 +77,7 @@ mod periodicity;
 mod state;
 mod wave;
 
+pub use crate::error::VerifyError;
 pub use exact::clamped_first_mode;
 pub use grid::Grid;
 pub use march::{
@@ -88,92 +89,3 @@ pub use periodicity::{
     periodicity_check, periodicity_of_state, PeriodicityOptions, PeriodicityReport,
 };
 pub use state::{BarCells, BarSnapshot, Snapshot, State};
-
-use thiserror::Error;
-
-/// Errors of the time-domain integrator and of the periodicity check.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum VerifyError {
-    /// A boundary condition has a form the integrator cannot advance exactly.
-    #[error("condition `{condition}` is not supported by the time-domain integrator: {reason}")]
-    Unsupported {
-        /// Name of the condition.
-        condition: String,
-        /// What is missing or unexpected.
-        reason: &'static str,
-    },
-    /// The time step is not positive and finite.
-    #[error("time step must be positive and finite, got {dt}")]
-    InvalidTimeStep {
-        /// The rejected step.
-        dt: f64,
-    },
-    /// A bar's travel time `l / c` is not an integer number of steps.
-    #[error(
-        "bar {bar} has l/c = {travel_time} = {cells} steps of dt = {dt}: not an integer number of cells"
-    )]
-    NonMatchingGrid {
-        /// Index of the bar.
-        bar: usize,
-        /// Its travel time `l / c`.
-        travel_time: f64,
-        /// The time step.
-        dt: f64,
-        /// `l / (c dt)`.
-        cells: f64,
-    },
-    /// No time step near the requested one gives every bar an integer number of cells.
-    #[error("no time step between {low} and {high} gives every bar an integer number of cells")]
-    NoAdmissibleGrid {
-        /// Smallest step searched.
-        low: f64,
-        /// Largest step searched.
-        high: f64,
-    },
-    /// A value of the initial state (or a parameter) is NaN or infinite.
-    #[error("non-finite {what} in bar {bar} at index {index}: {value}")]
-    NonFinite {
-        /// Which quantity.
-        what: &'static str,
-        /// Bar index.
-        bar: usize,
-        /// Index of the cell or node (0 for end values).
-        index: usize,
-        /// The rejected value.
-        value: f64,
-    },
-    /// A vector of the initial state has the wrong length.
-    #[error("{what} of bar {bar} has length {got}, expected {expected}")]
-    Length {
-        /// Which vector.
-        what: &'static str,
-        /// Bar index.
-        bar: usize,
-        /// Its length.
-        got: usize,
-        /// The expected length.
-        expected: usize,
-    },
-    /// The number of bars of an input does not match the model.
-    #[error("input describes {got} bar(s), the model has {expected}")]
-    BarCount {
-        /// Bars given.
-        got: usize,
-        /// Bars of the model.
-        expected: usize,
-    },
-    /// A real parameter is out of its admissible range.
-    #[error("{what} is out of range: {value}")]
-    InvalidParameter {
-        /// Which parameter.
-        what: &'static str,
-        /// The rejected value.
-        value: f64,
-    },
-    /// Two states that should share a model and a grid do not.
-    #[error("the two states have different models or grids")]
-    MismatchedStates,
-    /// The model itself is inconsistent (an end without or with two conditions, a bad gap...).
-    #[error(transparent)]
-    Model(#[from] crate::error::ModelError),
-}

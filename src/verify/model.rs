@@ -450,7 +450,10 @@ mod tests {
         // Robin at a right end on a stiff bar, Neumann at the left.
         let mut b = AssemblyBuilder::new();
         let id = b.add_bar(Bar::new(1.0, 1.0, 4.0).unwrap());
-        b.neumann(id.left()).robin(id.right(), 2.0).unwrap();
+        b.neumann(id.left())
+            .unwrap()
+            .robin(id.right(), 2.0)
+            .unwrap();
         let m = Model::from_system(&b.build().unwrap()).unwrap();
         assert_eq!(m.conditions()[0], Condition::Free { end: id.left() });
         assert_eq!(
@@ -483,7 +486,10 @@ mod tests {
     fn rejects_what_it_cannot_advance() {
         let mut b = AssemblyBuilder::new();
         let id = b.add_bar(Bar::unit());
-        b.dirichlet(id.left()).add_condition(EndMass(id.right()));
+        b.dirichlet(id.left())
+            .unwrap()
+            .add_condition(EndMass(id.right()))
+            .unwrap();
         let err = Model::from_system(&b.build().unwrap()).unwrap_err();
         assert!(
             matches!(err, VerifyError::Unsupported { ref condition, .. } if condition == "end mass")
