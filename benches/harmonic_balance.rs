@@ -14,22 +14,22 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nonsmooth_modes::continuation::{ContinuationProblem, Speculation};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::backbone::backbone_speculative_with;
+use nonsmooth_modes::modal::backbone_speculative_with;
 use nonsmooth_modes::modal::{
     backbone, energy, energy_at, BackboneOptions, BackbonePoint, PeriodGrid,
 };
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, Problem, SemismoothNewton};
 use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::hint::black_box;
 use std::ops::ControlFlow;
 use std::time::Duration;
 
 const GAP: f64 = 1e-3;
 
-fn settings(m: usize) -> HarmonicBalance {
-    HarmonicBalance {
+fn settings(m: usize) -> HarmonicBalanceSettings {
+    HarmonicBalanceSettings {
         harmonics: m,
         ..Default::default()
     }

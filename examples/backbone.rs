@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release --example backbone -- [--system ds|rs|two-bar] [--gap 1e-3]
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
-//!     [--harmonics 20 --samples-per-harmonic 30 --penalty 4] [--mode 1] [--subharmonic 1]
+//!     [--harmonics 20 --samples-per-harmonic 30 --complementarity 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
 //!     [--newton fail-fast|full] [--retry-depth K] [--selection first|lowest-energy] [--serial]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
@@ -49,18 +49,18 @@ use nonsmooth_modes::continuation::{
     linspace, Arclength, ArclengthOptions, Event, Point, Selection, Sequential, SequentialOptions,
     Speculation, StallEscape, Step,
 };
-use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, energy, grazing_energy, ArclengthBackboneOptions,
     BackboneOptions, BackbonePoint, PeriodGrid,
 };
+use nonsmooth_modes::modal::{backbone_speculative_with, backbone_with};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
 // A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
 use nonsmooth_modes::sweep::Solver;
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance, ParameterFamily};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, ParameterFamily};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
@@ -70,7 +70,7 @@ use std::process::ExitCode;
 
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
-  [--penalty AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
+  [--complementarity AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
   [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K]
   [--selection first|lowest-energy] [--serial] [--out FILE]
   [--method sequential|arclength]
@@ -103,7 +103,7 @@ struct Args {
     length2: f64,
     speed2: f64,
     stiffness_ratio: f64,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     mode: usize,
     subharmonic: usize,
     period_start: Option<f64>,
@@ -158,7 +158,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         length2: 0.95,
         speed2: 1.0,
         stiffness_ratio: 1.0,
-        settings: HarmonicBalance::default(),
+        settings: HarmonicBalanceSettings::default(),
         mode: 1,
         subharmonic: 1,
         period_start: None,
@@ -201,7 +201,7 @@ fn parse() -> Result<Args, lexopt::Error> {
             Long("samples-per-harmonic") => {
                 a.settings.samples_per_harmonic = parser.value()?.parse()?
             }
-            Long("penalty") => a.settings.penalty = parser.value()?.parse()?,
+            Long("complementarity") => a.settings.complementarity = parser.value()?.parse()?,
             Long("mode") => a.mode = parser.value()?.parse()?,
             Long("subharmonic") => a.subharmonic = parser.value()?.parse()?,
             Long("period-start") => a.period_start = Some(parser.value()?.parse()?),
@@ -300,7 +300,7 @@ fn events(events: &[Event]) -> String {
 /// Writes rows and counts them; remembers the first I/O error and stops the run on it.
 struct Sink<'a> {
     out: &'a mut dyn Write,
-    verify: Option<HarmonicBalance>,
+    verify: Option<HarmonicBalanceSettings>,
     exact: Option<f64>,
     total: usize,
     converged: usize,
@@ -496,7 +496,7 @@ fn run_parameter(
     let problem = ParameterFamily::at(family, a.settings, omega, value)?;
     let (lo, hi) = a.parameter_range.unwrap_or((value / 10.0, value * 10.0));
     let mut report = |p: &Point| {
-        let system = match build_system(a, parameter, p.lambda) {
+        let system = match build_system(a, parameter, p.parameter) {
             Ok(s) => s,
             Err(_) => return ControlFlow::Continue(()),
         };
@@ -507,7 +507,7 @@ fn run_parameter(
         let e = energy(&system, &basis, &p.x, omega);
         let e_g = grazing_energy(&system).map(|g| g.0).unwrap_or(f64::NAN);
         let point = BackbonePoint::from_point(p, omega, e, e_g);
-        sink.row(&system, &point, p.lambda)
+        sink.row(&system, &point, p.parameter)
     };
     if a.arclength {
         let options = ArclengthOptions {

@@ -17,7 +17,7 @@ use nonsmooth_modes::continuation::{
 use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 
 /// How a phase of the loop ended.
@@ -43,11 +43,11 @@ fn follow(
     loop {
         match step() {
             Step::Accepted(p) => {
-                let (e, exact) = (normalized(&p), ClampedFirstMode::new(1e-3, p.lambda));
+                let (e, exact) = (normalized(&p), ClampedFirstMode::new(1e-3, p.parameter));
                 let events: Vec<&str> = p.events.iter().map(|e| e.label()).collect();
                 println!(
                     "{label}  T {:.4}  E/Eg {:9.4}  exact {:9.4}  {}",
-                    p.lambda,
+                    p.parameter,
                     e,
                     exact.energy_normalized(),
                     events.join(",")
@@ -59,7 +59,7 @@ fn follow(
                 last = Some(p);
             }
             Step::Rejected(r) if stop_on_rejection => {
-                println!("{label}  T {:.4}  rejected: {:?}", r.lambda, r.reason);
+                println!("{label}  T {:.4}  rejected: {:?}", r.parameter, r.reason);
                 return Phase::Rejected(last);
             }
             Step::Rejected(_) => rejected += 1,
@@ -78,11 +78,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let gap = 1e-3;
     let system = clamped_bar_with_obstacle(gap)?;
-    let settings = HarmonicBalance::default();
+    let settings = HarmonicBalanceSettings::default();
     let mut problem = NonsmoothSystem::new(&system, settings)?;
     let basis = problem.basis().clone();
     let (e_g, _) = grazing_energy(&system)?;
-    let normalized = |p: &Point| energy(&system, &basis, &p.x, 2.0 * PI / p.lambda) / e_g;
+    let normalized = |p: &Point| energy(&system, &basis, &p.x, 2.0 * PI / p.parameter) / e_g;
 
     // Phase 1: sequential in the period, one call of `step()` at a time; it hands over at
     // the first rejected step.

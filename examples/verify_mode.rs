@@ -16,13 +16,13 @@
 //! and penetration.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::backbone::backbone_with;
+use nonsmooth_modes::modal::backbone_with;
 use nonsmooth_modes::modal::{BackboneOptions, PeriodGrid};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::HarmonicBalance;
+use nonsmooth_modes::system::HarmonicBalanceSettings;
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use std::ops::ControlFlow;
 
@@ -59,7 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "two-bar" => two_bars_in_contact(Bar::new(length2, speed2, ratio)?, gap)?,
         other => return Err(format!("unknown system {other}").into()),
     };
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics,
         ..Default::default()
     };

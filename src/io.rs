@@ -150,7 +150,7 @@ mod tests {
             iterations: 2,
             x: vec![0.0, 1e-3],
             step_size: -0.005,
-            events: vec![Event::Fold { lambda: 1.8 }],
+            events: vec![Event::Fold { parameter: 1.8 }],
         }
     }
 
@@ -220,6 +220,6 @@ mod tests {
         let text = to_json(&vec![point()]).unwrap();
         let value: serde_json::Value = serde_json::from_str(&text).unwrap();
         assert_eq!(value[0]["step"], 3);
-        assert_eq!(value[0]["events"][0]["Fold"]["lambda"], 1.8);
+        assert_eq!(value[0]["events"][0]["Fold"]["parameter"], 1.8);
     }
 }

@@ -53,10 +53,10 @@
 //! use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
 //! use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 //! use nonsmooth_modes::solve::SemismoothNewton;
-//! use nonsmooth_modes::system::HarmonicBalance;
+//! use nonsmooth_modes::system::HarmonicBalanceSettings;
 //!
 //! let system = clamped_bar_with_obstacle(1e-3)?;
-//! let settings = HarmonicBalance { harmonics: 10, ..Default::default() };
+//! let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
 //! let options = BackboneOptions {
 //!     grid: PeriodGrid { start: 3.9, end: 3.7, steps: 5 },
 //!     ..Default::default()

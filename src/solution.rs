@@ -7,10 +7,10 @@
 //! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 //! use nonsmooth_modes::solution::Solution;
 //! use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
-//! use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+//! use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 //!
 //! let system = clamped_bar_with_obstacle(1e-3)?;
-//! let settings = HarmonicBalance { harmonics: 10, ..Default::default() };
+//! let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
 //! let mut problem = NonsmoothSystem::new(&system, settings)?;
 //! let omega = 2.0 * std::f64::consts::PI / 3.6;
 //! let mut x = branch_seed(&mut problem, 1, 1, omega)?;

@@ -13,7 +13,7 @@
 //! use nonsmooth_modes::modal::{BackboneOptions, PeriodGrid};
 //! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 //! use nonsmooth_modes::sweep::{backbones, Solver, SweepJob};
-//! use nonsmooth_modes::system::HarmonicBalance;
+//! use nonsmooth_modes::system::HarmonicBalanceSettings;
 //!
 //! let system = clamped_bar_with_obstacle(1e-3)?;
 //! let options = BackboneOptions {
@@ -25,7 +25,7 @@
 //!     .into_iter()
 //!     .map(|m| SweepJob {
 //!         system: system.clone(),
-//!         settings: HarmonicBalance { harmonics: m, ..Default::default() },
+//!         settings: HarmonicBalanceSettings { harmonics: m, ..Default::default() },
 //!         options,
 //!         solver: Solver::default(),
 //!     })
@@ -39,7 +39,7 @@
 use crate::error::{Error, SolveError};
 use crate::modal::{backbone, BackboneOptions, BackbonePoint};
 use crate::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo, SolveMonitor};
-use crate::system::{BarSystem, HarmonicBalance};
+use crate::system::{BarSystem, HarmonicBalanceSettings};
 
 /// A solver chosen per job (so that one sweep can mix solvers).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,8 +82,8 @@ impl NonlinearSolver for Solver {
 pub struct SweepJob<S = Solver> {
     /// The bar system.
     pub system: BarSystem,
-    /// Harmonic-balance settings (harmonics, samples, penalty).
-    pub settings: HarmonicBalance,
+    /// Harmonic-balance settings (harmonics, samples, complementarity parameter).
+    pub settings: HarmonicBalanceSettings,
     /// Period grid, mode, subharmonic, predictor, failure budget.
     pub options: BackboneOptions,
     /// The nonlinear solver (cloned for the run).
@@ -151,7 +151,7 @@ mod tests {
         for m in [10, 20, 31] {
             jobs.push(SweepJob {
                 system: clamped.clone(),
-                settings: HarmonicBalance {
+                settings: HarmonicBalanceSettings {
                     harmonics: m,
                     ..Default::default()
                 },
@@ -164,7 +164,7 @@ mod tests {
         }
         jobs.push(SweepJob {
             system: clamped.clone(),
-            settings: HarmonicBalance::default(),
+            settings: HarmonicBalanceSettings::default(),
             options: BackboneOptions {
                 grid,
                 ..Default::default()
@@ -173,7 +173,7 @@ mod tests {
         });
         jobs.push(SweepJob {
             system: robin,
-            settings: HarmonicBalance {
+            settings: HarmonicBalanceSettings {
                 harmonics: 12,
                 ..Default::default()
             },
@@ -190,7 +190,7 @@ mod tests {
         // an invalid job: its error comes back in its slot
         jobs.push(SweepJob {
             system: clamped,
-            settings: HarmonicBalance {
+            settings: HarmonicBalanceSettings {
                 harmonics: 0,
                 ..Default::default()
             },

@@ -14,7 +14,9 @@ use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{
     Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton,
 };
-use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{
+    AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
+};
 use nonsmooth_modes::{ContinuationError, Error, ModelError, SettingsError, SolveError};
 use std::f64::consts::PI;
 
@@ -215,13 +217,13 @@ fn wrong_equation_count() {
 fn bad_harmonic_balance_settings() {
     let system = clamped();
     let err = |settings| NonsmoothSystem::new(&system, settings).unwrap_err();
-    let zero = HarmonicBalance {
+    let zero = HarmonicBalanceSettings {
         harmonics: 0,
         ..Default::default()
     };
     assert_eq!(err(zero), Error::Settings(SettingsError::ZeroHarmonics));
     for n_h in [0, 1, 2] {
-        let s = HarmonicBalance {
+        let s = HarmonicBalanceSettings {
             samples_per_harmonic: n_h,
             ..Default::default()
         };
@@ -232,22 +234,22 @@ fn bad_harmonic_balance_settings() {
     }
     assert!(NonsmoothSystem::new(
         &system,
-        HarmonicBalance {
+        HarmonicBalanceSettings {
             samples_per_harmonic: 3,
             ..Default::default()
         }
     )
     .is_ok());
     for v in BAD {
-        match err(HarmonicBalance {
-            penalty: v,
+        match err(HarmonicBalanceSettings {
+            complementarity: v,
             ..Default::default()
         }) {
             Error::Settings(SettingsError::NotPositive { what, value }) => {
-                assert_eq!(what, "complementarity penalty a_c");
+                assert_eq!(what, "complementarity parameter a_c");
                 assert!(same(value, v));
             }
-            other => panic!("penalty {v}: {other:?}"),
+            other => panic!("a_c {v}: {other:?}"),
         }
     }
     // Errors reach backbone unchanged.
@@ -268,7 +270,7 @@ fn system_without_contact() {
     let system = linear_only();
     assert_eq!(system.contact_count(), 0);
     assert_eq!(
-        NonsmoothSystem::new(&system, HarmonicBalance::default()).unwrap_err(),
+        NonsmoothSystem::new(&system, HarmonicBalanceSettings::default()).unwrap_err(),
         Error::Settings(SettingsError::NoContact)
     );
     assert_eq!(
@@ -278,7 +280,7 @@ fn system_without_contact() {
     assert_eq!(
         backbone(
             &system,
-            HarmonicBalance::default(),
+            HarmonicBalanceSettings::default(),
             &BackboneOptions::default(),
             SemismoothNewton::default()
         )
@@ -293,7 +295,7 @@ fn system_without_contact() {
 #[test]
 fn bad_modes_and_subharmonics() {
     let system = clamped();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 5,
         ..Default::default()
     };
@@ -362,7 +364,7 @@ fn frozen(problem: &mut NonsmoothSystem) -> &mut NonsmoothSystem {
 
 #[test]
 fn solver_input_errors() {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 6,
         ..Default::default()
     };
@@ -402,7 +404,7 @@ fn solver_input_errors() {
 
 #[test]
 fn iteration_budget() {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 6,
         ..Default::default()
     };
@@ -775,7 +777,7 @@ fn bad_continuation_ranges() {
     assert_eq!(values.len(), 5);
     assert!(values.iter().all(|v| v.is_finite()));
 
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 4,
         ..Default::default()
     };
@@ -818,7 +820,7 @@ fn bad_continuation_ranges() {
 #[test]
 fn bad_period_grids() {
     let system = clamped();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 4,
         ..Default::default()
     };
@@ -928,7 +930,7 @@ fn error_messages_carry_the_numbers() {
 fn kink_blend_must_be_non_negative_and_finite() {
     let system = nonsmooth_modes::reference::clamped_bar_with_obstacle(1e-3).unwrap();
     for v in [-1e-4, f64::NAN, f64::INFINITY] {
-        let settings = HarmonicBalance {
+        let settings = HarmonicBalanceSettings {
             kink_blend: v,
             ..Default::default()
         };
@@ -940,7 +942,7 @@ fn kink_blend_must_be_non_negative_and_finite() {
             other => panic!("kink blend {v}: {other:?}"),
         }
     }
-    let exact = HarmonicBalance {
+    let exact = HarmonicBalanceSettings {
         kink_blend: 0.0,
         ..Default::default()
     };

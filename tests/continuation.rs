@@ -12,7 +12,7 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::{residual_scale, Problem, SemismoothNewton};
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem, ParameterFamily};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -22,7 +22,7 @@ fn run_backbone(
     options: &ArclengthBackboneOptions,
 ) -> (Vec<BackbonePoint>, nonsmooth_modes::continuation::Branch) {
     let mut points = Vec::new();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics,
         ..Default::default()
     };
@@ -46,7 +46,7 @@ fn assert_all_converged(
     harmonics: usize,
     points: &[BackbonePoint],
 ) {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics,
         ..Default::default()
     };
@@ -108,7 +108,7 @@ fn robin_bar_arclength_crosses_the_figure_10_range() {
 fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
     // The truncated problem is positively homogeneous in the gap: x(s g0) = s x(g0), so
     // E / g0^2 is constant along the branch.
-    let settings = HarmonicBalance::default();
+    let settings = HarmonicBalanceSettings::default();
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
     let grid = BackboneOptions {
         grid: PeriodGrid {
@@ -138,20 +138,20 @@ fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
     };
     let mut driver = Arclength::new(family, solver, x, 1e-3, options).unwrap();
     let per_gap2 = |p: &Point| {
-        let s = clamped_bar_with_obstacle(p.lambda).unwrap();
-        energy(&s, &basis, &p.x, omega) / (p.lambda * p.lambda)
+        let s = clamped_bar_with_obstacle(p.parameter).unwrap();
+        energy(&s, &basis, &p.x, omega) / (p.parameter * p.parameter)
     };
     let branch = driver.run(&mut nonsmooth_modes::continuation::quiet);
     let reference = per_gap2(&branch.points[0]);
     let exact = ClampedFirstMode::new(1.0, period).energy();
     assert!((reference / exact - 1.0).abs() < 0.05);
     assert!(branch.points.len() > 5);
-    assert!(branch.points.iter().any(|p| p.lambda > 3.5e-3));
+    assert!(branch.points.iter().any(|p| p.parameter > 3.5e-3));
     for p in &branch.points {
         assert!(
             (per_gap2(p) / reference - 1.0).abs() < 1e-8,
             "gap {}",
-            p.lambda
+            p.parameter
         );
     }
 }
@@ -159,7 +159,7 @@ fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
 #[test]
 fn iterator_restart_and_reverse_direction() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 10,
         ..Default::default()
     };
@@ -181,7 +181,7 @@ fn iterator_restart_and_reverse_direction() {
     .unwrap();
     let forward: Vec<Point> = driver.take(15).map(Result::unwrap).collect();
     assert_eq!(forward.len(), 15);
-    assert!(forward.last().unwrap().lambda < 3.9);
+    assert!(forward.last().unwrap().parameter < 3.9);
     // Restart from a stored point in the other direction: the period grows again.
     let pivot = &forward[10];
     let mut back = Arclength::restart(
@@ -197,7 +197,7 @@ fn iterator_restart_and_reverse_direction() {
     let mut grew = false;
     for _ in 0..20 {
         if let Step::Accepted(p) = back.step() {
-            grew |= p.lambda > pivot.lambda;
+            grew |= p.parameter > pivot.parameter;
             assert!(p.residual_norm <= 1e-12);
             assert!(p
                 .events
@@ -399,10 +399,10 @@ fn clamped_backbone_m40(
     options: &BackboneOptions,
     speculation: Option<nonsmooth_modes::continuation::Speculation>,
 ) -> Vec<BackbonePoint> {
-    use nonsmooth_modes::modal::backbone::{backbone_speculative_with, backbone_with};
+    use nonsmooth_modes::modal::{backbone_speculative_with, backbone_with};
     use nonsmooth_modes::solve::NewtonOptions;
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 40,
         ..Default::default()
     };

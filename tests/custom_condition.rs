@@ -19,7 +19,9 @@ use nonsmooth_modes::reference::{
     ROBIN_FREE_FREQUENCIES,
 };
 use nonsmooth_modes::solve::{Problem, SemismoothNewton};
-use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{
+    AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
+};
 use std::f64::consts::PI;
 
 const GAP: f64 = 1e-3;
@@ -141,7 +143,7 @@ fn end_mass_frequencies() {
 /// system is the paper's Robin-Signorini system, residual, Jacobian and backbone alike.
 #[test]
 fn massless_spring_is_the_robin_condition() {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 10,
         ..Default::default()
     };
@@ -200,7 +202,7 @@ fn massless_spring_is_the_robin_condition() {
 /// a central difference (and does not without it).
 #[test]
 fn mass_row_derivative_reaches_the_system() {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 8,
         ..Default::default()
     };
@@ -294,7 +296,7 @@ impl UnilateralLaw for CompliantObstacle {
             terms: vec![Term::new(self.end, Quantity::ContactForce, 1.0)],
         }
     }
-    fn residual(&self, gap: f64, force: f64, penalty: f64) -> LawValue {
+    fn residual(&self, gap: f64, force: f64, a_c: f64) -> LawValue {
         if self.penalty_form {
             let d_gap = if gap < 0.0 { self.stiffness } else { 0.0 };
             return LawValue {
@@ -303,7 +305,7 @@ impl UnilateralLaw for CompliantObstacle {
                 d_force: 1.0,
             };
         }
-        let v = complementarity(gap + force / self.stiffness, force, penalty);
+        let v = complementarity(gap + force / self.stiffness, force, a_c);
         LawValue {
             d_force: v.d_force + v.d_gap / self.stiffness,
             ..v
@@ -332,7 +334,7 @@ fn compliant_system(stiffness: f64, penalty_form: bool) -> BarSystem {
 /// Returns `(period, converged, E / E_g)`.
 fn compliant_backbone(
     stiffness: f64,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     periods: &[f64],
     seed_scale: f64,
 ) -> Vec<(f64, bool, f64)> {
@@ -365,9 +367,9 @@ fn compliant_backbone(
     .flatten()
     .map(|p| {
         (
-            p.lambda,
+            p.parameter,
             p.converged,
-            energy(&system, &basis, &p.x, 2.0 * PI / p.lambda) / e_g,
+            energy(&system, &basis, &p.x, 2.0 * PI / p.parameter) / e_g,
         )
     })
     .collect()
@@ -379,7 +381,7 @@ fn compliant_backbone(
 /// 2.606, 3.226, 3.394 for `k_c = 1e2 .. 1e5`, rigid 3.415.
 #[test]
 fn compliant_obstacle_tends_to_the_rigid_one() {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 20,
         ..Default::default()
     };
@@ -437,7 +439,7 @@ fn compliant_obstacle_tends_to_the_rigid_one() {
 #[test]
 fn custom_law_jacobian_matches_finite_differences() {
     use nonsmooth_modes::linalg::DenseMatrix;
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 6,
         ..Default::default()
     };

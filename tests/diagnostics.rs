@@ -5,7 +5,7 @@ use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::diagnose;
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 
 const GAP: f64 = 1e-3;
@@ -20,7 +20,7 @@ fn signorini_residual_norm_decreases_with_m_at_about_the_first_order_rate() {
     let exact = ClampedFirstMode::new(GAP, PERIOD).energy_normalized();
     let mut norms = Vec::new();
     for m in [10, 20, 40, 80] {
-        let settings = HarmonicBalance {
+        let settings = HarmonicBalanceSettings {
             harmonics: m,
             ..Default::default()
         };

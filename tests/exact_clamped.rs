@@ -14,7 +14,7 @@ use nonsmooth_modes::reference::{
 };
 use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::rows::HarmonicRows;
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -35,12 +35,12 @@ fn score(points: &[BackbonePoint]) -> (usize, usize) {
 
 fn paper_grid_backbone(solver: impl NonlinearSolver) -> Vec<BackbonePoint> {
     let system = clamped_bar_with_obstacle(GAP).unwrap();
-    let settings = HarmonicBalance::default();
+    let settings = HarmonicBalanceSettings::default();
     assert_eq!(
         (
             settings.harmonics,
             settings.samples_per_harmonic,
-            settings.penalty
+            settings.complementarity
         ),
         (20, 30, 4.0)
     );
@@ -255,7 +255,7 @@ fn energy_of_the_truncated_exact_mode_converges() {
     let (e_g, _) = grazing_energy(&system).unwrap();
     let mut previous = f64::INFINITY;
     for m in [10, 20, 40, 80] {
-        let settings = HarmonicBalance {
+        let settings = HarmonicBalanceSettings {
             harmonics: m,
             ..Default::default()
         };
@@ -299,7 +299,7 @@ fn solved_energy_near_the_exact_mode() {
     let system = clamped_bar_with_obstacle(GAP).unwrap();
     let (e_g, _) = grazing_energy(&system).unwrap();
     for m in [10, 20, 40] {
-        let settings = HarmonicBalance {
+        let settings = HarmonicBalanceSettings {
             harmonics: m,
             ..Default::default()
         };

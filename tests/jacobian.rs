@@ -9,7 +9,7 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
 use nonsmooth_modes::solve::Problem;
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
@@ -31,13 +31,13 @@ fn system(which: usize) -> (BarSystem, f64, f64) {
 
 /// Which branch of `r = -min(lambda, a_c g)` every time sample of every law takes.
 fn active_set(problem: &mut NonsmoothSystem, x: &[f64], omega: f64) -> Vec<bool> {
-    let penalty = problem.penalty();
+    let a_c = problem.complementarity();
     let laws = problem.system().contact_count();
     let mut set = Vec::new();
     for l in 0..laws {
         let g = problem.gap_history(x, omega, l);
         let f = problem.force_history(x, omega, l);
-        set.extend(g.iter().zip(&f).map(|(g, f)| *f < penalty * g));
+        set.extend(g.iter().zip(&f).map(|(g, f)| *f < a_c * g));
     }
     set
 }
@@ -55,7 +55,7 @@ fn seed(which: usize, harmonics: usize) -> Vec<f64> {
             .map(|k| {
                 let (sys, t0, t1) = system(k / 2);
                 let m = if k % 2 == 0 { 3 } else { 8 };
-                let settings = HarmonicBalance {
+                let settings = HarmonicBalanceSettings {
                     harmonics: m,
                     // The exact generalised Jacobian is what is checked here.
                     kink_blend: 0.0,
@@ -200,7 +200,7 @@ proptest! {
         perturbation in proptest::collection::vec(-1.0..=1.0_f64, 36),
     ) {
         let (sys, t0, t1) = system(which);
-        let settings = HarmonicBalance { harmonics, kink_blend: 0.0, ..Default::default() };
+        let settings = HarmonicBalanceSettings { harmonics, kink_blend: 0.0, ..Default::default() };
         let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
         let period = t0 + period_fraction * (t1 - t0);
         let omega = 2.0 * PI / period;
@@ -228,7 +228,7 @@ proptest! {
         perturbation in proptest::collection::vec(-1.0..=1.0_f64, 36),
     ) {
         let (sys, t0, t1) = system(which);
-        let settings = HarmonicBalance { harmonics: 8, kink_blend: 0.0, ..Default::default() };
+        let settings = HarmonicBalanceSettings { harmonics: 8, kink_blend: 0.0, ..Default::default() };
         let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
         let period = t0 + period_fraction * (t1 - t0);
         let omega = 2.0 * PI / period;
@@ -297,7 +297,7 @@ fn jacobian_matches_finite_differences_near_converged_points() {
     for which in 0..3 {
         let (sys, t0, t1) = system(which);
         for harmonics in [3, 8] {
-            let settings = HarmonicBalance {
+            let settings = HarmonicBalanceSettings {
                 harmonics,
                 // The exact generalised Jacobian is what is checked here.
                 kink_blend: 0.0,

@@ -5,7 +5,7 @@ use nonsmooth_modes::modal::{branch_seed, natural_frequencies, ContactState};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use nonsmooth_modes::{Error, SettingsError};
 use std::f64::consts::PI;
 
@@ -96,7 +96,7 @@ fn clamped_and_two_bar_frequencies_to_1e8() {
 fn a_mode_beyond_the_searched_range_is_a_typed_error() {
     // A single clamped bar has modes at (2i - 1) pi / 2: mode 10^6 is far beyond the search.
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let mut problem = NonsmoothSystem::new(&system, HarmonicBalance::default()).unwrap();
+    let mut problem = NonsmoothSystem::new(&system, HarmonicBalanceSettings::default()).unwrap();
     match branch_seed(&mut problem, 1_000_000, 1, 1.6) {
         Err(Error::Settings(SettingsError::ModeNotFound { mode, omega_max })) => {
             assert_eq!(mode, 1_000_000);
@@ -121,7 +121,8 @@ fn seed_from_a_known_mode_equals_the_searched_seed() {
         robin_bar_with_obstacle(0.5, 1e-3).unwrap(),
         two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 1e-3).unwrap(),
     ] {
-        let mut problem = NonsmoothSystem::new(&system, HarmonicBalance::default()).unwrap();
+        let mut problem =
+            NonsmoothSystem::new(&system, HarmonicBalanceSettings::default()).unwrap();
         let (_, first) = grazing_energy(&system).unwrap();
         for (subharmonic, omega) in [(1, 0.9 * first.omega), (3, 2.9 * first.omega)] {
             let searched = branch_seed(&mut problem, 1, subharmonic, omega).unwrap();

@@ -9,7 +9,7 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
 use nonsmooth_modes::solve::{Problem, Structured};
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 
 /// Gaussian elimination with partial pivoting: the dense reference.
@@ -44,7 +44,7 @@ fn dense_solve(j: &DenseMatrix, f: &[f64]) -> Vec<f64> {
 }
 
 fn check(system: &BarSystem, harmonics: usize, period: f64) {
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics,
         ..Default::default()
     };
@@ -109,7 +109,7 @@ fn line_search_residual_equals_the_residual_at_the_trial_point() {
         two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 1e-3).unwrap(),
     ];
     for system in &systems {
-        let settings = HarmonicBalance {
+        let settings = HarmonicBalanceSettings {
             harmonics: 12,
             ..Default::default()
         };

@@ -102,13 +102,13 @@ fn sequential_follows_the_upper_sheet_and_loses_it_past_the_fold() {
     assert_eq!(tally.rejected, branch.rejections);
     assert_eq!(branch.points.len() + branch.rejections, values.len());
     for p in &branch.points {
-        assert!(on_branch(p.x[0], p.lambda));
+        assert!(on_branch(p.x[0], p.parameter));
     }
     // Upper sheet while it exists, the lower one after the fold.
-    let upper = branch.points.iter().filter(|p| p.lambda > -0.38);
+    let upper = branch.points.iter().filter(|p| p.parameter > -0.38);
     assert!(upper.clone().all(|p| p.x[0] > 0.57), "upper sheet");
     let last = branch.points.last().unwrap();
-    assert!(last.lambda < -0.38 && last.x[0] < -1.0, "{last:?}");
+    assert!(last.parameter < -0.38 && last.x[0] < -1.0, "{last:?}");
     // The iterator gives the same points.
     let mut again = Sequential::new(
         Cusp::default(),
@@ -146,20 +146,20 @@ fn arclength_passes_both_folds_and_an_observer_can_stop_it() {
     let mut tally = Tally::default();
     let branch = driver().run(&mut tally);
     assert!(
-        matches!(branch.end, EndReason::ParameterOutOfRange { lambda } if lambda < -1.0),
+        matches!(branch.end, EndReason::ParameterOutOfRange { parameter } if parameter < -1.0),
         "{:?}",
         branch.end
     );
     assert_eq!(tally.ended, Some(branch.end.clone()));
     let folds: Vec<f64> = branch
         .with_event(|e| matches!(e, Event::Fold { .. }))
-        .map(|p| p.lambda)
+        .map(|p| p.parameter)
         .collect();
     assert_eq!(folds.len(), 2, "{folds:?}");
     let fold = 2.0 / (3.0 * 3f64.sqrt());
     assert!((folds[0] + fold).abs() < 0.05 && (folds[1] - fold).abs() < 0.05);
     for p in &branch.points {
-        assert!(on_branch(p.x[0], p.lambda));
+        assert!(on_branch(p.x[0], p.parameter));
     }
     // Our observer stops the run after 7 accepted points (the start included).
     let mut stopping = Tally {
@@ -231,7 +231,7 @@ fn our_solver_drives_both_drivers() {
     .unwrap();
     let points: Vec<_> = sequential.by_ref().map(Result::unwrap).collect();
     assert_eq!(points.len(), 9);
-    assert!(points.iter().all(|p| on_branch(p.x[0], p.lambda)));
+    assert!(points.iter().all(|p| on_branch(p.x[0], p.parameter)));
     let options = ArclengthOptions {
         max_steps: 10,
         scale: ArclengthScale::Fixed(1.0, 1.0),
@@ -241,5 +241,5 @@ fn our_solver_drives_both_drivers() {
     let branch = arclength.run(&mut nonsmooth_modes::continuation::quiet);
     assert_eq!(branch.end, EndReason::MaxSteps);
     assert_eq!(branch.points.len(), 11);
-    assert!(branch.points.iter().all(|p| on_branch(p.x[0], p.lambda)));
+    assert!(branch.points.iter().all(|p| on_branch(p.x[0], p.parameter)));
 }

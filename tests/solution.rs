@@ -9,12 +9,12 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use nonsmooth_modes::verify::PeriodicityOptions;
 use nonsmooth_modes::{SettingsError, Solution};
 
-fn settings() -> HarmonicBalance {
-    HarmonicBalance {
+fn settings() -> HarmonicBalanceSettings {
+    HarmonicBalanceSettings {
         harmonics: 20,
         ..Default::default()
     }

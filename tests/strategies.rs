@@ -7,7 +7,7 @@ use nonsmooth_modes::strategies::{
     bar, clamped_system, frequency, gap, helmholtz_coefficients, period_in_first_family,
     robin_system, two_bar_system,
 };
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::TestRunner;
@@ -47,7 +47,7 @@ proptest! {
             prop_assert_eq!(system.contact_count(), 1);
             let gap = system.laws().next().unwrap().gap().offset;
             prop_assert!((1e-4..=1e-1).contains(&gap));
-            let settings = HarmonicBalance { harmonics: 4, ..Default::default() };
+            let settings = HarmonicBalanceSettings { harmonics: 4, ..Default::default() };
             let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
             let seed = branch_seed(&mut problem, 1, 1, 1.0).unwrap();
             prop_assert!(seed.iter().all(|v| v.is_finite()));

@@ -5,7 +5,7 @@ use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::modal::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{HarmonicBalance, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 
 const GAP: f64 = 1e-3;
@@ -27,28 +27,24 @@ fn bar_unknowns(x: &[f64], bar: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Backbones of the two systems on the same grid: two unit bars (gap `g0`, penalty `a_c`)
-/// and one clamped unit bar (gap `g0/2`, penalty `2 a_c`).
-fn pair(
-    harmonics: usize,
-    penalty: f64,
-    grid: PeriodGrid,
-) -> (Vec<BackbonePoint>, Vec<BackbonePoint>) {
+/// Backbones of the two systems on the same grid: two unit bars (gap `g0`, complementarity parameter `a_c`)
+/// and one clamped unit bar (gap `g0/2`, `2 a_c`).
+fn pair(harmonics: usize, a_c: f64, grid: PeriodGrid) -> (Vec<BackbonePoint>, Vec<BackbonePoint>) {
     let options = BackboneOptions {
         grid,
         ..Default::default()
     };
     let twins = two_bars_in_contact(Bar::unit(), GAP).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics,
-        penalty,
+        complementarity: a_c,
         ..Default::default()
     };
     let two = backbone(&twins, settings, &options, SemismoothNewton::default()).unwrap();
     let single = clamped_bar_with_obstacle(0.5 * GAP).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics,
-        penalty: 2.0 * penalty,
+        complementarity: 2.0 * a_c,
         ..Default::default()
     };
     let one = backbone(&single, settings, &options, SemismoothNewton::default()).unwrap();
@@ -57,16 +53,16 @@ fn pair(
 
 /// Both systems are the same problem: with `v_A = v_B = v` the two-bar gap `g0 - 2v` is twice
 /// the single-bar gap `g0/2 - v`, so `-min(lambda, a_c (g0 - 2v)) = -min(lambda, 2 a_c (g0/2 - v))`.
-/// Truncated solutions depend on `a_c`, so the comparison needs the doubled penalty.
+/// Truncated solutions depend on `a_c`, so the comparison needs the doubled `a_c`.
 #[test]
 fn two_identical_bars_move_like_one_bar_against_half_the_gap() {
-    for (harmonics, penalty) in [(10, 4.0), (20, 4.0), (12, 1.5)] {
+    for (harmonics, a_c) in [(10, 4.0), (20, 4.0), (12, 1.5)] {
         let grid = PeriodGrid {
             start: 3.95,
             end: 3.3,
             steps: 14,
         };
-        let (two, one) = pair(harmonics, penalty, grid);
+        let (two, one) = pair(harmonics, a_c, grid);
         assert_eq!(two.len(), one.len());
         let mut compared = 0;
         for (p2, p1) in two.iter().zip(&one) {
@@ -89,7 +85,11 @@ fn two_identical_bars_move_like_one_bar_against_half_the_gap() {
             // The same equations up to scaling: the solutions agree to rounding (the two
             // systems' Newton steps are computed from differently sized reduced matrices).
             let d = distance(&a, &p1.x);
-            assert!(d < 1e-9, "m {harmonics}, a_c {penalty}, T {}: two-bar vs single-bar unknowns differ by {d:e}", p2.period);
+            assert!(
+                d < 1e-9,
+                "m {harmonics}, a_c {a_c}, T {}: two-bar vs single-bar unknowns differ by {d:e}",
+                p2.period
+            );
             // Twice the bars, twice the energy; E_g doubles too (the twin first mode is double
             // and the grazing motion of least energy moves both bars by g0/2).
             assert!((p2.energy / (2.0 * p1.energy) - 1.0).abs() < 1e-8);
@@ -110,7 +110,7 @@ fn two_identical_bars_move_like_one_bar_against_half_the_gap() {
 #[test]
 fn degenerate_harmonic_of_two_identical_bars() {
     let twins = two_bars_in_contact(Bar::unit(), GAP).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 10,
         ..Default::default()
     };

@@ -7,7 +7,7 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::HarmonicBalance;
+use nonsmooth_modes::system::HarmonicBalanceSettings;
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions, State, VerifyError};
 use std::f64::consts::PI;
 
@@ -35,7 +35,7 @@ fn truncated_exact_solution_defect_decays_with_harmonics() {
     let mut reports = Vec::new();
     for m in [20, 80] {
         let (x, omega) = truncated_exact(3.65, m);
-        let basis = HarmonicBalance {
+        let basis = HarmonicBalanceSettings {
             harmonics: m,
             ..Default::default()
         }
@@ -65,7 +65,7 @@ fn truncated_exact_solution_defect_decays_with_harmonics() {
 #[test]
 fn clamped_bar_harmonic_balance_point_is_as_periodic_as_the_truncated_exact_mode() {
     let system = clamped_bar_with_obstacle(GAP).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 20,
         ..Default::default()
     };
@@ -111,7 +111,7 @@ fn two_bar_check_of_the_paper_figure_16() {
     // Configuration 1 (l = 0.95, c = 1, EA ratio 1), a point of the first-mode backbone,
     // dt = 0.01: bar 1 has 100 cells, bar 2 has 95.
     let system = two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), GAP).unwrap();
-    let settings = HarmonicBalance {
+    let settings = HarmonicBalanceSettings {
         harmonics: 20,
         ..Default::default()
     };

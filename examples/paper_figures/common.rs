@@ -14,7 +14,7 @@ use nonsmooth_modes::plot::{
 };
 use nonsmooth_modes::reference::ClampedFamily;
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{BarSystem, HarmonicBalance};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use std::io::Write as _;
 use std::path::PathBuf;
 
@@ -173,11 +173,11 @@ impl Table {
 }
 
 /// Harmonic-balance settings with `m` harmonics, 30 samples per harmonic, `a_c = 4`.
-pub fn settings(m: usize) -> HarmonicBalance {
-    HarmonicBalance {
+pub fn settings(m: usize) -> HarmonicBalanceSettings {
+    HarmonicBalanceSettings {
         harmonics: m,
         samples_per_harmonic: 30,
-        penalty: 4.0,
+        complementarity: 4.0,
         ..Default::default()
     }
 }

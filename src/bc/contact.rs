@@ -79,18 +79,11 @@ impl UnilateralLaw for Contact {
             terms: vec![Term::new(self.first, Quantity::ContactForce, 1.0)],
         }
     }
-    fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
-        smoothed_complementarity(gap, force, penalty, smoothing)
+    fn smoothed_residual(&self, gap: f64, force: f64, a_c: f64, smoothing: f64) -> LawValue {
+        smoothed_complementarity(gap, force, a_c, smoothing)
     }
 
-    fn sample(
-        &self,
-        gaps: &[f64],
-        forces: &[f64],
-        penalty: f64,
-        smoothing: f64,
-        out: LawSamples<'_>,
-    ) {
-        complementarity_samples(gaps, forces, penalty, smoothing, out);
+    fn sample(&self, gaps: &[f64], forces: &[f64], a_c: f64, smoothing: f64, out: LawSamples<'_>) {
+        complementarity_samples(gaps, forces, a_c, smoothing, out);
     }
 }

@@ -35,13 +35,13 @@ pub struct LawSamples<'a> {
 }
 
 /// The Signorini complementarity `g >= 0, lambda >= 0, g lambda = 0` as one equation
-/// (formulation §3): `r = -min(lambda, a_c g)`, `a_c > 0` (the paper's `penalty`, default 4).
+/// (formulation §3): `r = -min(lambda, a_c g)`, `a_c > 0` (the paper's complementarity parameter, default 4).
 ///
 /// For a right end with `EA = 1` this is the paper's
 /// `r = p + max(a_c (v - g0) - p, 0)`. Where `lambda < a_c g` the force branch is active
 /// (`r = -lambda`); elsewhere, including the kink, the gap branch (`r = -a_c g`).
-pub fn complementarity(gap: f64, force: f64, penalty: f64) -> LawValue {
-    if force < penalty * gap {
+pub fn complementarity(gap: f64, force: f64, a_c: f64) -> LawValue {
+    if force < a_c * gap {
         LawValue {
             value: -force,
             d_gap: 0.0,
@@ -49,8 +49,8 @@ pub fn complementarity(gap: f64, force: f64, penalty: f64) -> LawValue {
         }
     } else {
         LawValue {
-            value: -penalty * gap,
-            d_gap: -penalty,
+            value: -a_c * gap,
+            d_gap: -a_c,
             d_force: 0.0,
         }
     }
@@ -60,16 +60,16 @@ pub fn complementarity(gap: f64, force: f64, penalty: f64) -> LawValue {
 /// smoothing `min_eps(a, b) = (a + b - sqrt((a - b)^2 + 4 eps^2)) / 2`: smooth for `eps > 0`,
 /// equal to [`complementarity`] for `eps = 0` (up to the choice at the kink). Solvers use it
 /// for homotopies `eps -> 0` ([`crate::solve::SmoothingHomotopy`]).
-pub fn smoothed_complementarity(gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
+pub fn smoothed_complementarity(gap: f64, force: f64, a_c: f64, smoothing: f64) -> LawValue {
     if smoothing <= 0.0 {
-        return complementarity(gap, force, penalty);
+        return complementarity(gap, force, a_c);
     }
-    let (a, b) = (force, penalty * gap);
+    let (a, b) = (force, a_c * gap);
     let root = ((a - b) * (a - b) + 4.0 * smoothing * smoothing).sqrt();
     let t = (a - b) / root;
     LawValue {
         value: -0.5 * (a + b - root),
-        d_gap: -0.5 * penalty * (1.0 + t),
+        d_gap: -0.5 * a_c * (1.0 + t),
         d_force: -0.5 * (1.0 - t),
     }
 }
@@ -115,12 +115,12 @@ fn sample_pointwise(
 pub fn complementarity_samples(
     gaps: &[f64],
     forces: &[f64],
-    penalty: f64,
+    a_c: f64,
     smoothing: f64,
     out: LawSamples<'_>,
 ) {
     if smoothing > 0.0 {
-        let law = |g, f| smoothed_complementarity(g, f, penalty, smoothing);
+        let law = |g, f| smoothed_complementarity(g, f, a_c, smoothing);
         return sample_pointwise(gaps, forces, out, law);
     }
     check_lengths(gaps, forces, &out);
@@ -132,10 +132,10 @@ pub fn complementarity_samples(
         .zip(out.d_force.iter_mut());
     for ((&g, &f), ((value, d_gap), d_force)) in samples.zip(outputs) {
         // The branch of `complementarity`: the force branch where `lambda < a_c g`.
-        let b = penalty * g;
+        let b = a_c * g;
         let force_branch = f < b;
         *value = if force_branch { -f } else { -b };
-        *d_gap = if force_branch { 0.0 } else { -penalty };
+        *d_gap = if force_branch { 0.0 } else { -a_c };
         *d_force = if force_branch { -1.0 } else { 0.0 };
     }
 }
@@ -154,17 +154,17 @@ pub trait UnilateralLaw: Debug + Send + Sync {
     fn force(&self) -> Observable;
 
     /// The pointwise residual; defaults to [`complementarity`].
-    fn residual(&self, gap: f64, force: f64, penalty: f64) -> LawValue {
-        complementarity(gap, force, penalty)
+    fn residual(&self, gap: f64, force: f64, a_c: f64) -> LawValue {
+        complementarity(gap, force, a_c)
     }
 
     /// A smoothed version of [`UnilateralLaw::residual`] with smoothing `smoothing >= 0`
     /// (a force), used by smoothing homotopies; it must equal `residual` at `smoothing = 0`.
     /// The default ignores the smoothing (a law that overrides `residual` keeps its own
     /// nonsmooth form); Signorini and contact use [`smoothed_complementarity`].
-    fn smoothed_residual(&self, gap: f64, force: f64, penalty: f64, smoothing: f64) -> LawValue {
+    fn smoothed_residual(&self, gap: f64, force: f64, a_c: f64, smoothing: f64) -> LawValue {
         let _ = smoothing;
-        self.residual(gap, force, penalty)
+        self.residual(gap, force, a_c)
     }
 
     /// [`UnilateralLaw::smoothed_residual`] at every sample `(gaps[k], forces[k])` of a time
@@ -174,15 +174,8 @@ pub trait UnilateralLaw: Debug + Send + Sync {
     ///
     /// # Panics
     /// If the slices do not all have the same length (a programmer contract of the caller).
-    fn sample(
-        &self,
-        gaps: &[f64],
-        forces: &[f64],
-        penalty: f64,
-        smoothing: f64,
-        out: LawSamples<'_>,
-    ) {
-        let law = |g, f| self.smoothed_residual(g, f, penalty, smoothing);
+    fn sample(&self, gaps: &[f64], forces: &[f64], a_c: f64, smoothing: f64, out: LawSamples<'_>) {
+        let law = |g, f| self.smoothed_residual(g, f, a_c, smoothing);
         sample_pointwise(gaps, forces, out, law);
     }
 }

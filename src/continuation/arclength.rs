@@ -534,7 +534,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         point: &Point,
         options: ArclengthOptions,
     ) -> Result<Self, ContinuationError> {
-        Self::new(problem, solver, point.x.clone(), point.lambda, options)
+        Self::new(problem, solver, point.x.clone(), point.parameter, options)
     }
 
     /// The problem.
@@ -596,7 +596,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         let n = self.problem.dimension();
         Point {
             step,
-            lambda: self.y[n],
+            parameter: self.y[n],
             x: self.y[..n].to_vec(),
             residual_norm: info.residual_norm,
             iterations: info.iterations,
@@ -610,7 +610,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     fn reject(&mut self, lambda: f64, reason: RejectReason) -> Step {
         let rejection = Rejection {
             step: self.accepted + 1,
-            lambda,
+            parameter: lambda,
             step_size: self.ds,
             reason,
             point: None,
@@ -701,12 +701,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         }
         let (lo, hi) = self.options.parameter_range;
         if y[n] < lo || y[n] > hi {
-            let end = EndReason::ParameterOutOfRange { lambda: y[n] };
+            let end = EndReason::ParameterOutOfRange { parameter: y[n] };
             self.finished = Some(end.clone());
             return Step::Finished(end);
         }
         if tangent[n] * self.tangent[n] < 0.0 {
-            events.push(Event::Fold { lambda: y[n] });
+            events.push(Event::Fold { parameter: y[n] });
         }
         self.problem.set_parameter(y[n]);
         let active = self.problem.structure().and_then(|s| s.active_set(&y[..n]));
@@ -744,7 +744,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 self.history.pop_front();
             }
             if self.is_stalled(&escape) {
-                return self.escape(&escape, point.lambda);
+                return self.escape(&escape, point.parameter);
             }
         }
         Step::Accepted(point)
@@ -792,7 +792,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             let target = dir * (ahead + distance);
             let (lo, hi) = self.options.parameter_range;
             if target < lo || target > hi {
-                let end = EndReason::ParameterOutOfRange { lambda: target };
+                let end = EndReason::ParameterOutOfRange { parameter: target };
                 self.finished = Some(end.clone());
                 return Step::Finished(end);
             }
@@ -831,7 +831,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         }
         let end = EndReason::Stalled {
             failures: escape.max_attempts,
-            lambda: now,
+            parameter: now,
         };
         self.finished = Some(end.clone());
         Step::Finished(end)
@@ -917,7 +917,9 @@ mod tests {
         .unwrap();
         let branch = driver.run(&mut crate::continuation::quiet);
         // Leaves through lambda < -0.5 on the lower half after turning at lambda = 1.
-        assert!(matches!(branch.end, EndReason::ParameterOutOfRange { lambda } if lambda < -0.5));
+        assert!(
+            matches!(branch.end, EndReason::ParameterOutOfRange { parameter } if parameter < -0.5)
+        );
         assert_eq!(branch.points[0].step, 0);
         assert!(
             (branch.points[0].x[0] - 1.0).abs() < 1e-9,
@@ -927,18 +929,19 @@ mod tests {
             .with_event(|e| matches!(e, Event::Fold { .. }))
             .collect();
         assert_eq!(folds.len(), 1);
-        assert!(folds[0].lambda > 0.95);
+        assert!(folds[0].parameter > 0.95);
         assert!(
             branch.points.iter().any(|p| p.x[0] < -0.5),
             "came back on the other side"
         );
         for p in &branch.points {
-            assert!((p.x[0].powi(2) + p.lambda.powi(2) - 1.0).abs() < 1e-9);
+            assert!((p.x[0].powi(2) + p.parameter.powi(2) - 1.0).abs() < 1e-9);
         }
         // Arclength steps match the geometry: consecutive points are ds apart (chord ~ arc).
         for w in branch.points.windows(2) {
-            let chord =
-                ((w[1].x[0] - w[0].x[0]).powi(2) + (w[1].lambda - w[0].lambda).powi(2)).sqrt();
+            let chord = ((w[1].x[0] - w[0].x[0]).powi(2)
+                + (w[1].parameter - w[0].parameter).powi(2))
+            .sqrt();
             assert!((chord - w[1].step_size).abs() < 0.01 * w[1].step_size + 1e-3);
         }
     }

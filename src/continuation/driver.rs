@@ -43,7 +43,7 @@ pub struct Rejection {
     pub step: usize,
     /// Parameter value tried (the predicted one, or the corrected one when the corrector
     /// converged).
-    pub lambda: f64,
+    pub parameter: f64,
     /// Step tried: the parameter increment for natural-parameter runs, the arclength `ds`
     /// for pseudo-arclength runs.
     pub step_size: f64,
@@ -89,7 +89,7 @@ pub enum EndReason {
     /// The corrected parameter left the allowed range (the point is not kept).
     ParameterOutOfRange {
         /// The parameter value reached.
-        lambda: f64,
+        parameter: f64,
     },
     /// The step fell below its minimum.
     StepBelowMinimum {
@@ -104,7 +104,7 @@ pub enum EndReason {
         /// Consecutive failures, or escape attempts.
         failures: usize,
         /// Parameter value where the run stalled.
-        lambda: f64,
+        parameter: f64,
     },
 }
 
@@ -113,13 +113,16 @@ impl EndReason {
     /// a run that ended as asked.
     pub fn error(&self) -> Option<ContinuationError> {
         match self {
-            Self::Stalled { failures, lambda } => Some(ContinuationError::Stalled {
+            Self::Stalled {
+                failures,
+                parameter,
+            } => Some(ContinuationError::Stalled {
                 failures: *failures,
-                parameter: *lambda,
+                parameter: *parameter,
             }),
             Self::StepBelowMinimum { last } => Some(ContinuationError::StepBelowMinimum {
                 step_size: last.step_size,
-                parameter: last.lambda,
+                parameter: last.parameter,
             }),
             _ => None,
         }

@@ -137,7 +137,7 @@ pub struct Point {
     pub step: usize,
     /// Value of the continuation parameter (the period under [`PeriodParametrised`], the
     /// frequency for a harmonic-balance system, the system parameter of a family).
-    pub lambda: f64,
+    pub parameter: f64,
     /// Solution (the last iterate when the step failed).
     pub x: Vec<f64>,
     /// `|F(x, lambda)|_2`.
@@ -163,7 +163,7 @@ pub enum Event {
     /// Turning point: the parameter component of the tangent changed sign.
     Fold {
         /// Parameter at the point after the fold.
-        lambda: f64,
+        parameter: f64,
     },
     /// The corrected point is far from its prediction even at the smallest step.
     Jump {

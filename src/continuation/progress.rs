@@ -74,7 +74,7 @@ impl<W: Write> Progress<W> {
                 self.writer,
                 "step {:6}  parameter {:.8}{}  ds {:.3e}{}{}",
                 p.step,
-                p.lambda,
+                p.parameter,
                 measure,
                 p.step_size,
                 if events.is_empty() { "" } else { "  " },
@@ -92,7 +92,7 @@ impl<W: Write> Observer for Progress<W> {
                 let _ = writeln!(
                     self.writer,
                     "rejected  parameter {:.8}  step {:.3e}  {:?}",
-                    r.lambda, r.step_size, r.reason
+                    r.parameter, r.step_size, r.reason
                 );
             }
             Step::Finished(end) => {
@@ -113,7 +113,7 @@ mod tests {
         for step in 0..5 {
             let p = Point {
                 step,
-                lambda: step as f64,
+                parameter: step as f64,
                 x: vec![2.0 * step as f64],
                 residual_norm: 0.0,
                 iterations: 1,

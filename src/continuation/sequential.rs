@@ -384,7 +384,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                 self.last_lambda = lambda;
                 Step::Accepted(Point {
                     step,
-                    lambda,
+                    parameter: lambda,
                     x,
                     residual_norm: info.residual_norm,
                     iterations: info.iterations,
@@ -427,7 +427,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                 };
                 let point = Point {
                     step,
-                    lambda,
+                    parameter: lambda,
                     x,
                     residual_norm: norm(&f),
                     iterations,
@@ -439,12 +439,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                 if self.failures >= self.options.max_consecutive_failures {
                     self.finished = Some(EndReason::Stalled {
                         failures: self.failures,
-                        lambda,
+                        parameter: lambda,
                     });
                 }
                 Step::Rejected(Rejection {
                     step,
-                    lambda,
+                    parameter: lambda,
                     step_size,
                     reason,
                     point: Some(point),

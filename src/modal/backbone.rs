@@ -11,7 +11,7 @@ use crate::modal::energy::energy;
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::solution::Solution;
 use crate::solve::NonlinearSolver;
-use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -169,7 +169,7 @@ impl BackbonePoint {
 /// Invalid settings or options, a failed seed, or a stalled run.
 pub fn backbone_with<S: NonlinearSolver>(
     system: &BarSystem,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
@@ -188,7 +188,7 @@ pub fn backbone_with<S: NonlinearSolver>(
 /// See [`backbone_with`].
 pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
     system: &BarSystem,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     speculation: Speculation,
     solver: S,
@@ -204,7 +204,7 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
 /// itself left to `run`.
 fn drive_backbone<S: NonlinearSolver>(
     system: &BarSystem,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
     run: impl FnOnce(
@@ -282,10 +282,10 @@ fn drive_backbone<S: NonlinearSolver>(
         let Some(p) = step.point() else {
             return ControlFlow::Continue(());
         };
-        let omega = 2.0 * PI / p.lambda;
+        let omega = 2.0 * PI / p.parameter;
         let known = {
             let last = last_energy.borrow();
-            (last.1 == p.lambda && last.0 == p.x).then_some(last.2)
+            (last.1 == p.parameter && last.0 == p.x).then_some(last.2)
         };
         let e = known.unwrap_or_else(|| energy(system, &basis, &p.x, omega));
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
@@ -319,7 +319,7 @@ fn grazing_and_seed(
 /// See [`backbone_with`].
 pub fn backbone<S: NonlinearSolver>(
     system: &BarSystem,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
 ) -> Result<Vec<BackbonePoint>, Error> {
@@ -375,7 +375,7 @@ impl Default for ArclengthBackboneOptions {
 /// Invalid settings or options, a failed seed or a failed start.
 pub fn arclength_backbone<S: NonlinearSolver>(
     system: &BarSystem,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     options: &ArclengthBackboneOptions,
     solver: S,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
@@ -402,8 +402,8 @@ pub fn arclength_backbone<S: NonlinearSolver>(
     let branch = driver.run(&mut |step: &Step| match step {
         Step::Accepted(p) => observer(&BackbonePoint::from_point(
             p,
-            p.lambda,
-            energy(system, &basis, &p.x, p.lambda),
+            p.parameter,
+            energy(system, &basis, &p.x, p.parameter),
             e_g,
         )),
         _ => ControlFlow::Continue(()),

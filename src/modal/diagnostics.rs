@@ -13,7 +13,7 @@ use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
 use crate::solve::NonlinearSolver;
 use crate::system::rows::{dot, HarmonicRows};
-use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 
 /// Time histories of one end over a period.
@@ -179,7 +179,7 @@ pub fn law_history<B: Basis>(
         h.gap.push(g);
         h.force.push(l);
         h.residual
-            .push(law_ref.residual(g, l, problem.penalty()).value);
+            .push(law_ref.residual(g, l, problem.complementarity()).value);
     }
     Ok(h)
 }
@@ -274,14 +274,14 @@ pub struct ConvergenceEntry {
 /// Invalid settings or options (the first `m` that fails to set up).
 pub fn convergence_study<S: NonlinearSolver + Clone>(
     system: &BarSystem,
-    base: HarmonicBalance,
+    base: HarmonicBalanceSettings,
     grid: PeriodGrid,
     harmonics: &[usize],
     solver: S,
 ) -> Result<Vec<ConvergenceEntry>, Error> {
     let mut out = Vec::new();
     for &m in harmonics {
-        let settings = HarmonicBalance {
+        let settings = HarmonicBalanceSettings {
             harmonics: m,
             ..base
         };

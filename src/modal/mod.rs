@@ -1,15 +1,15 @@
 //! Modal post-processing: energy and its normalisation, linear modes of the open-contact
 //! system, branch seeds, and backbones.
 
-pub mod backbone;
+mod backbone;
 pub mod diagnostics;
 pub mod energy;
 pub mod field;
 pub mod linear;
 
 pub use backbone::{
-    arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
-    PeriodGrid,
+    arclength_backbone, backbone, backbone_speculative_with, backbone_with,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, PeriodGrid,
 };
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,

@@ -8,9 +8,9 @@
 //!
 //! ```
 //! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-//! use nonsmooth_modes::system::{HarmonicBalance, ParameterFamily};
+//! use nonsmooth_modes::system::{HarmonicBalanceSettings, ParameterFamily};
 //!
-//! let in_gap = ParameterFamily::new(clamped_bar_with_obstacle, HarmonicBalance::default(), 1.8)?;
+//! let in_gap = ParameterFamily::new(clamped_bar_with_obstacle, HarmonicBalanceSettings::default(), 1.8)?;
 //! # Ok::<(), nonsmooth_modes::Error>(())
 //! ```
 
@@ -18,7 +18,7 @@ use crate::continuation::ContinuationProblem;
 use crate::error::{Error, ModelError, SettingsError};
 use crate::linalg::DenseMatrix;
 use crate::solve::{Problem, Structured};
-use crate::system::{BarSystem, HarmonicBalance, NonsmoothSystem};
+use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
 /// A one-parameter family of bar systems.
 pub trait SystemFamily {
@@ -45,7 +45,7 @@ impl<F: Fn(f64) -> Result<BarSystem, ModelError>> SystemFamily for F {
 /// continuation step that leaves the admissible set is rejected rather than silently wrong.
 pub struct ParameterFamily<F> {
     family: F,
-    settings: HarmonicBalance,
+    settings: HarmonicBalanceSettings,
     omega: f64,
     value: f64,
     /// The system at `value` (`None` where the family rejects it).
@@ -61,7 +61,7 @@ impl<F: SystemFamily> ParameterFamily<F> {
     ///
     /// # Errors
     /// A non-positive `omega`, invalid settings, or a family that fails at the probe value.
-    pub fn new(family: F, settings: HarmonicBalance, omega: f64) -> Result<Self, Error> {
+    pub fn new(family: F, settings: HarmonicBalanceSettings, omega: f64) -> Result<Self, Error> {
         Self::at(family, settings, omega, 1.0)
     }
 
@@ -69,7 +69,12 @@ impl<F: SystemFamily> ParameterFamily<F> {
     ///
     /// # Errors
     /// See [`ParameterFamily::new`].
-    pub fn at(family: F, settings: HarmonicBalance, omega: f64, value: f64) -> Result<Self, Error> {
+    pub fn at(
+        family: F,
+        settings: HarmonicBalanceSettings,
+        omega: f64,
+        value: f64,
+    ) -> Result<Self, Error> {
         if !(omega.is_finite() && omega > 0.0) {
             return Err(SettingsError::NotPositive {
                 what: "fundamental frequency",

@@ -350,9 +350,10 @@ impl Integrator {
     }
 }
 
-/// History of one bar end.
+/// History of one bar end along a march (the harmonic-balance side is
+/// [`modal::diagnostics::EndHistory`](crate::modal::diagnostics::EndHistory)).
 #[derive(Debug, Clone, PartialEq)]
-pub struct EndHistory {
+pub struct MarchedEnd {
     /// The end.
     pub end: EndRef,
     /// Displacement at each instant of [`Trajectory::times`].
@@ -381,7 +382,7 @@ pub struct Trajectory {
     /// Energy at each instant (exact for the discrete state, see [`State::energy`]).
     pub energy: Vec<f64>,
     /// Every bar end, `[bar 0 left, bar 0 right, bar 1 left, ...]`.
-    pub ends: Vec<EndHistory>,
+    pub ends: Vec<MarchedEnd>,
     /// Every unilateral condition, in model order.
     pub contacts: Vec<ContactHistory>,
     /// Snapshots every [`MarchOptions::snapshot_every`] steps (and at `t = 0`).
@@ -422,12 +423,12 @@ pub fn march(
         fractions.push(rest);
     }
     let model = initial.model().clone();
-    let mut ends: Vec<EndHistory> = (0..model.bars().len())
+    let mut ends: Vec<MarchedEnd> = (0..model.bars().len())
         .flat_map(|b| {
             let id = crate::bar::BarId(b);
             [id.left(), id.right()]
         })
-        .map(|end| EndHistory {
+        .map(|end| MarchedEnd {
             end,
             displacement: vec![initial.end_displacement(end)],
             strain: Vec::with_capacity(fractions.len()),

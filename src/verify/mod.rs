@@ -81,7 +81,7 @@ pub use crate::error::VerifyError;
 pub use exact::clamped_first_mode;
 pub use grid::Grid;
 pub use march::{
-    march, ContactHistory, EndHistory, Integrator, MarchOptions, SpringUpdate, StepSummary,
+    march, ContactHistory, Integrator, MarchOptions, MarchedEnd, SpringUpdate, StepSummary,
     Trajectory,
 };
 pub use model::{Condition, Model};

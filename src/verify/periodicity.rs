@@ -132,11 +132,11 @@ pub fn periodicity_of_state(
 /// use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
 /// use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 /// use nonsmooth_modes::solve::SemismoothNewton;
-/// use nonsmooth_modes::system::HarmonicBalance;
+/// use nonsmooth_modes::system::HarmonicBalanceSettings;
 /// use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 ///
 /// let system = clamped_bar_with_obstacle(1e-3)?;
-/// let settings = HarmonicBalance { harmonics: 10, ..Default::default() };
+/// let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
 /// let options = BackboneOptions {
 ///     grid: PeriodGrid { start: 3.9, end: 3.8, steps: 3 },
 ///     ..Default::default()

@@ -29,36 +29,35 @@ use step::Reduced;
 
 /// Harmonic-balance settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HarmonicBalance {
+pub struct HarmonicBalanceSettings {
     /// Number of harmonics `m` (default 20).
     pub harmonics: usize,
     /// Time samples per harmonic `n_h`; the period has `N = n_h m` samples (default 30).
     pub samples_per_harmonic: usize,
     /// Complementarity parameter `a_c > 0` of `r = -min(lambda, a_c g)` (default 4).
-    pub penalty: f64,
+    pub complementarity: f64,
     /// Width, relative to the largest gap, of the band around each kink of the law in which
     /// the Jacobian blends the two one-sided derivatives (default 0: an exact element of the
     /// generalised Jacobian at every sample). The residual is never blended. The blend (the
     /// derivative of the smoothed law of [`crate::bc::smoothed_complementarity`]) acts like the
-    /// finite-difference Jacobian of the paper's solver: with `1e-4` the clamped bar's
-    /// 181-step backbone converges 138 steps instead of 125 at `m = 80`, in less time, but
-    /// branches near internal resonances are sensitive to it and some two-bar runs lose most
-    /// of their steps (`docs/performance.md`), hence the exact default.
+    /// finite-difference Jacobian of the paper's solver: it can converge steps whose exact
+    /// Jacobian jumps between iterations, but branches near internal resonances are sensitive
+    /// to it (`docs/performance.md` has the measurements), hence the exact default.
     pub kink_blend: f64,
 }
 
-impl Default for HarmonicBalance {
+impl Default for HarmonicBalanceSettings {
     fn default() -> Self {
         Self {
             harmonics: 20,
             samples_per_harmonic: 30,
-            penalty: 4.0,
+            complementarity: 4.0,
             kink_blend: 0.0,
         }
     }
 }
 
-impl HarmonicBalance {
+impl HarmonicBalanceSettings {
     /// The constant + cosine basis of these settings.
     ///
     /// # Errors
@@ -176,10 +175,10 @@ fn set_key(key: &mut Option<Vec<f64>>, v: &[f64]) {
 pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     system: BarSystem,
     basis: B,
-    penalty: f64,
+    complementarity: f64,
     /// Smoothing of the unilateral laws (0: the nonsmooth problem).
     smoothing: f64,
-    /// See [`HarmonicBalance::kink_blend`].
+    /// See [`HarmonicBalanceSettings::kink_blend`].
     kink_blend: f64,
     unknowns: usize,
     linear_count: usize,
@@ -206,8 +205,9 @@ impl NonsmoothSystem<CosineBasis> {
     /// # Errors
     /// Invalid settings ([`SettingsError`]) or a system without unilateral condition
     /// ([`SettingsError::NoContact`]).
-    pub fn new(system: &BarSystem, settings: HarmonicBalance) -> Result<Self, Error> {
-        let mut problem = Self::with_basis(system, settings.cosine_basis()?, settings.penalty)?;
+    pub fn new(system: &BarSystem, settings: HarmonicBalanceSettings) -> Result<Self, Error> {
+        let mut problem =
+            Self::with_basis(system, settings.cosine_basis()?, settings.complementarity)?;
         problem.set_kink_blend(settings.kink_blend)?;
         Ok(problem)
     }
@@ -217,13 +217,14 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// The system with any basis.
     ///
     /// # Errors
-    /// [`SettingsError::NotPositive`] for a bad penalty, [`SettingsError::NoContact`] for a
+    /// [`SettingsError::NotPositive`] for a bad complementarity parameter `a_c`,
+    /// [`SettingsError::NoContact`] for a
     /// linear system.
-    pub fn with_basis(system: &BarSystem, basis: B, penalty: f64) -> Result<Self, Error> {
-        if !(penalty.is_finite() && penalty > 0.0) {
+    pub fn with_basis(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
+        if !(a_c.is_finite() && a_c > 0.0) {
             return Err(SettingsError::NotPositive {
-                what: "complementarity penalty a_c",
-                value: penalty,
+                what: "complementarity parameter a_c",
+                value: a_c,
             }
             .into());
         }
@@ -265,7 +266,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         Ok(Self {
             system: system.clone(),
             basis,
-            penalty,
+            complementarity: a_c,
             smoothing: 0.0,
             kink_blend: 0.0,
             unknowns,
@@ -284,7 +285,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         })
     }
 
-    /// Sets [`HarmonicBalance::kink_blend`] (0 for the exact generalised Jacobian).
+    /// Sets [`HarmonicBalanceSettings::kink_blend`] (0 for the exact generalised Jacobian).
     ///
     /// # Errors
     /// [`SettingsError::NotPositive`] if `blend` is negative or not finite.
@@ -311,8 +312,8 @@ impl<B: Basis> NonsmoothSystem<B> {
     }
 
     /// The complementarity parameter `a_c`.
-    pub fn penalty(&self) -> f64 {
-        self.penalty
+    pub fn complementarity(&self) -> f64 {
+        self.complementarity
     }
 
     /// Number of unknowns (and equations).
@@ -433,7 +434,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             law.sample(
                 gaps,
                 forces,
-                self.penalty,
+                self.complementarity,
                 self.smoothing,
                 LawSamples {
                     values: &mut ws.values[range],
@@ -446,7 +447,7 @@ impl<B: Basis> NonsmoothSystem<B> {
                 law.sample(
                     gaps,
                     forces,
-                    self.penalty,
+                    self.complementarity,
                     blend,
                     LawSamples {
                         values: &mut ws.scratch,
@@ -528,7 +529,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         let law = self.system.laws().nth(l).expect("law index in range");
         g.iter()
             .zip(&f)
-            .map(|(&g, &f)| law.residual(g, f, self.penalty).value)
+            .map(|(&g, &f)| law.residual(g, f, self.complementarity).value)
             .collect()
     }
 
