@@ -46,21 +46,19 @@
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
-    linspace, Arclength, ArclengthOptions, Event, Point, Selection, Sequential, SequentialOptions,
-    Speculation, StallEscape, Step,
+    linspace, ArclengthOptions, Event, Selection, SequentialOptions, Speculation, StallEscape,
 };
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, energy, grazing_energy, ArclengthBackboneOptions,
-    BackboneOptions, BackbonePoint, PeriodGrid,
+    arclength_backbone, backbone, backbone_speculative_with, backbone_with, parameter_branch,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
 };
-use nonsmooth_modes::modal::{backbone_speculative_with, backbone_with};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
 // A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
 use nonsmooth_modes::sweep::Solver;
-use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, ParameterFamily};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
@@ -491,39 +489,14 @@ fn run_parameter(
         .find(|p| p.converged)
         .ok_or("no converged point on the way to the starting period")?
         .clone();
-    let omega = 2.0 * PI / start.period;
     let family = move |v: f64| build_system(a, parameter, v);
-    let problem = ParameterFamily::at(family, a.settings, omega, value)?;
     let (lo, hi) = a.parameter_range.unwrap_or((value / 10.0, value * 10.0));
-    let mut report = |p: &Point| {
-        let system = match build_system(a, parameter, p.parameter) {
-            Ok(s) => s,
-            Err(_) => return ControlFlow::Continue(()),
-        };
-        let basis = match a.settings.cosine_basis() {
-            Ok(b) => b,
-            Err(_) => return ControlFlow::Break(()),
-        };
-        let e = energy(&system, &basis, &p.x, omega);
-        let e_g = grazing_energy(&system).map(|g| g.0).unwrap_or(f64::NAN);
-        let point = BackbonePoint::from_point(p, omega, e, e_g);
-        sink.row(&system, &point, p.parameter)
-    };
-    if a.arclength {
-        let options = ArclengthOptions {
+    let steps = if a.arclength {
+        ParameterSteps::Arclength(ArclengthOptions {
             parameter_range: (lo, hi),
             escape: None,
             ..a.driver
-        };
-        let mut driver = Arclength::new(problem, solver, start.x, value, options)?;
-        let branch = driver.run(&mut |step: &Step| match step {
-            Step::Accepted(p) => report(p),
-            _ => ControlFlow::Continue(()),
-        });
-        eprintln!(
-            "backbone: arclength ended: {:?}; {} rejected steps",
-            branch.end, branch.rejections
-        );
+        })
     } else {
         // Sequential parameter runs go from the current value to the far end of the range.
         let far = if (hi - value).abs() >= (value - lo).abs() {
@@ -531,24 +504,38 @@ fn run_parameter(
         } else {
             lo
         };
-        let values = linspace(value, far, a.steps)?;
-        let mut driver = Sequential::new(
-            problem,
-            solver,
-            start.x,
-            values,
-            SequentialOptions {
-                retry_depth: a.retry_depth,
-                ..Default::default()
-            },
-        )?;
-        let branch = driver
-            .run(&mut |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report));
-        if let Some(e) = branch.end.error() {
-            return Err(e.into());
-        }
+        let options = SequentialOptions {
+            retry_depth: a.retry_depth,
+            ..Default::default()
+        };
+        ParameterSteps::Values(linspace(value, far, a.steps)?, options)
+    };
+    let branch = parameter_branch(
+        family,
+        a.settings,
+        (start.x, start.omega),
+        value,
+        steps,
+        solver,
+        |v, point| match build_system(a, parameter, v) {
+            Ok(system) => sink.row(&system, point, v),
+            Err(_) => ControlFlow::Continue(()),
+        },
+    )?;
+    eprintln!(
+        "backbone: {} ended: {:?}; {} rejected steps",
+        if a.arclength {
+            "arclength"
+        } else {
+            "sequential"
+        },
+        branch.end,
+        branch.rejections
+    );
+    match branch.end.error() {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 fn main() -> ExitCode {

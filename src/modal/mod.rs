@@ -1,11 +1,12 @@
 //! Modal post-processing: energy and its normalisation, linear modes of the open-contact
-//! system, branch seeds, and backbones.
+//! system, branch seeds, backbones, and branches in a system parameter.
 
 mod backbone;
 pub mod diagnostics;
 pub mod energy;
 pub mod field;
 pub mod linear;
+mod parameter;
 
 pub use backbone::{
     arclength_backbone, backbone, backbone_speculative_with, backbone_with,
@@ -19,3 +20,4 @@ pub use field::{FieldEvaluator, FieldValue};
 pub use linear::{
     branch_seed, grazing_energy, natural_frequencies, seed_from_mode, ContactState, LinearMode,
 };
+pub use parameter::{parameter_branch, ParameterSteps};

@@ -1,0 +1,84 @@
+//! A point of a nonsmooth mode continued in a system parameter (gap, spring stiffness,
+//! stiffness ratio, a length...) at its fixed fundamental frequency.
+//!
+//! The family of systems is any [`SystemFamily`] (a closure `f64 -> Result<BarSystem, _>`);
+//! the continuation is natural-parameter over given values or pseudo-arclength inside a
+//! range. Every point reaches the observer as a [`BackbonePoint`] at the fixed frequency, its
+//! energy normalised by the grazing energy of the system at that parameter value.
+
+use crate::continuation::{
+    Arclength, ArclengthOptions, Branch, Point, Sequential, SequentialOptions, Step,
+};
+use crate::error::{ContinuationError, Error};
+use crate::modal::backbone::BackbonePoint;
+use crate::modal::energy::energy;
+use crate::modal::linear::grazing_energy;
+use crate::solve::NonlinearSolver;
+use crate::system::{HarmonicBalanceSettings, ParameterFamily, SystemFamily};
+use std::ops::ControlFlow;
+
+/// How [`parameter_branch`] steps through the parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParameterSteps {
+    /// Natural-parameter continuation over `values` (the first is solved from the start
+    /// point); failed steps reach the observer as points with `converged == false`.
+    Values(Vec<f64>, SequentialOptions),
+    /// Pseudo-arclength continuation from the start value inside
+    /// [`ArclengthOptions::parameter_range`], in [`ArclengthOptions::direction`].
+    Arclength(ArclengthOptions),
+}
+
+/// Continues the motion `x` at fundamental frequency `omega` of the system
+/// `family.build(value)` in the family's parameter, at fixed `omega`, handing every point
+/// (with the parameter value it was computed at) to `observer`, which may stop the run.
+///
+/// Returns the branch (its points carry the parameter in [`Point::parameter`]) with the
+/// reason it ended: a run that stalls returns what it computed, with
+/// [`EndReason::Stalled`](crate::continuation::EndReason::Stalled).
+///
+/// # Errors
+/// A family that rejects `value`, invalid settings or options, or a start where the solver
+/// fails ([`ContinuationError::Start`], arclength only).
+pub fn parameter_branch<F, S>(
+    family: F,
+    settings: HarmonicBalanceSettings,
+    (x, omega): (Vec<f64>, f64),
+    value: f64,
+    steps: ParameterSteps,
+    solver: S,
+    mut observer: impl FnMut(f64, &BackbonePoint) -> ControlFlow<()>,
+) -> Result<Branch, Error>
+where
+    F: SystemFamily + Clone,
+    S: NonlinearSolver,
+{
+    let basis = settings.cosine_basis()?;
+    let problem = ParameterFamily::at(family.clone(), settings, omega, value)?;
+    // The point in the frame of the system at its parameter value; a value the family
+    // rejects is skipped (it is not a point of the branch).
+    let mut report = |p: &Point| {
+        let Ok(system) = family.build(p.parameter) else {
+            return ControlFlow::Continue(());
+        };
+        let e = energy(&system, &basis, &p.x, omega);
+        let e_g = grazing_energy(&system).map_or(f64::NAN, |g| g.0);
+        observer(p.parameter, &BackbonePoint::from_point(p, omega, e, e_g))
+    };
+    let mut see = |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report);
+    let branch = match steps {
+        ParameterSteps::Values(values, options) => {
+            if values.first() != Some(&value) {
+                return Err(ContinuationError::InvalidOption {
+                    what: "first parameter value (must be the start's)",
+                    value: values.first().copied().unwrap_or(f64::NAN),
+                }
+                .into());
+            }
+            Sequential::new(problem, solver, x, values, options)?.run(&mut see)
+        }
+        ParameterSteps::Arclength(options) => {
+            Arclength::new(problem, solver, x, value, options)?.run(&mut see)
+        }
+    };
+    Ok(branch)
+}

@@ -1,0 +1,126 @@
+//! A backbone point continued in a system parameter with `modal::parameter_branch`: the gap of
+//! the clamped bar, where the truncated problem is positively homogeneous
+//! (`x(s g0) = s x(g0)`, so `E / g0^2` and `E / E_g` stay constant along the branch).
+
+use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, SequentialOptions};
+use nonsmooth_modes::modal::{
+    backbone, parameter_branch, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
+};
+use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::HarmonicBalanceSettings;
+use nonsmooth_modes::Error;
+use std::ops::ControlFlow;
+
+/// A converged point of the clamped bar's first mode near `T = 3.8`.
+fn start(settings: HarmonicBalanceSettings) -> BackbonePoint {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: 3.95,
+            end: 3.8,
+            steps: 31,
+        },
+        ..Default::default()
+    };
+    let points = backbone(&system, settings, &options, SemismoothNewton::default()).unwrap();
+    points.into_iter().rev().find(|p| p.converged).unwrap()
+}
+
+#[test]
+fn gap_branches_keep_the_normalised_energy() {
+    let settings = HarmonicBalanceSettings::default();
+    let from = start(settings);
+    let values: Vec<f64> = (0..9).map(|i| 1e-3 * (1.0 + 0.25 * i as f64)).collect();
+    for steps in [
+        ParameterSteps::Values(values.clone(), SequentialOptions::default()),
+        ParameterSteps::Arclength(ArclengthOptions {
+            parameter_range: (5e-4, 3e-3),
+            ..Default::default()
+        }),
+    ] {
+        let arclength = matches!(steps, ParameterSteps::Arclength(_));
+        let mut seen = Vec::new();
+        let branch = parameter_branch(
+            clamped_bar_with_obstacle,
+            settings,
+            (from.x.clone(), from.omega),
+            1e-3,
+            steps,
+            SemismoothNewton::default(),
+            |gap, p| {
+                seen.push((gap, p.clone()));
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        if arclength {
+            assert!(matches!(branch.end, EndReason::ParameterOutOfRange { .. }));
+        } else {
+            assert_eq!(branch.end, EndReason::Completed);
+            assert_eq!(seen.len(), values.len());
+        }
+        assert!(seen.len() > 5);
+        assert_eq!(
+            seen.len(),
+            branch.points.len() + branch.rejections * usize::from(!arclength)
+        );
+        for (gap, p) in &seen {
+            assert!(p.converged);
+            assert_eq!(p.omega, from.omega);
+            assert!(
+                (p.energy_normalized / from.energy_normalized - 1.0).abs() < 1e-8,
+                "gap {gap}: {} vs {}",
+                p.energy_normalized,
+                from.energy_normalized
+            );
+            assert!((p.energy / (gap * gap) / (from.energy / 1e-6) - 1.0).abs() < 1e-8);
+        }
+        assert!(seen.iter().any(|(gap, _)| *gap > 2.5e-3));
+    }
+}
+
+#[test]
+fn bad_starts_are_typed_errors() {
+    let settings = HarmonicBalanceSettings {
+        harmonics: 8,
+        ..Default::default()
+    };
+    let from = start(settings);
+    let run = |value: f64, steps| {
+        parameter_branch(
+            clamped_bar_with_obstacle,
+            settings,
+            (from.x.clone(), from.omega),
+            value,
+            steps,
+            SemismoothNewton::default(),
+            |_, _| ControlFlow::Continue(()),
+        )
+    };
+    // A gap the family rejects, values that do not start at the start's, a short start.
+    assert!(matches!(
+        run(
+            -1.0,
+            ParameterSteps::Values(vec![-1.0, 1.0], SequentialOptions::default())
+        ),
+        Err(Error::Model(_))
+    ));
+    assert!(matches!(
+        run(
+            1e-3,
+            ParameterSteps::Values(vec![2e-3, 3e-3], SequentialOptions::default())
+        ),
+        Err(Error::Continuation(_))
+    ));
+    let short = parameter_branch(
+        clamped_bar_with_obstacle,
+        settings,
+        (from.x[1..].to_vec(), from.omega),
+        1e-3,
+        ParameterSteps::Arclength(ArclengthOptions::default()),
+        SemismoothNewton::default(),
+        |_, _| ControlFlow::Continue(()),
+    );
+    assert!(matches!(short, Err(Error::Continuation(_))));
+}
