@@ -2,7 +2,7 @@
 
 use nonsmooth_modes::continuation::{
     Arclength, ArclengthOptions, ContinuationProblem, EndReason, Event, PeriodParametrised, Point,
-    Sequential, StallEscape, Step,
+    Sequential, Speculative, StallEscape, Step,
 };
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, branch_seed, energy, ArclengthBackboneOptions, BackboneOptions,
@@ -363,9 +363,10 @@ fn speculative_retries_give_the_serial_points() {
         after_evaluations: 0,
     };
     for patience_ms in [0, 300] {
-        let mut speculative = driver(std::time::Duration::from_millis(patience_ms));
+        let speculative = driver(std::time::Duration::from_millis(patience_ms));
         let mut points = Vec::new();
-        let branch = speculative.run_speculative(every_step, &mut |step: &Step| {
+        let mut speculative = Speculative::new(speculative, every_step);
+        let branch = speculative.run(&mut |step: &Step| {
             if let Step::Accepted(p) = step {
                 points.push(p.clone());
             }
@@ -374,7 +375,7 @@ fn speculative_retries_give_the_serial_points() {
         assert_eq!(branch.end, EndReason::Completed);
         assert_eq!(points, serial);
         assert_eq!(branch.points, serial);
-        let stats = speculative.speculation_stats();
+        let stats = speculative.stats();
         // One job per step with a history (steps 1 to 4); only lambda = 0.3 fails first.
         assert_eq!(stats.launched, 4);
         assert_eq!(stats.cancelled, 3);
@@ -385,12 +386,13 @@ fn speculative_retries_give_the_serial_points() {
         }
     }
     // A retry never handed over: no job, the serial path.
-    let mut never = driver(Default::default());
+    let never = driver(Default::default());
     let late = Speculation {
         after_evaluations: usize::MAX,
     };
-    assert_eq!(speculative_points(&mut never, late), serial);
-    assert_eq!(never.speculation_stats(), Default::default());
+    let (points, stats) = speculative_points(never, late);
+    assert_eq!(points, serial);
+    assert_eq!(stats, Default::default());
 }
 
 /// The clamped bar's 181-step backbone at m = 40 with the `backbone` example's solver,
@@ -420,16 +422,18 @@ fn clamped_backbone_m40(
     points
 }
 
-/// The points of `driver` stepped with [`Sequential::step_speculative`] to the end.
+/// The points of `driver` stepped with [`Speculative::step`] to the end, and its stats.
 fn speculative_points<P, S>(
-    driver: &mut nonsmooth_modes::continuation::Sequential<P, S>,
+    driver: Sequential<P, S>,
     speculation: nonsmooth_modes::continuation::Speculation,
-) -> Vec<Point>
+) -> (Vec<Point>, nonsmooth_modes::continuation::SpeculationStats)
 where
     P: ContinuationProblem + Clone + Send + 'static,
     S: nonsmooth_modes::solve::NonlinearSolver + Clone + Send + 'static,
 {
-    reported(|| driver.step_speculative(speculation))
+    let mut speculative = Speculative::new(driver, speculation);
+    let points = reported(|| speculative.step());
+    (points, speculative.stats())
 }
 
 /// On the clamped bar at m = 40 (16 first attempts fail, 5 retries converge) the speculative
@@ -590,14 +594,14 @@ fn speculative_lowest_measure_gives_the_serial_points() {
             .with_measure(|x, _| x[0])
         };
         let serial = run_points(driver());
-        let mut speculative = driver();
+        let speculative = driver();
         let every_step = Speculation {
             after_evaluations: 0,
         };
-        let points = speculative_points(&mut speculative, every_step);
+        let (points, stats) = speculative_points(speculative, every_step);
         assert_eq!(points, serial);
         assert_eq!(rounded(points)[2], (true, 0.2));
-        assert_eq!(speculative.speculation_stats(), Default::default());
+        assert_eq!(stats, Default::default());
     }
 }
 

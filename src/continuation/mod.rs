@@ -25,7 +25,7 @@ pub use arclength::{Arclength, ArclengthOptions, ArclengthScale, StallEscape, Ta
 pub use driver::{Branch, EndReason, Observer, RejectReason, Rejection, Step};
 pub use progress::{quiet, Progress};
 pub use sequential::{linspace, Predictor, Selection, Sequential, SequentialOptions};
-pub use speculative::{Speculation, SpeculationStats};
+pub use speculative::{Speculation, SpeculationStats, Speculative};
 
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;

@@ -87,11 +87,6 @@ impl Default for SequentialOptions {
 pub struct Sequential<P, S> {
     pub(super) problem: P,
     pub(super) solver: S,
-    /// The thread of speculative retries (started on first use by
-    /// [`Sequential::step_speculative`]).
-    pub(super) worker: Option<super::speculative::Worker>,
-    /// Counts of [`Sequential::step_speculative`]'s retries.
-    pub(super) speculation: super::SpeculationStats,
     values: Vec<f64>,
     options: SequentialOptions,
     next: usize,
@@ -178,8 +173,6 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             last_lambda: values[0],
             problem,
             solver,
-            worker: None,
-            speculation: Default::default(),
             values,
             options,
             next: 0,

@@ -8,16 +8,16 @@
 //! (a step that converges quickly never starts a thread), and it is cancelled as soon as the
 //! first attempt joins the branch.
 
-use super::driver::run_with;
+use super::driver::{next_point, run_with};
 use super::sequential::{accepts, Attempt};
-use super::{Branch, ContinuationProblem, Observer, Sequential, Step};
-use crate::error::SolveError;
+use super::{Branch, ContinuationProblem, Observer, Point, Sequential, Step};
+use crate::error::{ContinuationError, SolveError};
 use crate::solve::{NonlinearSolver, SolveInfo, SolveMonitor};
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::{mpsc, Arc};
 
-/// When [`Sequential::step_speculative`] starts the retry on a second thread.
+/// When [`Speculative`] starts the retry on a second thread.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Speculation {
     /// Residual evaluations (line-search trials included) the first attempt spends before the
@@ -36,7 +36,7 @@ impl Default for Speculation {
     }
 }
 
-/// What the speculative retries of a run did ([`Sequential::speculation_stats`]).
+/// What the speculative retries of a run did ([`Speculative::stats`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SpeculationStats {
     /// Retries handed to the worker (first attempts that reached
@@ -168,53 +168,84 @@ impl std::fmt::Debug for Worker {
     }
 }
 
-impl<P, S> Sequential<P, S> {
-    /// Counts of the speculative retries so far (all zero for a driver run with
-    /// [`Sequential::step`] only).
-    pub fn speculation_stats(&self) -> SpeculationStats {
-        self.speculation
+/// [`Sequential`] with the first retry of each failing step run speculatively on a worker
+/// thread (see [`Speculation`]): the same steps as the serial driver, bit for bit, in less
+/// wall time when steps fail and a second core is free. The worker is started on first use
+/// with clones of the problem and the solver, and stopped when this driver is dropped. The
+/// driver never waits for a retry it does not need: a cancelled retry is dropped, and one the
+/// worker has not started when the first attempt fails is run by the driver itself. Deeper
+/// retries ([`SequentialOptions::retry_depth`](super::SequentialOptions::retry_depth) above 1)
+/// run serially after it.
+///
+/// With [`Selection::LowestMeasure`](super::Selection::LowestMeasure) and a measure
+/// ([`Sequential::with_measure`]) a step is the serial [`Sequential::step`]: every start of
+/// every step is solved anyway, so a retry is never speculative.
+///
+/// It has the drivers' shape: [`Speculative::step`], [`Speculative::run`] and an iterator of
+/// `Result<Point, ContinuationError>`.
+pub struct Speculative<P, S> {
+    driver: Sequential<P, S>,
+    speculation: Speculation,
+    /// The thread of speculative retries (started on first use).
+    worker: Option<Worker>,
+    stats: SpeculationStats,
+    /// Whether the iterator has handed out the end.
+    done: bool,
+}
+
+impl<P, S> Speculative<P, S> {
+    /// `driver` with speculative retries as `speculation` says.
+    pub fn new(driver: Sequential<P, S>, speculation: Speculation) -> Self {
+        Self {
+            driver,
+            speculation,
+            worker: None,
+            stats: SpeculationStats::default(),
+            done: false,
+        }
+    }
+
+    /// Counts of the speculative retries so far.
+    pub fn stats(&self) -> SpeculationStats {
+        self.stats
+    }
+
+    /// The serial driver underneath (its problem, its last converged point).
+    pub fn driver_mut(&mut self) -> &mut Sequential<P, S> {
+        &mut self.driver
     }
 }
 
-impl<P, S> Sequential<P, S>
+impl<P, S> Speculative<P, S>
 where
     P: ContinuationProblem + Clone + Send + 'static,
     S: NonlinearSolver + Clone + Send + 'static,
 {
-    /// [`Sequential::step`] with the first retry run speculatively on a worker thread (see
-    /// [`Speculation`]): the same outcome as `step`, in less wall time when steps fail and a
-    /// second core is free. The worker is started on first use with clones of the problem and
-    /// the solver, and stopped when the driver is dropped. The driver never waits for a retry
-    /// it does not need: a cancelled retry is dropped, and one the worker has not started
-    /// when the first attempt fails is run by the driver itself. Deeper retries
-    /// ([`SequentialOptions::retry_depth`](super::SequentialOptions::retry_depth) above 1)
-    /// run serially after it.
-    ///
-    /// With [`Selection::LowestMeasure`](super::Selection::LowestMeasure) and a measure
-    /// ([`Sequential::with_measure`]) this is [`Sequential::step`]: every start of every step
-    /// is solved anyway, so a retry is never speculative, and the serial path is the one whose
-    /// result is the reference.
-    pub fn step_speculative(&mut self, speculation: Speculation) -> Step {
-        if self.selects_lowest() {
-            return self.step();
+    /// The next step: the outcome of [`Sequential::step`], with the first retry run beside
+    /// the first attempt.
+    pub fn step(&mut self) -> Step {
+        let d = &mut self.driver;
+        if d.selects_lowest() {
+            return d.step();
         }
-        let (step, lambda) = match self.next_value() {
+        let (step, lambda) = match d.next_value() {
             Ok(next) => next,
             Err(end) => return Step::Finished(end),
         };
-        let mut x = self.predict(lambda);
-        if self.retry_count() > 0 && self.worker.is_none() {
-            self.worker = Worker::spawn(self.problem.clone(), self.solver.clone());
+        let mut x = d.predict(lambda);
+        if d.retry_count() > 0 && self.worker.is_none() {
+            self.worker = Worker::spawn(d.problem.clone(), d.solver.clone());
         }
         // The retry's start is copied, and its state allocated, only if it is handed over.
-        let retries = self.retry_count() > 0;
-        let mut pending = match (&self.worker, self.history.front()) {
+        let retries = d.retry_count() > 0;
+        let mut pending = match (&self.worker, d.history.front()) {
             (Some(worker), Some((start, _))) if retries => {
                 worker.jobs.as_ref().map(|jobs| (jobs, start))
             }
             _ => None,
         };
         let mut handed: Option<Arc<AtomicU8>> = None;
+        let speculation = self.speculation;
         let result = {
             let mut launch = || {
                 if let Some((jobs, start)) = pending.take() {
@@ -237,18 +268,17 @@ where
                 hook: Some((speculation.after_evaluations, &mut launch)),
                 cancel: None,
             };
-            self.problem.set_parameter(lambda);
-            self.solver
-                .solve_monitored(&mut self.problem, &mut x, &mut watch)
+            d.problem.set_parameter(lambda);
+            d.solver.solve_monitored(&mut d.problem, &mut x, &mut watch)
         };
-        let accepted = accepts(&mut self.accept, &result, &x, lambda);
+        let accepted = accepts(&mut d.accept, &result, &x, lambda);
         let first = Attempt {
             x,
             result,
             accepted,
             from_history: None,
         };
-        let stats = &mut self.speculation;
+        let stats = &mut self.stats;
         let sent = handed.is_some();
         stats.launched += usize::from(sent);
         if first.joins() {
@@ -256,7 +286,7 @@ where
                 state.store(CANCELLED, Ordering::Release);
             }
             stats.cancelled += usize::from(sent);
-            return self.conclude(step, lambda, first);
+            return d.conclude(step, lambda, first);
         }
         let taken = handed.as_ref().is_none_or(|state| {
             state
@@ -272,7 +302,7 @@ where
         let chosen = match speculated {
             // The worker ran the first retry: judge it as `step` would have, then go deeper.
             Some((y, result)) => {
-                let accepted = accepts(&mut self.accept, &result, &y, lambda);
+                let accepted = accepts(&mut d.accept, &result, &y, lambda);
                 let retried = Attempt {
                     x: y,
                     result,
@@ -280,26 +310,33 @@ where
                     from_history: Some(0),
                 };
                 let best = if retried.joins() { retried } else { first };
-                self.retry_from(lambda, 1, best)
+                d.retry_from(lambda, 1, best)
             }
-            None => self.retry_from(lambda, 0, first),
+            None => d.retry_from(lambda, 0, first),
         };
-        self.conclude(step, lambda, chosen)
+        d.conclude(step, lambda, chosen)
     }
 
-    /// [`Sequential::run`] with [`Sequential::step_speculative`]: the same branch, in less
-    /// wall time when steps fail.
-    pub fn run_speculative(
-        &mut self,
-        speculation: Speculation,
-        observer: &mut (impl Observer + ?Sized),
-    ) -> Branch {
-        run_with(
-            self,
-            |driver| driver.step_speculative(speculation),
-            Self::stop,
-            observer,
-        )
+    /// Runs to the end like [`Sequential::run`]: the same branch, in less wall time when
+    /// steps fail.
+    pub fn run(&mut self, observer: &mut (impl Observer + ?Sized)) -> Branch {
+        run_with(self, Self::step, |s| s.driver.stop(), observer)
+    }
+}
+
+impl<P, S> Iterator for Speculative<P, S>
+where
+    P: ContinuationProblem + Clone + Send + 'static,
+    S: NonlinearSolver + Clone + Send + 'static,
+{
+    type Item = Result<Point, ContinuationError>;
+
+    /// The converged points; then, if the run stalled, its error; then `None`.
+    fn next(&mut self) -> Option<Self::Item> {
+        let mut done = self.done;
+        let item = next_point(&mut done, || self.step());
+        self.done = done;
+        item
     }
 }
 

@@ -3,7 +3,8 @@
 
 use crate::continuation::{
     linspace, Arclength, ArclengthOptions, Branch, Event, Observer, PeriodParametrised, Point,
-    Predictor, Selection, Sequential, SequentialOptions, Speculation, StallEscape, Step,
+    Predictor, Selection, Sequential, SequentialOptions, Speculation, Speculative, StallEscape,
+    Step,
 };
 use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
@@ -174,12 +175,12 @@ pub fn backbone_with<S: NonlinearSolver>(
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
-    let run = |driver: &mut Sequential<_, S>, see: &mut dyn Observer| driver.run(see);
+    let run = |mut driver: Sequential<_, S>, see: &mut dyn Observer| driver.run(see);
     drive_backbone(system, settings, options, solver, run, observer)
 }
 
 /// [`backbone_with`] with the first retry of each failing step run on a second thread beside
-/// the first attempt ([`Sequential::step_speculative`]): the same points, bit for bit, in
+/// the first attempt ([`Speculative`]): the same points, bit for bit, in
 /// less wall time when steps fail and a second core is free. The retries run on a worker
 /// thread with clones of the problem and the solver, so the solver must be `Clone + Send +
 /// 'static` (the crate's solvers are).
@@ -194,8 +195,8 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
-    let run = |driver: &mut Sequential<_, S>, see: &mut dyn Observer| {
-        driver.run_speculative(speculation, see)
+    let run = |driver: Sequential<_, S>, see: &mut dyn Observer| {
+        Speculative::new(driver, speculation).run(see)
     };
     drive_backbone(system, settings, options, solver, run, observer)
 }
@@ -207,10 +208,7 @@ fn drive_backbone<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
-    run: impl FnOnce(
-        &mut Sequential<PeriodParametrised<NonsmoothSystem>, S>,
-        &mut dyn Observer,
-    ) -> Branch,
+    run: impl FnOnce(Sequential<PeriodParametrised<NonsmoothSystem>, S>, &mut dyn Observer) -> Branch,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<f64, Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
@@ -254,7 +252,7 @@ fn drive_backbone<S: NonlinearSolver>(
     // The measure of `Selection::LowestMeasure` is called right after the acceptance test
     // took the same point: it reuses the energy the test computed.
     let measured_energy = Rc::clone(&last_energy);
-    let mut driver = Sequential::new(
+    let driver = Sequential::new(
         PeriodParametrised::new(problem),
         solver,
         start,
@@ -278,7 +276,7 @@ fn drive_backbone<S: NonlinearSolver>(
         }
     });
     // Converged points and the solver's last iterates of failed steps alike.
-    let branch = run(&mut driver, &mut |step: &Step| {
+    let branch = run(driver, &mut |step: &Step| {
         let Some(p) = step.point() else {
             return ControlFlow::Continue(());
         };
