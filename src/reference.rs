@@ -1,7 +1,7 @@
 //! The paper's three systems and the exact results to test against (formulation §8–§9).
 
 use crate::bar::Bar;
-use crate::error::ModelError;
+use crate::error::{ModelError, SettingsError};
 use crate::system::{AssemblyBuilder, BarSystem};
 use std::f64::consts::PI;
 
@@ -188,20 +188,40 @@ impl ClampedFirstMode {
 /// the same motion: evaluate the family at `T / k`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClampedFamily {
-    /// Gap at rest `g0`.
-    pub gap: f64,
-    /// Family index `i >= 1`.
-    pub index: usize,
+    gap: f64,
+    index: usize,
 }
 
 impl ClampedFamily {
     /// Family `index` for the gap `gap`.
     ///
-    /// # Panics
-    /// If `index` is 0.
-    pub fn new(gap: f64, index: usize) -> Self {
-        assert!(index >= 1, "exact families are numbered from 1");
-        Self { gap, index }
+    /// # Errors
+    /// [`SettingsError::ZeroIndex`] for `index = 0` (families are numbered from 1) and
+    /// [`SettingsError::NotPositive`] for a gap that is not positive and finite.
+    pub fn new(gap: f64, index: usize) -> Result<Self, SettingsError> {
+        if index == 0 {
+            return Err(SettingsError::ZeroIndex {
+                what: "exact family index",
+                value: 0,
+            });
+        }
+        if !(gap.is_finite() && gap > 0.0) {
+            return Err(SettingsError::NotPositive {
+                what: "gap",
+                value: gap,
+            });
+        }
+        Ok(Self { gap, index })
+    }
+
+    /// Gap at rest `g0`.
+    pub fn gap(&self) -> f64 {
+        self.gap
+    }
+
+    /// Family index `i >= 1`.
+    pub fn index(&self) -> usize {
+        self.index
     }
 
     /// `i^2 T - 2i - 1`, the factor the energy is built on.
@@ -252,7 +272,7 @@ mod tests {
 
     #[test]
     fn family_one_is_the_first_mode() {
-        let (gap, family) = (1e-3, ClampedFamily::new(1e-3, 1));
+        let (gap, family) = (1e-3, ClampedFamily::new(1e-3, 1).unwrap());
         assert_eq!(family.periods(), (3.0, 4.0));
         for period in [3.04, 3.2, 3.5, 3.55, 3.9, 3.99] {
             let first = ClampedFirstMode::new(gap, period);
@@ -265,7 +285,7 @@ mod tests {
 
     #[test]
     fn higher_families_and_their_backbones() {
-        let family = ClampedFamily::new(1e-3, 2);
+        let family = ClampedFamily::new(1e-3, 2).unwrap();
         let (lo, hi) = family.periods();
         assert!((lo - 1.25).abs() < 1e-15 && (hi - 4.0 / 3.0).abs() < 1e-15);
         // At the upper end i^2 T - 2i - 1 = 1/(2i - 1): E/E_g = 8 (2i - 1)^2 / pi^2.
@@ -285,8 +305,18 @@ mod tests {
     }
 
     #[test]
-    #[should_panic(expected = "numbered from 1")]
-    fn family_zero_is_rejected() {
-        let _ = ClampedFamily::new(1e-3, 0);
+    fn family_zero_and_bad_gaps_are_typed_errors() {
+        assert!(matches!(
+            ClampedFamily::new(1e-3, 0),
+            Err(SettingsError::ZeroIndex { .. })
+        ));
+        for gap in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                ClampedFamily::new(gap, 1),
+                Err(SettingsError::NotPositive { .. })
+            ));
+        }
+        let family = ClampedFamily::new(2e-3, 3).unwrap();
+        assert_eq!((family.gap(), family.index()), (2e-3, 3));
     }
 }

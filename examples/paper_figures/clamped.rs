@@ -16,14 +16,14 @@ use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// The exact first mode `(Omega/omega_1, E/E_g)` for `T` from 3.99 down to 3.04.
-fn first_mode_curve() -> Vec<(f64, f64)> {
-    ClampedFamily::new(GAP, 1).backbone(3.99, 3.04, 201)
+fn first_mode_curve() -> Res<Vec<(f64, f64)>> {
+    Ok(ClampedFamily::new(GAP, 1)?.backbone(3.99, 3.04, 201))
 }
 
 /// The first nonsmooth mode from `T = 3.95` down to 3.05 with `m` harmonics, labelled `label`.
 fn nsm1(ctx: &Ctx, system: &BarSystem, label: &str, m: usize) -> Res<Run> {
     let branch = Branch::new(label, 1, (3.95, 3.05), ctx.steps(181));
-    Ok(run(system, m, &branch)?.with_exact(Exact::new(1, 1)))
+    Ok(run(system, m, &branch)?.with_exact(Exact::new(1, 1)?))
 }
 
 /// Fig. 7: clamped-bar backbones (NSM1, NSM2, NSM2 sub2) with m = 20 and three fields.
@@ -36,8 +36,8 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
     let sub2 = Branch::new("NSM2 sub2", 2, (2.6633, 2.505), ctx.steps(81)).subharmonic(2);
     let runs = [
         nsm1(ctx, &system, "NSM1", m)?,
-        run(&system, m, &nsm2)?.with_exact(Exact::new(2, 1)),
-        run(&system, m, &sub2)?.with_exact(Exact::new(2, 2)),
+        run(&system, m, &nsm2)?.with_exact(Exact::new(2, 1)?),
+        run(&system, m, &sub2)?.with_exact(Exact::new(2, 2)?),
     ];
     stats.count(&runs);
     let branches: Vec<Series> = runs
@@ -45,8 +45,8 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
         .zip([GREEN, RED, YELLOW])
         .map(|(r, c)| series(r, w1, c, Marker::Circle))
         .collect();
-    let mut bb = backbone_panel("backbones, m = 20", &branches, Some(&first_mode_curve()));
-    let exact_nsm2 = ClampedFamily::new(GAP, 2).backbone(1.2525, 1.3330, 101);
+    let mut bb = backbone_panel("backbones, m = 20", &branches, Some(&first_mode_curve()?));
+    let exact_nsm2 = ClampedFamily::new(GAP, 2)?.backbone(1.2525, 1.3330, 101);
     let exact_sub2: Vec<(f64, f64)> = exact_nsm2.iter().map(|&(w, e)| (w / 2.0, e)).collect();
     bb.series
         .push(reference_line("exact NSM2, NSM2 sub2", exact_nsm2));
@@ -122,7 +122,7 @@ fn arclength_nsm1(ctx: &Ctx, system: &BarSystem, m: usize, w1: f64) -> Res<Run> 
         label: format!("arclength m={m}"),
         m,
         points,
-        exact: Some(Exact::new(1, 1)),
+        exact: Some(Exact::new(1, 1)?),
     })
 }
 
@@ -133,7 +133,7 @@ pub fn fig08(ctx: &Ctx) -> Res<Stats> {
     let w1 = omega_1(&system)?;
     let mut panels = Vec::new();
     let mut runs = Vec::new();
-    let exact = first_mode_curve();
+    let exact = first_mode_curve()?;
     for m in [20usize, 40] {
         let seq = nsm1(ctx, &system, "sequential", m)?;
         let arc = arclength_nsm1(ctx, &system, m, w1)?;
@@ -197,14 +197,14 @@ pub fn fig09(ctx: &Ctx) -> Res<Stats> {
     let m = 40;
     let r = nsm1(ctx, &system, "NSM1", m)?;
     stats.count([&r]);
-    let exact = Exact::new(1, 1);
+    let exact = Exact::new(1, 1)?;
     let ratio = |p: &BackbonePoint| p.energy_normalized / exact.at(p.period);
     let spikes = spikes(&r, exact);
     let basis = settings(m).cosine_basis()?;
     let bb = backbone_panel(
         "NSM1, m = 40",
         &[series(&r, w1, GREEN, Marker::Circle)],
-        Some(&first_mode_curve()),
+        Some(&first_mode_curve()?),
     );
     let mut panels = Vec::new();
     let mut notes = Vec::new();

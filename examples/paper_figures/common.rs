@@ -196,11 +196,11 @@ pub struct Exact {
 
 impl Exact {
     /// Family `index` of the clamped bar, followed on its `subharmonic`-th branch.
-    pub fn new(index: usize, subharmonic: usize) -> Self {
-        Self {
-            family: ClampedFamily::new(GAP, index),
+    pub fn new(index: usize, subharmonic: usize) -> Res<Self> {
+        Ok(Self {
+            family: ClampedFamily::new(GAP, index)?,
             subharmonic: subharmonic as f64,
-        }
+        })
     }
 
     /// `E/E_g` at the branch's period `period`.
