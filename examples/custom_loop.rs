@@ -45,15 +45,12 @@ fn follow(
             Step::Accepted(p) => {
                 let (e, exact) = (normalized(&p), ClampedFirstMode::new(1e-3, p.parameter));
                 let events: Vec<&str> = p.events.iter().map(|e| e.label()).collect();
+                let exact = exact.energy_normalized();
                 println!(
-                    "{label}  T {:.4}  E/Eg {:9.4}  exact {:9.4}  {}",
-                    p.parameter,
-                    e,
-                    exact.energy_normalized(),
-                    events.join(",")
+                    "{label}  T {:.4}  E/Eg {e:9.4}  exact {exact:9.4}  {events:?}",
+                    p.parameter
                 );
                 if e > threshold {
-                    println!("energy threshold {threshold} reached ({rejected} rejected steps)");
                     return Phase::Threshold;
                 }
                 last = Some(p);
@@ -118,12 +115,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     };
     let mut arclength = Arclength::restart(problem, SemismoothNewton::default(), &from, options)?;
-    follow(
-        "arclength ",
+    let phase = follow(
+        "arclength",
         || arclength.step(),
         normalized,
         threshold,
         false,
     );
+    if let Phase::Threshold = phase {
+        println!("energy threshold {threshold} reached");
+    }
     Ok(())
 }

@@ -237,7 +237,10 @@ fn our_solver_drives_both_drivers() {
         scale: ArclengthScale::Fixed(1.0, 1.0),
         ..Default::default()
     };
-    let mut arclength = Arclength::new(Cusp::default(), Plain, vec![1.5], 1.875, options).unwrap();
+    // A solver chosen at run time drives them through a reference.
+    let boxed: Box<dyn nonsmooth_modes::solve::NonlinearSolver> = Box::new(Plain);
+    let mut arclength =
+        Arclength::new(Cusp::default(), &*boxed, vec![1.5], 1.875, options).unwrap();
     let branch = arclength.run(&mut nonsmooth_modes::continuation::quiet);
     assert_eq!(branch.end, EndReason::MaxSteps);
     assert_eq!(branch.points.len(), 11);

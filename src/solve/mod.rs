@@ -173,8 +173,9 @@ impl SolveMonitor for () {
     }
 }
 
-/// A solver of square nonsmooth systems. Object safe: continuation drivers take
-/// `&dyn NonlinearSolver` or a generic `S: NonlinearSolver`.
+/// A solver of square nonsmooth systems. Object safe: continuation drivers take a generic
+/// `S: NonlinearSolver`, and `&S` is one too, so a solver chosen at run time
+/// (`Box<dyn NonlinearSolver>`) is passed as `&*boxed`.
 pub trait NonlinearSolver {
     /// Solves `F(x) = 0` starting from `x`, telling `monitor` of every residual evaluation;
     /// on success `x` holds the solution, on failure the last iterate. A solver that cannot
@@ -203,21 +204,6 @@ pub trait NonlinearSolver {
 }
 
 impl<S: NonlinearSolver + ?Sized> NonlinearSolver for &S {
-    fn solve_monitored(
-        &self,
-        problem: &mut dyn Problem,
-        x: &mut [f64],
-        monitor: &mut dyn SolveMonitor,
-    ) -> Result<SolveInfo, SolveError> {
-        (**self).solve_monitored(problem, x, monitor)
-    }
-    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
-        (**self).tolerance(problem)
-    }
-}
-
-/// A boxed solver (`Box<dyn NonlinearSolver>`, chosen at run time) is a solver.
-impl<S: NonlinearSolver + ?Sized> NonlinearSolver for Box<S> {
     fn solve_monitored(
         &self,
         problem: &mut dyn Problem,
