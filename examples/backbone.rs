@@ -47,7 +47,7 @@
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
     linspace, Arclength, ArclengthOptions, Event, Point, Selection, Sequential, SequentialOptions,
-    Speculation, StallEscape, Step,
+    Speculation, Step,
 };
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, energy, grazing_energy, ArclengthBackboneOptions,
@@ -171,10 +171,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         serial: false,
         out: None,
         arclength: false,
-        driver: ArclengthOptions {
-            escape: Some(StallEscape::default()),
-            ..Default::default()
-        },
+        driver: ArclengthOptions::default(),
         omega_range: None,
         parameter: Parameter::Omega,
         parameter_range: None,
@@ -512,7 +509,6 @@ fn run_parameter(
     if a.arclength {
         let options = ArclengthOptions {
             parameter_range: (lo, hi),
-            escape: None,
             ..a.driver
         };
         let mut driver = Arclength::new(problem, solver, start.x, value, options)?;

@@ -13,16 +13,13 @@
 //!    turn of the tangent sharper than `max_turn` halves it and retries from `y_k`, which is
 //!    never modified; below `ds_min` the run ends.
 //!
-//! **Stalls.** Near internal resonances a truncated harmonic-balance branch can turn into an
-//! (almost) vertical branch whose energy grows without bound at fixed parameter; the paper
-//! abandoned arclength continuation for this reason. With [`StallEscape`] set, a run whose
-//! parameter has not progressed by `min_progress` in the requested direction over `window`
-//! accepted points jumps: from the recent point of smallest state norm (resonant branches
-//! carry more energy than the backbone they leave) it solves at fixed parameter a little
-//! beyond the most advanced parameter reached, doubling the distance while the solve fails or
-//! lands on a state more than `max_norm_ratio` times larger; it then restarts the tangent
-//! there and reports [`Event::Jump`] on that point. Without it, the run follows the
-//! branch wherever it goes.
+//! The run ends when the parameter leaves `parameter_range`, after `max_steps` accepted
+//! points, when the step falls below `ds_min`, or after more than `max_rejections` rejected
+//! steps ([`EndReason`]). The driver follows the branch wherever it goes; strategies that
+//! leave it (a jump past a stall of a harmonic-balance backbone,
+//! [`StallEscape`](crate::modal::StallEscape)) are written on top of its public methods: a
+//! fixed-parameter solve ([`Arclength::solve_at`]) and a restart from the solution found
+//! ([`Arclength::restart_from`]), which keeps the driver's scale, counters and acceptance test.
 //!
 //! Events are reported on accepted points: folds (the parameter component of the tangent
 //! changes sign), jumps that could not be refined away, and grazing (the problem's active
@@ -34,13 +31,13 @@
 mod bordered;
 mod options;
 
-pub use options::{ArclengthOptions, ArclengthScale, StallEscape, TangentPredictor};
+pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
 
 use super::driver::{next_point, run_with, Acceptance};
 use super::{
     Branch, ContinuationProblem, EndReason, Event, Observer, Point, RejectReason, Rejection, Step,
 };
-use crate::error::ContinuationError;
+use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::{NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
 use bordered::{BorderScratch, Bordered, Metric};
@@ -62,8 +59,8 @@ pub struct Arclength<P, S> {
     finished: Option<EndReason>,
     /// Whether the iterator has handed out the end.
     done: bool,
-    history: std::collections::VecDeque<(f64, Vec<f64>)>,
-    frontier: Option<(f64, Vec<f64>)>,
+    /// Rejected steps so far.
+    rejections: usize,
     accept: Option<Acceptance>,
     border: BorderScratch,
 }
@@ -84,18 +81,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     ) -> Result<Self, ContinuationError> {
         options.validate()?;
         let n = problem.dimension();
-        if x0.len() != n {
-            return Err(ContinuationError::Dimension {
-                got: x0.len(),
-                expected: n,
-            });
-        }
-        if !lambda0.is_finite() {
-            return Err(ContinuationError::InvalidOption {
-                what: "starting parameter",
-                value: lambda0,
-            });
-        }
+        check_start(&x0, n, lambda0, "starting parameter")?;
         let mut x = x0;
         problem.set_parameter(lambda0);
         let info = solver
@@ -143,8 +129,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             start: None,
             finished: None,
             done: false,
-            history: Default::default(),
-            frontier: None,
+            rejections: 0,
             accept: None,
             border: BorderScratch::default(),
         };
@@ -179,6 +164,99 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     /// The problem.
     pub fn problem_mut(&mut self) -> &mut P {
         &mut self.problem
+    }
+
+    /// The problem and the solver, giving up the driver.
+    pub fn into_parts(self) -> (P, S) {
+        (self.problem, self.solver)
+    }
+
+    /// The options the driver runs with.
+    pub fn options(&self) -> &ArclengthOptions {
+        &self.options
+    }
+
+    /// The current point `y = (x, lambda)`: the last accepted point (the corrected start
+    /// before any step). Rejected steps never change it.
+    pub fn state(&self) -> &[f64] {
+        &self.y
+    }
+
+    /// Rejected steps so far (the one that ended a run past
+    /// [`ArclengthOptions::max_rejections`] included).
+    pub fn rejections(&self) -> usize {
+        self.rejections
+    }
+
+    /// The scaled norm `|v|_W` of the step control: `v = (x, lambda)` with the problem's
+    /// dimension plus one entries, or a state `x` alone (its `x` part). Under
+    /// [`ArclengthScale::Automatic`] the corrected start has `|x0|_W = 1` (unless it is 0).
+    pub fn norm(&self, v: &[f64]) -> f64 {
+        self.metric.norm(v)
+    }
+
+    /// The parameter scale `s_lambda` of [`Arclength::norm`]: `|(0, lambda)|_W =
+    /// |lambda| / s_lambda`.
+    pub fn parameter_scale(&self) -> f64 {
+        1.0 / self.metric.lambda_w.sqrt()
+    }
+
+    /// Solves `F(x, lambda) = 0` at the fixed parameter `lambda` from `x` (updated in place)
+    /// with the driver's problem and solver. The branch is unchanged; a solution can become
+    /// its next point through [`Arclength::restart_from`].
+    ///
+    /// # Errors
+    /// The solver's.
+    pub fn solve_at(&mut self, x: &mut [f64], lambda: f64) -> Result<SolveInfo, SolveError> {
+        self.problem.set_parameter(lambda);
+        self.solver.solve(&mut self.problem, x)
+    }
+
+    /// Whether the acceptance test ([`Arclength::with_acceptance`]) takes the state `x` at
+    /// `lambda` (`true` without a test).
+    pub fn accepts(&mut self, x: &[f64], lambda: f64) -> bool {
+        self.accept.as_mut().is_none_or(|accept| accept(x, lambda))
+    }
+
+    /// Continues the branch from another solution `x` at `lambda` (one found by
+    /// [`Arclength::solve_at`], for instance): `x` is corrected at fixed `lambda`, the tangent
+    /// there is oriented along [`ArclengthOptions::direction`] in `lambda`, and the point
+    /// becomes the current one, numbered as the next step (it counts towards `max_steps`),
+    /// with no events and `step_size = 0`. The step size goes back to `options.ds` and the
+    /// secant history is forgotten; the scale of the norm, the counts of accepted and
+    /// rejected steps and the acceptance test (not applied to this point) are kept, and a
+    /// driver that had finished runs again. Unlike [`Arclength::restart`], which builds a
+    /// driver with a scale of its own, the steps that follow are measured as before.
+    ///
+    /// # Errors
+    /// A wrong-sized `x` or a non-finite `lambda`, a failed correction
+    /// ([`ContinuationError::Start`]) or a singular bordered Jacobian; the driver is then
+    /// unchanged.
+    pub fn restart_from(&mut self, x: Vec<f64>, lambda: f64) -> Result<Point, ContinuationError> {
+        let n = self.problem.dimension();
+        check_start(&x, n, lambda, "restart parameter")?;
+        let mut y = x;
+        let info = self
+            .solve_at(&mut y, lambda)
+            .map_err(ContinuationError::Start)?;
+        y.push(lambda);
+        let mut seed = vec![0.0; n + 1];
+        seed[n] = self.options.direction;
+        let tangent = self
+            .tangent_at(&y, &seed)
+            .ok_or(ContinuationError::SingularTangent { lambda })?;
+        self.previous = None;
+        self.y = y;
+        self.tangent = tangent;
+        self.active = self.active_set();
+        self.accepted += 1;
+        self.ds = self.options.ds;
+        self.start = None;
+        self.finished = None;
+        self.done = false;
+        let mut point = self.point(self.accepted, &info, Vec::new());
+        point.step_size = 0.0;
+        Ok(point)
     }
 
     /// Current step size.
@@ -254,20 +332,22 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             reason,
             point: None,
         };
+        self.rejections += 1;
         self.ds *= self.options.shrink;
-        if self.ds < self.options.ds_min {
-            if let Some(escape) = self.options.escape {
-                if self.history.len() > 1 {
-                    return self.escape(&escape, self.y[self.y.len() - 1]);
-                }
-            }
-            let end = EndReason::StepBelowMinimum {
+        let end = if self.ds < self.options.ds_min {
+            EndReason::StepBelowMinimum {
                 last: Box::new(rejection),
-            };
-            self.finished = Some(end.clone());
-            return Step::Finished(end);
-        }
-        Step::Rejected(rejection)
+            }
+        } else if self.rejections > self.options.max_rejections {
+            EndReason::TooManyRejections {
+                rejections: self.rejections,
+                last: Box::new(rejection),
+            }
+        } else {
+            return Step::Rejected(rejection);
+        };
+        self.finished = Some(end.clone());
+        Step::Finished(end)
     }
 
     /// One predictor–corrector attempt (the first call returns the corrected start).
@@ -369,111 +449,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         }
         let mut point = self.point(self.accepted, &info, events);
         point.step_size = step_used;
-        if let Some(escape) = self.options.escape {
-            let dir = self.options.direction;
-            if self
-                .frontier
-                .as_ref()
-                .is_none_or(|(l, _)| dir * self.y[n] > dir * l)
-            {
-                self.frontier = Some((self.y[n], self.y[..n].to_vec()));
-            }
-            self.history.push_back((self.y[n], self.y[..n].to_vec()));
-            if self.history.len() > 2 * escape.window {
-                self.history.pop_front();
-            }
-            if self.is_stalled(&escape) {
-                return self.escape(&escape, point.parameter);
-            }
-        }
         Step::Accepted(point)
-    }
-
-    /// Parameter scale `s_lambda`.
-    fn lambda_scale(&self) -> f64 {
-        1.0 / self.metric.lambda_w.sqrt()
-    }
-
-    /// Whether the last `window` accepted points made less than `min_progress` progress.
-    fn is_stalled(&self, escape: &StallEscape) -> bool {
-        let h = &self.history;
-        if h.len() <= escape.window {
-            return false;
-        }
-        let now = h[h.len() - 1].0;
-        let then = h[h.len() - 1 - escape.window].0;
-        self.options.direction * (now - then) < escape.min_progress * self.lambda_scale()
-    }
-
-    /// Jumps past a stall: see [`StallEscape`].
-    fn escape(&mut self, escape: &StallEscape, now: f64) -> Step {
-        let n = self.problem.dimension();
-        let dir = self.options.direction;
-        let scale = self.lambda_scale();
-        // Anchors: the recent point of least state norm (the backbone below a resonant
-        // branch) and the most advanced point ever accepted (the frontier).
-        let mut anchors: Vec<(f64, Vec<f64>)> = self
-            .history
-            .iter()
-            .min_by(|a, b| self.metric.norm(&a.1).total_cmp(&self.metric.norm(&b.1)))
-            .into_iter()
-            .cloned()
-            .collect();
-        anchors.extend(self.frontier.clone());
-        let ahead = anchors
-            .iter()
-            .chain(self.history.iter())
-            .map(|(l, _)| dir * l)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let mut distance = escape.jump * scale;
-        for _ in 0..escape.max_attempts {
-            // `ahead` and `distance` are in progress coordinates `dir * lambda`.
-            let target = dir * (ahead + distance);
-            let (lo, hi) = self.options.parameter_range;
-            if target < lo || target > hi {
-                let end = EndReason::ParameterOutOfRange { parameter: target };
-                self.finished = Some(end.clone());
-                return Step::Finished(end);
-            }
-            for from in &anchors {
-                let from_norm = self.metric.norm(&from.1);
-                let mut x = from.1.clone();
-                self.problem.set_parameter(target);
-                let solved = self.solver.solve(&mut self.problem, &mut x);
-                let accepted = solved.is_ok()
-                    && self.metric.norm(&x) <= escape.max_norm_ratio * from_norm
-                    && self.accept.as_mut().is_none_or(|accept| accept(&x, target));
-                if let (Ok(info), true) = (solved, accepted) {
-                    let mut y = x;
-                    y.push(target);
-                    let mut seed = vec![0.0; n + 1];
-                    seed[n] = dir;
-                    if let Some(t) = self.tangent_at(&y, &seed) {
-                        let jump: Vec<f64> = y.iter().zip(&self.y).map(|(a, b)| a - b).collect();
-                        let ratio = self.metric.norm(&jump) / self.ds;
-                        self.previous = None;
-                        self.y = y;
-                        self.tangent = t;
-                        self.history.clear();
-                        self.history.push_back((target, self.y[..n].to_vec()));
-                        self.active = self.active_set();
-                        self.accepted += 1;
-                        self.ds = self.options.ds;
-                        let mut point =
-                            self.point(self.accepted, &info, vec![Event::Jump { ratio }]);
-                        point.step_size = target - now;
-                        return Step::Accepted(point);
-                    }
-                }
-            }
-            distance *= 2.0;
-        }
-        let end = EndReason::Stalled {
-            failures: escape.max_attempts,
-            parameter: now,
-        };
-        self.finished = Some(end.clone());
-        Step::Finished(end)
     }
 
     /// Runs until the end, handing every step (the start, accepted points and rejections) to
@@ -488,182 +464,38 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     }
 }
 
+/// Checks a starting state `x` of a problem of dimension `n` at parameter `lambda`, named
+/// `what` in the error.
+fn check_start(
+    x: &[f64],
+    n: usize,
+    lambda: f64,
+    what: &'static str,
+) -> Result<(), ContinuationError> {
+    if x.len() != n {
+        return Err(ContinuationError::Dimension {
+            got: x.len(),
+            expected: n,
+        });
+    }
+    if !lambda.is_finite() {
+        return Err(ContinuationError::InvalidOption {
+            what,
+            value: lambda,
+        });
+    }
+    Ok(())
+}
+
 impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<P, S> {
     type Item = Result<Point, ContinuationError>;
 
     /// The accepted points (rejections are retried internally); then, if the run failed
     /// ([`EndReason::error`]), its error; then `None`.
     fn next(&mut self) -> Option<Self::Item> {
-        let mut done = self.done;
-        let item = next_point(&mut done, || self.step());
-        self.done = done;
-        item
+        next_point(self, |d| &mut d.done, Self::step)
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::solve::SemismoothNewton;
-
-    /// `F(x, lambda) = x^2 + lambda^2 - 1`: a circle with folds at `lambda = +-1`.
-    struct Circle {
-        lambda: f64,
-    }
-
-    impl Problem for Circle {
-        fn dimension(&self) -> usize {
-            1
-        }
-        fn residual(&mut self, x: &[f64], f: &mut [f64]) {
-            f[0] = x[0] * x[0] + self.lambda * self.lambda - 1.0;
-        }
-        fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
-            jac.reset(1, 1);
-            jac[(0, 0)] = 2.0 * x[0];
-        }
-    }
-
-    impl ContinuationProblem for Circle {
-        fn parameter(&self) -> f64 {
-            self.lambda
-        }
-        fn set_parameter(&mut self, lambda: f64) {
-            self.lambda = lambda;
-        }
-        fn parameter_derivative(&mut self, _: &[f64], df: &mut [f64]) {
-            df[0] = 2.0 * self.lambda;
-        }
-    }
-
-    #[test]
-    fn passes_the_fold_of_a_circle_and_comes_back() {
-        let options = ArclengthOptions {
-            ds: 0.05,
-            ds_max: 0.1,
-            max_steps: 400,
-            parameter_range: (-0.5, 2.0),
-            scale: ArclengthScale::Fixed(1.0, 1.0),
-            ..Default::default()
-        };
-        let mut driver = Arclength::new(
-            Circle { lambda: 0.0 },
-            SemismoothNewton::default(),
-            vec![0.9],
-            0.0,
-            options,
-        )
-        .unwrap();
-        let branch = driver.run(&mut crate::continuation::quiet);
-        // Leaves through lambda < -0.5 on the lower half after turning at lambda = 1.
-        assert!(
-            matches!(branch.end, EndReason::ParameterOutOfRange { parameter } if parameter < -0.5)
-        );
-        assert_eq!(branch.points[0].step, 0);
-        assert!(
-            (branch.points[0].x[0] - 1.0).abs() < 1e-9,
-            "the corrected start"
-        );
-        let folds: Vec<_> = branch
-            .with_event(|e| matches!(e, Event::Fold { .. }))
-            .collect();
-        assert_eq!(folds.len(), 1);
-        assert!(folds[0].parameter > 0.95);
-        assert!(
-            branch.points.iter().any(|p| p.x[0] < -0.5),
-            "came back on the other side"
-        );
-        for p in &branch.points {
-            assert!((p.x[0].powi(2) + p.parameter.powi(2) - 1.0).abs() < 1e-9);
-        }
-        // Arclength steps match the geometry: consecutive points are ds apart (chord ~ arc).
-        for w in branch.points.windows(2) {
-            let chord = ((w[1].x[0] - w[0].x[0]).powi(2)
-                + (w[1].parameter - w[0].parameter).powi(2))
-            .sqrt();
-            assert!((chord - w[1].step_size).abs() < 0.01 * w[1].step_size + 1e-3);
-        }
-    }
-
-    #[test]
-    fn observer_stops_and_secant_works() {
-        let options = ArclengthOptions {
-            predictor: TangentPredictor::Secant,
-            scale: ArclengthScale::Fixed(1.0, 1.0),
-            ..Default::default()
-        };
-        let mut driver = Arclength::new(
-            Circle { lambda: 0.0 },
-            SemismoothNewton::default(),
-            vec![1.0],
-            0.0,
-            options,
-        )
-        .unwrap();
-        let mut seen = 0;
-        let branch = driver.run(&mut |o: &Step| {
-            seen += usize::from(matches!(o, Step::Accepted(_)));
-            if seen == 5 {
-                std::ops::ControlFlow::Break(())
-            } else {
-                std::ops::ControlFlow::Continue(())
-            }
-        });
-        assert_eq!(branch.points.len(), 5);
-        assert_eq!(branch.end, EndReason::StoppedByObserver);
-        assert!(matches!(
-            driver.step(),
-            Step::Finished(EndReason::StoppedByObserver)
-        ));
-        // The iterator ends at once, without an error.
-        assert!(driver.next().is_none());
-    }
-
-    #[test]
-    fn rejects_bad_options() {
-        let bad = [
-            ArclengthOptions {
-                ds_min: 1.0,
-                ds_max: 0.1,
-                ds: 0.5,
-                ..Default::default()
-            },
-            ArclengthOptions {
-                ds: f64::NAN,
-                ..Default::default()
-            },
-            ArclengthOptions {
-                parameter_range: (1.0, 1.0),
-                ..Default::default()
-            },
-            ArclengthOptions {
-                parameter_range: (f64::NAN, 1.0),
-                ..Default::default()
-            },
-            ArclengthOptions {
-                direction: 0.0,
-                ..Default::default()
-            },
-            ArclengthOptions {
-                max_steps: 0,
-                ..Default::default()
-            },
-            ArclengthOptions {
-                scale: ArclengthScale::Fixed(0.0, 1.0),
-                ..Default::default()
-            },
-        ];
-        for o in bad {
-            assert!(matches!(
-                Arclength::new(
-                    Circle { lambda: 0.0 },
-                    SemismoothNewton::default(),
-                    vec![1.0],
-                    0.0,
-                    o
-                ),
-                Err(ContinuationError::InvalidOption { .. })
-            ));
-        }
-    }
-}
+mod tests;

@@ -1,6 +1,8 @@
 //! Options of the pseudo-arclength driver: steps, range, predictor, norm scales, step control,
 //! and their validation.
 
+#[cfg(doc)]
+use crate::continuation::EndReason;
 use crate::error::ContinuationError;
 
 /// How the predictor direction is formed.
@@ -17,8 +19,8 @@ pub enum TangentPredictor {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum ArclengthScale {
     /// `|x|^2 = sum_i w_i x_i^2 / sum_i w_i x0_i^2` with the problem's
-    /// [`Structured::state_weights`] (an energy norm for harmonic balance; all 1 if it
-    /// has none), so that `ds` is the relative change of the state; and
+    /// [`Structured::state_weights`](crate::solve::Structured::state_weights) (an energy
+    /// norm for harmonic balance; all 1 if it has none), so that `ds` is the relative change of the state; and
     /// `s_lambda = |lambda_0|` (or 1 when `lambda_0 = 0`) (default).
     #[default]
     Automatic,
@@ -26,49 +28,20 @@ pub enum ArclengthScale {
     Fixed(f64, f64),
 }
 
-/// Automatic escape from stalls (see the module documentation). Distances are relative to the
-/// parameter scale `s_lambda`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StallEscape {
-    /// Accepted points over which progress is measured (default 20).
-    pub window: usize,
-    /// Least progress of the parameter over the window, relative (default `2e-3`).
-    pub min_progress: f64,
-    /// First jump beyond the stalled parameter, relative (default `2e-3`); doubled on each
-    /// failed attempt.
-    pub jump: f64,
-    /// Attempts before the run ends with [`EndReason::Stalled`] (default 6).
-    pub max_attempts: usize,
-    /// A jump is accepted only if the new state's norm is at most this multiple of the norm
-    /// of the point it started from (default 2).
-    pub max_norm_ratio: f64,
-}
-
-impl Default for StallEscape {
-    fn default() -> Self {
-        Self {
-            window: 20,
-            min_progress: 2e-3,
-            jump: 2e-3,
-            max_attempts: 6,
-            max_norm_ratio: 2.0,
-        }
-    }
-}
-
 /// Options of [`Arclength`](super::Arclength). Every field documents its default.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArclengthOptions {
     /// Initial step `ds` (default `0.02`).
     pub ds: f64,
-    /// Smallest step before the run ends with [`EndReason::StepBelowMinimum`] (default `1e-5`).
+    /// Smallest step before the run ends with [`EndReason::StepBelowMinimum`] (default
+    /// `1e-5`).
     pub ds_min: f64,
     /// Largest step (default `0.2`).
     pub ds_max: f64,
     /// Accepted points before [`EndReason::MaxSteps`] (default 2000).
     pub max_steps: usize,
-    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves
-    /// `[lo, hi]` (default unbounded).
+    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves `[lo, hi]`
+    /// (default unbounded).
     pub parameter_range: (f64, f64),
     /// Initial direction of `lambda`: `+1` or `-1` (default `+1`).
     pub direction: f64,
@@ -87,8 +60,12 @@ pub struct ArclengthOptions {
     pub jump_ratio: f64,
     /// Largest angle in radians between successive tangents (default `pi/4`).
     pub max_turn: f64,
-    /// Automatic escape from stalls (default `None`: follow the branch wherever it goes).
-    pub escape: Option<StallEscape>,
+    /// Rejected steps a run may take; one more ends it with
+    /// [`EndReason::TooManyRejections`] (default 10 000). Consecutive rejections are
+    /// bounded by `ds_min` (with the default steps and factors, at most 15 halvings of `ds`
+    /// from `ds_max`), but a `shrink` close to 1 takes millions of them, each a corrector
+    /// solve, to get there; this bounds the whole run's.
+    pub max_rejections: usize,
 }
 
 impl Default for ArclengthOptions {
@@ -107,7 +84,7 @@ impl Default for ArclengthOptions {
             shrink: 0.5,
             jump_ratio: 2.0,
             max_turn: std::f64::consts::FRAC_PI_4,
-            escape: None,
+            max_rejections: 10_000,
         }
     }
 }
@@ -154,23 +131,6 @@ impl ArclengthOptions {
         if self.max_steps == 0 {
             return bad("max_steps", 0.0);
         }
-        if let Some(e) = self.escape {
-            if e.window < 2 || e.max_attempts == 0 {
-                return bad(
-                    "escape window/attempts",
-                    e.window.min(e.max_attempts) as f64,
-                );
-            }
-            for (what, v) in [
-                ("escape min_progress", e.min_progress),
-                ("escape jump", e.jump),
-                ("escape max_norm_ratio", e.max_norm_ratio),
-            ] {
-                if !(v.is_finite() && v > 0.0) {
-                    return bad(what, v);
-                }
-            }
-        }
         if let ArclengthScale::Fixed(a, b) = self.scale {
             for v in [a, b] {
                 if !(v.is_finite() && v > 0.0) {
@@ -179,5 +139,66 @@ impl ArclengthOptions {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_options() {
+        let bad = [
+            ArclengthOptions {
+                ds_min: 1.0,
+                ds_max: 0.1,
+                ds: 0.5,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                ds: f64::NAN,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                parameter_range: (1.0, 1.0),
+                ..Default::default()
+            },
+            ArclengthOptions {
+                parameter_range: (f64::NAN, 1.0),
+                ..Default::default()
+            },
+            ArclengthOptions {
+                direction: 0.0,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                max_steps: 0,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                scale: ArclengthScale::Fixed(0.0, 1.0),
+                ..Default::default()
+            },
+            ArclengthOptions {
+                shrink: 1.0,
+                ..Default::default()
+            },
+            ArclengthOptions {
+                growth: 0.5,
+                ..Default::default()
+            },
+        ];
+        for o in bad {
+            assert!(
+                matches!(o.validate(), Err(ContinuationError::InvalidOption { .. })),
+                "{o:?}"
+            );
+        }
+        assert!(ArclengthOptions::default().validate().is_ok());
+        let none_allowed = ArclengthOptions {
+            max_rejections: 0,
+            ..Default::default()
+        };
+        assert!(none_allowed.validate().is_ok());
     }
 }
