@@ -46,7 +46,7 @@
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
-    linspace, ArclengthOptions, Event, Selection, SequentialOptions, Speculation, StallEscape,
+    linspace, ArclengthOptions, Event, Selection, SequentialOptions, Speculation,
 };
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, backbone_speculative_with, backbone_with, parameter_branch,
@@ -169,10 +169,7 @@ fn parse() -> Result<Args, lexopt::Error> {
         serial: false,
         out: None,
         arclength: false,
-        driver: ArclengthOptions {
-            escape: Some(StallEscape::default()),
-            ..Default::default()
-        },
+        driver: ArclengthOptions::default(),
         omega_range: None,
         parameter: Parameter::Omega,
         parameter_range: None,
@@ -494,7 +491,6 @@ fn run_parameter(
     let steps = if a.arclength {
         ParameterSteps::Arclength(ArclengthOptions {
             parameter_range: (lo, hi),
-            escape: None,
             ..a.driver
         })
     } else {

@@ -11,8 +11,7 @@
 //! ```
 
 use nonsmooth_modes::continuation::{
-    Arclength, ArclengthOptions, PeriodParametrised, Point, Sequential, SequentialOptions,
-    StallEscape, Step,
+    Arclength, ArclengthOptions, PeriodParametrised, Point, Sequential, SequentialOptions, Step,
 };
 use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
@@ -111,7 +110,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = ArclengthOptions {
         direction: -1.0,
         parameter_range: (3.0, 4.0),
-        escape: Some(StallEscape::default()),
         ..Default::default()
     };
     let mut arclength = Arclength::restart(problem, SemismoothNewton::default(), &from, options)?;

@@ -277,12 +277,12 @@ pub enum ContinuationError {
         /// The rejected value.
         value: f64,
     },
-    /// Too many consecutive steps failed: the branch is lost.
+    /// Too many consecutive steps (or attempts to leave a stall) failed: the branch is lost.
     #[error(
         "continuation stalled: {failures} consecutive failed steps, last at parameter {parameter}"
     )]
     Stalled {
-        /// Consecutive failures.
+        /// Consecutive failures, or attempts.
         failures: usize,
         /// Parameter value of the last failure.
         parameter: f64,
@@ -293,6 +293,15 @@ pub enum ContinuationError {
     StepBelowMinimum {
         /// The last step tried.
         step_size: f64,
+        /// Parameter value of the last rejected step.
+        parameter: f64,
+    },
+    /// A run rejected more steps than it allows
+    /// ([`ArclengthOptions::max_rejections`](crate::continuation::ArclengthOptions::max_rejections)).
+    #[error("{rejections} rejected steps, the last at parameter {parameter}")]
+    TooManyRejections {
+        /// Rejected steps, the last one included.
+        rejections: usize,
         /// Parameter value of the last rejected step.
         parameter: f64,
     },

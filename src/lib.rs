@@ -29,8 +29,8 @@
 //! | [`system::AssemblyBuilder`] → [`system::BarSystem`] | compose and validate |
 //! | [`system::NonsmoothSystem`] | `F(x; Omega)`, Jacobian, `dF/dOmega` for a [`fourier::Basis`] |
 //! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`], [`solve::SmoothingHomotopy`] |
-//! | [`continuation::ContinuationProblem`] | [`continuation::Sequential`], [`continuation::Arclength`] (with [`continuation::StallEscape`]), [`system::ParameterFamily`] for any system parameter |
-//! | [`modal::backbone()`], [`modal::arclength_backbone`] | one call: a backbone with `E / E_g` |
+//! | [`continuation::ContinuationProblem`] | [`continuation::Sequential`], [`continuation::Arclength`], [`system::ParameterFamily`] for any system parameter |
+//! | [`modal::backbone()`], [`modal::arclength_backbone`] (with [`modal::StallEscape`]) | one call: a backbone with `E / E_g` |
 //! | [`Solution`] | a computed motion (problem, unknowns, frequency): energy, `E/E_g`, fields, end and law histories, diagnostics, time-domain check |
 //! | [`modal::diagnose`], [`modal::FieldEvaluator`] | residual norm `R^(m)`, penetration, fields, histories of a point |
 //! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |

@@ -2,7 +2,7 @@
 
 use nonsmooth_modes::continuation::{
     Arclength, ArclengthOptions, ContinuationProblem, EndReason, Event, PeriodParametrised, Point,
-    Sequential, Speculative, StallEscape, Step,
+    Sequential, Speculative, Step,
 };
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, branch_seed, energy, ArclengthBackboneOptions, BackboneOptions,
@@ -168,7 +168,6 @@ fn iterator_restart_and_reverse_direction() {
     let options = ArclengthOptions {
         direction: -1.0,
         parameter_range: (3.5, 3.95),
-        escape: Some(StallEscape::default()),
         ..Default::default()
     };
     let driver = Arclength::new(

@@ -6,8 +6,10 @@ use crate::common::{
     omega_1, pick, point_map, reference_line, run, series, Branch, Ctx, Exact, Res, Run, Stats,
     BLUE, GAP, GREEN, RED, YELLOW,
 };
-use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, StallEscape};
-use nonsmooth_modes::modal::{arclength_backbone, ArclengthBackboneOptions, BackbonePoint};
+use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
+use nonsmooth_modes::modal::{
+    arclength_backbone, ArclengthBackboneOptions, BackbonePoint, StallEscape,
+};
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::solve::SemismoothNewton;
@@ -90,9 +92,9 @@ fn arclength_nsm1(ctx: &Ctx, system: &BarSystem, m: usize, w1: f64) -> Res<Run> 
         omega_range: (2.0 * PI / 3.96, 2.0 * PI / 3.05),
         arclength: ArclengthOptions {
             max_steps: if ctx.quick { 150 } else { 2000 },
-            escape: Some(StallEscape::default()),
             ..Default::default()
         },
+        escape: Some(StallEscape::default()),
         ..Default::default()
     };
     let (_, branch) = arclength_backbone(

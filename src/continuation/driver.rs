@@ -96,12 +96,21 @@ pub enum EndReason {
         /// The last rejection.
         last: Box<Rejection>,
     },
+    /// More steps were rejected than the run allows
+    /// ([`ArclengthOptions::max_rejections`](super::ArclengthOptions::max_rejections)).
+    TooManyRejections {
+        /// Rejected steps, the last one included.
+        rejections: usize,
+        /// The last rejection.
+        last: Box<Rejection>,
+    },
     /// The observer returned `ControlFlow::Break`.
     StoppedByObserver,
     /// The branch is lost: too many consecutive failed steps (natural-parameter runs), or
-    /// every attempt to escape a stall failed (pseudo-arclength runs with an escape).
+    /// every attempt to leave a stall failed (a strategy on top of a driver, such as the
+    /// backbone's [`StallEscape`](crate::modal::StallEscape)).
     Stalled {
-        /// Consecutive failures, or escape attempts.
+        /// Consecutive failures, or attempts.
         failures: usize,
         /// Parameter value where the run stalled.
         parameter: f64,
@@ -109,8 +118,8 @@ pub enum EndReason {
 }
 
 impl EndReason {
-    /// The error of a run that ended by failing (`Stalled`, `StepBelowMinimum`); `None` for
-    /// a run that ended as asked.
+    /// The error of a run that ended by failing (`Stalled`, `StepBelowMinimum`,
+    /// `TooManyRejections`); `None` for a run that ended as asked.
     pub fn error(&self) -> Option<ContinuationError> {
         match self {
             Self::Stalled {
@@ -124,6 +133,12 @@ impl EndReason {
                 step_size: last.step_size,
                 parameter: last.parameter,
             }),
+            Self::TooManyRejections { rejections, last } => {
+                Some(ContinuationError::TooManyRejections {
+                    rejections: *rejections,
+                    parameter: last.parameter,
+                })
+            }
             _ => None,
         }
     }
@@ -171,7 +186,7 @@ pub(super) type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
 
 /// Steps `driver` with `step` until the run ends or `observer` stops it, collecting the
 /// branch. `stop` records an observer's stop in the driver, so that later steps report it.
-pub(super) fn run_with<D>(
+pub(crate) fn run_with<D>(
     driver: &mut D,
     mut step: impl FnMut(&mut D) -> Step,
     stop: impl FnOnce(&mut D),
@@ -203,21 +218,23 @@ pub(super) fn run_with<D>(
     }
 }
 
-/// The next item of a driver's iterator: the next accepted point, the error of a run that
-/// failed, or `None` at the end. `done` is set once the end has been handed out.
-pub(super) fn next_point(
-    done: &mut bool,
-    mut step: impl FnMut() -> Step,
+/// The next item of a driver's iterator, stepping `driver` with `step`: the next accepted
+/// point, the error of a run that failed, or `None` at the end. The flag `done` of the
+/// driver is set once the end has been handed out.
+pub(crate) fn next_point<D>(
+    driver: &mut D,
+    done: fn(&mut D) -> &mut bool,
+    step: fn(&mut D) -> Step,
 ) -> Option<Result<Point, ContinuationError>> {
-    if *done {
+    if *done(driver) {
         return None;
     }
     loop {
-        match step() {
+        match step(driver) {
             Step::Accepted(p) => return Some(Ok(p)),
             Step::Rejected(_) => continue,
             Step::Finished(end) => {
-                *done = true;
+                *done(driver) = true;
                 return end.error().map(Err);
             }
         }

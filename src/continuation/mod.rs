@@ -21,7 +21,8 @@ mod progress;
 mod sequential;
 mod speculative;
 
-pub use arclength::{Arclength, ArclengthOptions, ArclengthScale, StallEscape, TangentPredictor};
+pub use arclength::{Arclength, ArclengthOptions, ArclengthScale, TangentPredictor};
+pub(crate) use driver::{next_point, run_with};
 pub use driver::{Branch, EndReason, Observer, RejectReason, Rejection, Step};
 pub use progress::{quiet, Progress};
 pub use sequential::{linspace, Predictor, Selection, Sequential, SequentialOptions};
@@ -165,9 +166,11 @@ pub enum Event {
         /// Parameter at the point after the fold.
         parameter: f64,
     },
-    /// The corrected point is far from its prediction even at the smallest step.
+    /// The branch jumped: the corrected point is far from its prediction even at the
+    /// smallest step, or a strategy on top of the driver moved it to a solution found at
+    /// fixed parameter (the backbone's [`StallEscape`](crate::modal::StallEscape)).
     Jump {
-        /// Distance to the prediction over the step size.
+        /// Distance to the prediction (or to the point jumped from) over the step size.
         ratio: f64,
     },
     /// The active set of a unilateral law appeared (`contact == true`) or vanished.

@@ -333,10 +333,7 @@ where
 
     /// The converged points; then, if the run stalled, its error; then `None`.
     fn next(&mut self) -> Option<Self::Item> {
-        let mut done = self.done;
-        let item = next_point(&mut done, || self.step());
-        self.done = done;
-        item
+        next_point(self, |d| &mut d.done, Self::step)
     }
 }
 

@@ -3,12 +3,12 @@
 
 use crate::continuation::{
     linspace, Arclength, ArclengthOptions, Branch, Event, Observer, PeriodParametrised, Point,
-    Predictor, Selection, Sequential, SequentialOptions, Speculation, Speculative, StallEscape,
-    Step,
+    Predictor, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
 };
 use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
 use crate::modal::energy::energy;
+use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::solution::Solution;
 use crate::solve::NonlinearSolver;
@@ -340,10 +340,13 @@ pub struct ArclengthBackboneOptions {
     pub mode: usize,
     /// Period multiple of the seed (default 1).
     pub subharmonic: usize,
-    /// Driver options. The default has `direction = +1` (towards higher `Omega`) and
-    /// `escape = Some(StallEscape::default())`, so that internal-resonance branches do not
-    /// stall the backbone.
+    /// Driver options (default [`ArclengthOptions::default`]: `direction = +1`, towards
+    /// higher `Omega`); their `parameter_range` is replaced by `omega_range`.
     pub arclength: ArclengthOptions,
+    /// Escape from stalls ([`EscapingArclength`]; default `Some(StallEscape::default())`, so
+    /// that internal-resonance branches do not stall the backbone; `None` follows the branch
+    /// wherever it goes).
+    pub escape: Option<StallEscape>,
     /// As [`BackboneOptions::trivial_energy`] (default `1e-6`).
     pub trivial_energy: f64,
 }
@@ -355,10 +358,8 @@ impl Default for ArclengthBackboneOptions {
             omega_range: (2.0 * PI / 3.96, 2.0 * PI / 3.05),
             mode: 1,
             subharmonic: 1,
-            arclength: ArclengthOptions {
-                escape: Some(StallEscape::default()),
-                ..Default::default()
-            },
+            arclength: ArclengthOptions::default(),
+            escape: Some(StallEscape::default()),
             trivial_energy: 1e-6,
         }
     }
@@ -366,7 +367,8 @@ impl Default for ArclengthBackboneOptions {
 
 /// Computes a backbone by pseudo-arclength continuation in `Omega` (see
 /// [`Arclength`]): seeds the branch from the linear mode at `start_period`, follows it inside
-/// `omega_range` and hands every accepted point to `observer`, which may stop the run.
+/// `omega_range`, jumping past stalls when `options.escape` is set ([`EscapingArclength`]),
+/// and hands every accepted point to `observer`, which may stop the run.
 /// Returns `E_g` and the branch summary (points, rejections, end reason).
 ///
 /// # Errors
@@ -393,11 +395,14 @@ pub fn arclength_backbone<S: NonlinearSolver>(
         parameter_range: options.omega_range,
         ..options.arclength
     };
+    if let Some(escape) = options.escape {
+        escape.validate()?;
+    }
     let floor = options.trivial_energy * e_g;
     let (accept_system, accept_basis) = (system.clone(), basis.clone());
     let mut driver = Arclength::new(problem, solver, start, omega0, arclength)?
         .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
-    let branch = driver.run(&mut |step: &Step| match step {
+    let mut see = |step: &Step| match step {
         Step::Accepted(p) => observer(&BackbonePoint::from_point(
             p,
             p.parameter,
@@ -405,6 +410,10 @@ pub fn arclength_backbone<S: NonlinearSolver>(
             e_g,
         )),
         _ => ControlFlow::Continue(()),
-    });
+    };
+    let branch = match options.escape {
+        Some(escape) => EscapingArclength::new(driver, escape)?.run(&mut see),
+        None => driver.run(&mut see),
+    };
     Ok((e_g, branch))
 }

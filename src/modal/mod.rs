@@ -4,6 +4,7 @@
 mod backbone;
 pub mod diagnostics;
 pub mod energy;
+mod escape;
 pub mod field;
 pub mod linear;
 mod parameter;
@@ -16,6 +17,7 @@ pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,
 };
 pub use energy::{energy, energy_at};
+pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};
 pub use linear::{
     branch_seed, grazing_energy, natural_frequencies, seed_from_mode, ContactState, LinearMode,

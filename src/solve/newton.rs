@@ -104,7 +104,7 @@ impl NewtonOptions {
     /// backbone's time proving it (`docs/performance.md`). On the clamped bar's 181-step
     /// backbone they converge the same steps as the defaults at `m = 20` and `40` and one
     /// fewer at `m = 80` (169 of 181), in a half to a third of the time. Not for far starts
-    /// (a seed, the jumps of [`crate::continuation::StallEscape`]): those can need a slow
+    /// (a seed, the jumps of [`crate::modal::StallEscape`]): those can need a slow
     /// first phase before converging.
     pub fn fail_fast() -> Self {
         Self {

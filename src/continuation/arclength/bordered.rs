@@ -1,0 +1,192 @@
+//! The bordered corrector system of the pseudo-arclength driver, its bordering solve, and the
+//! diagonal metric of the scaled norm on `y = (x, lambda)`.
+
+use crate::continuation::ContinuationProblem;
+use crate::linalg::DenseMatrix;
+use crate::solve::{residual_scale, Problem, SingularStep, Structured, PIVOT_TOLERANCE};
+
+/// The bordered corrector system `[F(x, lambda); s <t, y - y_p>_W]` as a [`Problem`] in
+/// `y = (x, lambda)`, with `s` the residual scale of the problem.
+///
+/// Its structured solve is the bordering algorithm on the problem's own structured solve:
+/// `J a = r_x` and `J b = dF/dlambda` in one call, then
+/// `dlambda = (r_lambda - c.a) / (d - c.b)`, `dx = a - dlambda b`, where `(c, d)` is the
+/// border row. Where `J` alone is singular (a fold) or has no structure, it falls back to
+/// the dense bordered Jacobian.
+pub(super) struct Bordered<'a, P: ?Sized> {
+    problem: &'a mut P,
+    tangent: &'a [f64],
+    predicted: &'a [f64],
+    metric: &'a Metric,
+    scratch: &'a mut BorderScratch,
+    /// The residual scale of the problem at the last parameter evaluated.
+    scale: f64,
+}
+
+/// Storage of the bordered Jacobian's blocks, kept by the driver across corrector iterations
+/// and steps.
+#[derive(Debug, Default)]
+pub(super) struct BorderScratch {
+    /// `dF/dx`.
+    inner: DenseMatrix,
+    /// `dF/dlambda`.
+    df: Vec<f64>,
+    /// Right-hand sides of the bordering algorithm.
+    columns: Vec<f64>,
+}
+
+impl<'a, P: ContinuationProblem + ?Sized> Bordered<'a, P> {
+    pub(super) fn new(
+        problem: &'a mut P,
+        (tangent, predicted): (&'a [f64], &'a [f64]),
+        metric: &'a Metric,
+        scratch: &'a mut BorderScratch,
+    ) -> Self {
+        let scale = residual_scale(problem);
+        Self {
+            problem,
+            tangent,
+            predicted,
+            metric,
+            scratch,
+            scale,
+        }
+    }
+
+    /// Moves the problem to the parameter of `y` and returns the unknowns of `y`.
+    fn at<'y>(&mut self, y: &'y [f64]) -> &'y [f64] {
+        let n = self.problem.dimension();
+        self.problem.set_parameter(y[n]);
+        self.scale = residual_scale(self.problem);
+        &y[..n]
+    }
+
+    /// The border row `(c, d)`: `c_i = s t_i w_i`, `d = s t_lambda w_lambda`.
+    fn border(&self, i: usize) -> f64 {
+        self.scale * self.tangent[i] * self.metric.weight(i)
+    }
+}
+
+impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
+    fn dimension(&self) -> usize {
+        self.problem.dimension() + 1
+    }
+    fn residual(&mut self, y: &[f64], f: &mut [f64]) {
+        let n = self.problem.dimension();
+        let x = self.at(y);
+        self.problem.residual(x, &mut f[..n]);
+        f[n] = self.scale * self.metric.dot_diff(self.tangent, y, self.predicted);
+    }
+    /// `[dF/dx, dF/dlambda; s t^T W]`.
+    fn jacobian(&mut self, y: &[f64], jac: &mut DenseMatrix) {
+        let n = self.problem.dimension();
+        let x = self.at(y);
+        let BorderScratch { inner, df, .. } = &mut *self.scratch;
+        df.resize(n, 0.0);
+        self.problem.jacobian(x, inner);
+        self.problem.parameter_derivative(x, df);
+        jac.reset(n + 1, n + 1);
+        for j in 0..n {
+            for i in 0..n {
+                jac[(i, j)] = inner[(i, j)];
+            }
+        }
+        for i in 0..n {
+            jac[(i, n)] = df[i];
+        }
+        for i in 0..=n {
+            jac[(n, i)] = self.border(i);
+        }
+    }
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        Some(self)
+    }
+}
+
+impl<P: ContinuationProblem + ?Sized> Structured for Bordered<'_, P> {
+    fn residual_scale(&self) -> f64 {
+        self.scale
+    }
+
+    fn solve_jacobian(
+        &mut self,
+        y: &[f64],
+        rhs: &mut [f64],
+        columns: usize,
+    ) -> Option<Result<(), SingularStep>> {
+        let n = self.problem.dimension();
+        let x = self.at(y);
+        let mut buffer = std::mem::take(&mut self.scratch.columns);
+        buffer.clear();
+        for column in rhs.chunks_exact(n + 1).take(columns) {
+            buffer.extend_from_slice(&column[..n]);
+        }
+        buffer.resize((columns + 1) * n, 0.0);
+        self.problem
+            .parameter_derivative(x, &mut buffer[columns * n..]);
+        let solved = self
+            .problem
+            .structure()
+            .and_then(|s| s.solve_jacobian(x, &mut buffer, columns + 1));
+        let result = match solved {
+            Some(Ok(())) => {
+                let b = &buffer[columns * n..];
+                let cb: f64 = (0..n).map(|i| self.border(i) * b[i]).sum();
+                let pivot = self.border(n) - cb;
+                let size = self.border(n).abs() + cb.abs();
+                if pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * size {
+                    for (column, a) in rhs.chunks_exact_mut(n + 1).zip(buffer.chunks_exact(n)) {
+                        let ca: f64 = (0..n).map(|i| self.border(i) * a[i]).sum();
+                        let dl = (column[n] - ca) / pivot;
+                        for i in 0..n {
+                            column[i] = a[i] - dl * b[i];
+                        }
+                        column[n] = dl;
+                    }
+                    Some(Ok(()))
+                } else {
+                    None
+                }
+            }
+            // A singular J with a regular bordered matrix (a fold): the dense path decides.
+            _ => None,
+        };
+        self.scratch.columns = buffer;
+        result
+    }
+
+    fn set_smoothing(&mut self, smoothing: f64) -> bool {
+        self.problem
+            .structure()
+            .is_some_and(|s| s.set_smoothing(smoothing))
+    }
+}
+
+/// Diagonal metric `W` of the scaled norm on `y = (x, lambda)`: `x[i]` weighs `x_w[i]`,
+/// `lambda` weighs `lambda_w`.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Metric {
+    pub(super) x_w: Vec<f64>,
+    pub(super) lambda_w: f64,
+}
+
+impl Metric {
+    pub(super) fn weight(&self, i: usize) -> f64 {
+        self.x_w.get(i).copied().unwrap_or(self.lambda_w)
+    }
+
+    /// `<a, b - c>_W`.
+    pub(super) fn dot_diff(&self, a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+        (0..a.len())
+            .map(|i| a[i] * (b[i] - c[i]) * self.weight(i))
+            .sum()
+    }
+
+    /// `|v|_W` for `v = (x, lambda)` or `v = x` alone.
+    pub(super) fn norm(&self, v: &[f64]) -> f64 {
+        (0..v.len())
+            .map(|i| v[i] * v[i] * self.weight(i))
+            .sum::<f64>()
+            .sqrt()
+    }
+}
