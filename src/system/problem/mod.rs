@@ -99,12 +99,15 @@ impl HarmonicBalanceSettings {
 /// (solvers report it as [`SolveError::NonFinite`](crate::SolveError::NonFinite)).
 ///
 /// # Samples reused
-/// A Jacobian-type evaluation at `x` (Jacobian, structured solve, `dF/dOmega`, active set)
-/// right after a residual evaluation at the same `x` and frequency uses the time samples of
-/// that evaluation. After [`Structured::residual_along`] these are the line search's samples
-/// of the trial point, formed along the ray, which equal a fresh synthesis to rounding only:
-/// the Newton step at an accepted trial is that of the residual the line search accepted.
-/// [`Problem::residual`] always synthesises afresh.
+/// [`Problem::residual`] at `x` depends on `x` and the frequency alone. A Jacobian-type
+/// evaluation at `x` (Jacobian, structured solve, `dF/dOmega`, active set) right after a
+/// residual evaluation at the same `x` and frequency uses the time samples of that
+/// evaluation. After [`Structured::residual_along`] these are the line search's samples of
+/// the trial point, formed along the ray, which equal a synthesis of the trial to rounding
+/// only: the Newton step at an accepted trial is that of the residual the line search
+/// accepted. For the complementarity laws this matters only where a sample lies within
+/// rounding of the law's kink (their gradient is piecewise constant); with a smoothing or a
+/// custom law the Jacobian differs from a synthesis' in the last bits.
 #[derive(Debug, Clone)]
 pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     description: Discretization<B>,
@@ -260,11 +263,11 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
         self.dimension()
     }
 
-    /// Samples `x` afresh: the value depends on `x` and `Omega` alone.
+    /// From a synthesis of `x`: the value depends on `x` and `Omega` alone.
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
         let (d, rows) = (&self.description, &self.ws.frequency.rows);
         d.linear_block(rows, x, false, f);
-        self.ws.samples.synthesize(d, rows, x);
+        self.ws.samples.synthesis(d, rows, x);
         self.ws.samples.project(d, f);
     }
 
@@ -389,5 +392,78 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     fn active_set(&mut self, x: &[f64]) -> Option<Vec<usize>> {
         self.sample_laws(x);
         Some(self.ws.samples.active_set(&self.description))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::modal::branch_seed;
+    use crate::reference::clamped_bar_with_obstacle;
+
+    /// A clamped bar with an obstacle at `T = 3.9`, and a point and a direction there that use
+    /// both branches of the law.
+    fn problem_and_ray() -> (NonsmoothSystem, Vec<f64>, Vec<f64>) {
+        let system = clamped_bar_with_obstacle(1e-3).unwrap();
+        let settings = HarmonicBalanceSettings {
+            harmonics: 12,
+            ..Default::default()
+        };
+        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+        let omega = 2.0 * std::f64::consts::PI / 3.9;
+        let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+        problem.set_parameter(omega);
+        let wiggle = |i: usize, k: usize| ((i * k) % 11) as f64 - 5.0;
+        let x = (seed.iter().enumerate())
+            .map(|(i, s)| 1.7 * s + 2e-5 * wiggle(i, 7))
+            .collect();
+        let dx = (0..seed.len()).map(|i| 1e-6 * wiggle(i, 3)).collect();
+        (problem, x, dx)
+    }
+
+    fn jacobian(problem: &mut NonsmoothSystem, x: &[f64]) -> Vec<f64> {
+        let mut jac = DenseMatrix::zeros(0, 0);
+        problem.jacobian(x, &mut jac);
+        let n = x.len();
+        (0..n * n).map(|k| jac[(k % n, k / n)]).collect()
+    }
+
+    #[test]
+    fn a_synthesis_is_a_pure_function_of_the_point() {
+        let (mut problem, x, _) = problem_and_ray();
+        let mut fresh = problem.clone();
+        let mut f = vec![0.0; x.len()];
+        problem.residual(&x, &mut f);
+        // Reused samples of a residual evaluation equal those of a first synthesis.
+        assert_eq!(jacobian(&mut problem, &x), jacobian(&mut fresh, &x));
+    }
+
+    #[test]
+    fn after_a_line_search_the_jacobian_is_that_of_the_trial_samples() {
+        let (mut problem, x, dx) = problem_and_ray();
+        let n = x.len();
+        // Smoothed, so that the law's gradient moves with the samples (the complementarity
+        // law's is piecewise constant: there, samples that agree to rounding give the same
+        // Jacobian unless one of them sits on the kink).
+        problem.set_smoothing(1e-5);
+        let mut fresh = problem.clone();
+        let (mut trial, mut f_along, mut f) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        problem.residual(&x, &mut f);
+        assert!(problem.residual_along(&x, &dx, 0.5, &mut trial, &mut f_along));
+        fresh.residual(&trial, &mut f);
+        let scale = problem.residual_scale();
+        for (a, b) in f_along.iter().zip(&f) {
+            assert!((a - b).abs() <= 1e-12 * scale, "{a:e} vs {b:e}");
+        }
+        // The Jacobian at the trial is evaluated at the line search's samples, which agree with
+        // a synthesis to rounding; once the trial's residual is evaluated afresh it is the
+        // synthesis' bit for bit.
+        let (along, synthesised) = (jacobian(&mut problem, &trial), jacobian(&mut fresh, &trial));
+        let size = synthesised.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (a, b) in along.iter().zip(&synthesised) {
+            assert!((a - b).abs() <= 1e-12 * size, "{a:e} vs {b:e}");
+        }
+        problem.residual(&trial, &mut f_along);
+        assert_eq!(jacobian(&mut problem, &trial), synthesised);
     }
 }
