@@ -17,4 +17,4 @@ pub mod rows;
 pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};
 pub use layout::Layout;
-pub use problem::{HarmonicBalanceSettings, NonsmoothSystem};
+pub use problem::{Discretization, HarmonicBalanceSettings, NonsmoothSystem};

@@ -13,18 +13,31 @@
 //! `G(w)` is the basis' weighted Gram matrix of the law's generalised gradient `w` sampled in time
 //! (Toeplitz + Hankel for cosines: formulation §6). `dF/dOmega` at fixed `x` comes only through
 //! the wave numbers `k = n Omega / c` in the rows.
+//!
+//! [`NonsmoothSystem`] is a [`Discretization`] (what the problem is: system, basis, law
+//! settings, layout; never changed by an evaluation) and a workspace (what its evaluations
+//! change: the rows at the current frequency and their condensation, time samples, the
+//! structured step's factorisation), in files of their own:
+//!
+//! - `discretization.rs`: [`Discretization`] and its evaluations into given buffers;
+//! - `state.rs`: the rows at one frequency and the law samples, with the record of how the
+//!   samples were made (its docs state when a Jacobian-type evaluation reuses them);
+//! - `step.rs`: the structured (condensed) Newton step.
 
+mod discretization;
+mod state;
 mod step;
 
-use crate::bc::LawSamples;
+pub use discretization::Discretization;
+
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::DenseMatrix;
 use crate::solve::{point_on_ray, Problem, SingularStep, Structured};
-use crate::system::condense::{CondenseScratch, Condensed};
-use crate::system::rows::{dot, HarmonicRows, RowsScratch};
+use crate::system::rows::HarmonicRows;
 use crate::system::{BarSystem, Layout};
+use state::{Frequency, Samples};
 use step::Reduced;
 
 /// Harmonic-balance settings.
@@ -67,94 +80,6 @@ impl HarmonicBalanceSettings {
     }
 }
 
-/// Relative singular-value threshold under which a harmonic's linear rows count as
-/// rank-deficient (see [`HarmonicRows::regularise`]).
-const RANK_TOLERANCE: f64 = 1e-9;
-
-/// Time samples of the laws' observables and generalised gradients.
-#[derive(Debug, Clone, Default)]
-struct Workspace {
-    coefficients: Vec<f64>,
-    gap: Vec<f64>,
-    force: Vec<f64>,
-    values: Vec<f64>,
-    w_gap: Vec<f64>,
-    w_force: Vec<f64>,
-    scratch: Vec<f64>,
-    /// Samples of `d gap / d Omega` (scratch of `dF/dOmega`).
-    d_samples: Vec<f64>,
-    projection: Vec<f64>,
-    /// `G(w_gap)` of every law, `len x len` row-major each, one after the other.
-    gram_gap: Vec<f64>,
-    /// `G(w_force)` of every law, laid out as `gram_gap`.
-    gram_force: Vec<f64>,
-    /// The unknowns the law samples (`values`, `w_gap`, `w_force`) were computed for, at the
-    /// current `Omega`, smoothing and blend; `None` when they are stale. Newton evaluates the
-    /// residual at the accepted point and then its Jacobian there: the second sampling is
-    /// skipped. `gap` and `force` hold that point's samples too.
-    sampled: Option<Vec<f64>>,
-    along: LineSamples,
-}
-
-/// Samples of a line search `x + t dx` at the current `Omega`: gap, force and linear rows of
-/// `x` and of `dx` (see `residual_along`).
-#[derive(Debug, Clone, Default)]
-struct LineSamples {
-    start: Option<Vec<f64>>,
-    direction: Option<Vec<f64>>,
-    gap: Vec<f64>,
-    force: Vec<f64>,
-    d_gap: Vec<f64>,
-    d_force: Vec<f64>,
-    linear: Vec<f64>,
-    d_linear: Vec<f64>,
-}
-
-impl Workspace {
-    /// Forgets every cached sample (after a change of `Omega`, smoothing or blend).
-    fn invalidate(&mut self) {
-        self.sampled = None;
-        self.along.start = None;
-    }
-
-    /// The Gram matrices `(G(w_gap), G(w_force))` of law `l` (`len x len` each).
-    fn grams(&self, l: usize, len: usize) -> (&[f64], &[f64]) {
-        let range = l * len * len..(l + 1) * len * len;
-        (&self.gram_gap[range.clone()], &self.gram_force[range])
-    }
-}
-
-/// `(alpha, beta)` with `w_force[k] = alpha + beta w_gap[k]` at every sample (to a few
-/// roundings), if there are such: the Gram matrix is linear in the weight, so then
-/// `G(w_force) = alpha G(1) + beta G(w_gap)` and one transform is saved. Complementarity laws
-/// (Signorini, contact) always have it: for `r = -min(lambda, a_c g)`, `w_gap` is 0 or `-a_c`
-/// and `w_force = -1 - w_gap / a_c`.
-fn affine_relation(w_gap: &[f64], w_force: &[f64]) -> Option<(f64, f64)> {
-    let (&g0, &f0) = (w_gap.first()?, w_force.first()?);
-    let (alpha, beta) = match w_gap.iter().position(|&g| g != g0) {
-        Some(k) => {
-            let beta = (w_force[k] - f0) / (w_gap[k] - g0);
-            (f0 - beta * g0, beta)
-        }
-        None => (f0, 0.0),
-    };
-    // Branch-free, so that the scan vectorises (it runs once per Newton step).
-    let fits = w_gap.iter().zip(w_force).fold(true, |fits, (&g, &f)| {
-        let model = alpha + beta * g;
-        fits & ((f - model).abs()
-            <= 4.0 * f64::EPSILON * (f.abs() + alpha.abs() + (beta * g).abs()))
-    });
-    (fits && alpha.is_finite() && beta.is_finite()).then_some((alpha, beta))
-}
-
-/// Sets a cache key to a copy of `v`, reusing its storage.
-fn set_key(key: &mut Option<Vec<f64>>, v: &[f64]) {
-    let mut k = key.take().unwrap_or_default();
-    k.clear();
-    k.extend_from_slice(v);
-    *key = Some(k);
-}
-
 /// A bar system under harmonic balance at a variable fundamental frequency `Omega`.
 ///
 /// It is a [`Problem`] at its current frequency (residual and generalised Jacobian, analytic),
@@ -171,32 +96,30 @@ fn set_key(key: &mut Option<Vec<f64>>, v: &[f64]) {
 /// [`ContinuationError::Dimension`](crate::ContinuationError::Dimension) instead). Before the
 /// first [`ContinuationProblem::set_parameter`] the frequency is NaN and so is the residual
 /// (solvers report it as [`SolveError::NonFinite`](crate::SolveError::NonFinite)).
+/// (solvers report it as [`SolveError::NonFinite`](crate::SolveError::NonFinite)).
+///
+/// # Samples reused
+/// [`Problem::residual`] at `x` depends on `x` and the frequency alone. A Jacobian-type
+/// evaluation at `x` (Jacobian, structured solve, `dF/dOmega`, active set) right after a
+/// residual evaluation at the same `x` and frequency uses the time samples of that
+/// evaluation. After [`Structured::residual_along`] these are the line search's samples of
+/// the trial point, formed along the ray, which equal a synthesis of the trial to rounding
+/// only: the Newton step at an accepted trial is that of the residual the line search
+/// accepted. For the complementarity laws this matters only where a sample lies within
+/// rounding of the law's kink (their gradient is piecewise constant); with a smoothing or a
+/// custom law the Jacobian differs from a synthesis' in the last bits.
 #[derive(Debug, Clone)]
 pub struct NonsmoothSystem<B: Basis = CosineBasis> {
-    system: BarSystem,
-    basis: B,
-    complementarity: f64,
-    /// Smoothing of the unilateral laws (0: the nonsmooth problem).
-    smoothing: f64,
-    /// See [`HarmonicBalanceSettings::kink_blend`].
-    kink_blend: f64,
-    unknowns: usize,
-    linear_count: usize,
-    laws: usize,
-    offsets: Vec<(f64, f64)>,
-    omega: f64,
-    rows: Vec<HarmonicRows>,
-    rows_scratch: RowsScratch,
-    /// Null bases and pseudo-inverses of `rows` (storage kept across frequencies).
-    condensed: Vec<Condensed>,
-    /// Whether `condensed` is up to date (`None`: stale) and every harmonic's rows had full
-    /// rank.
-    condensed_state: Option<bool>,
-    condense_scratch: CondenseScratch,
-    reduced: Reduced,
-    /// `G(1)`, the Gram matrix of the unit weight (see [`affine_relation`]).
-    unit_gram: Vec<f64>,
+    description: Discretization<B>,
     ws: Workspace,
+}
+
+/// What the evaluations of a [`NonsmoothSystem`] change.
+#[derive(Debug, Clone)]
+struct Workspace {
+    frequency: Frequency,
+    samples: Samples,
+    reduced: Reduced,
 }
 
 impl NonsmoothSystem<CosineBasis> {
@@ -221,68 +144,13 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// [`SettingsError::NoContact`] for a
     /// linear system.
     pub fn with_basis(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
-        if !(a_c.is_finite() && a_c > 0.0) {
-            return Err(SettingsError::NotPositive {
-                what: "complementarity parameter a_c",
-                value: a_c,
-            }
-            .into());
-        }
-        let laws = system.contact_count();
-        if laws == 0 {
-            return Err(SettingsError::NoContact.into());
-        }
-        let unknowns = system.unknowns_per_harmonic();
-        let offsets = system
-            .laws()
-            .map(|l| (l.gap().offset, l.force().offset))
-            .collect();
-        // Laws are evaluated on the basis' folded samples only (the others repeat them).
-        let n = basis.folded_samples();
-        let len = basis.len();
-        let mut unit_gram = vec![0.0; len * len];
-        basis.weighted_gram_folded(&vec![1.0; n], &mut unit_gram);
+        let description = Discretization::new(system, basis, a_c)?;
         let ws = Workspace {
-            coefficients: vec![0.0; len],
-            gap: vec![0.0; laws * n],
-            force: vec![0.0; laws * n],
-            values: vec![0.0; laws * n],
-            w_gap: vec![0.0; laws * n],
-            w_force: vec![0.0; laws * n],
-            scratch: vec![0.0; n],
-            d_samples: vec![0.0; n],
-            projection: vec![0.0; len],
-            gram_gap: vec![0.0; laws * len * len],
-            gram_force: vec![0.0; laws * len * len],
-            sampled: None,
-            along: LineSamples {
-                gap: vec![0.0; laws * n],
-                force: vec![0.0; laws * n],
-                d_gap: vec![0.0; laws * n],
-                d_force: vec![0.0; laws * n],
-                ..Default::default()
-            },
-        };
-        Ok(Self {
-            system: system.clone(),
-            basis,
-            complementarity: a_c,
-            smoothing: 0.0,
-            kink_blend: 0.0,
-            unknowns,
-            linear_count: unknowns - laws,
-            laws,
-            offsets,
-            omega: f64::NAN,
-            rows: Vec::new(),
-            rows_scratch: RowsScratch::default(),
-            condensed: Vec::new(),
-            condensed_state: None,
-            condense_scratch: CondenseScratch::default(),
+            frequency: Frequency::new(),
+            samples: Samples::new(&description),
             reduced: Reduced::default(),
-            unit_gram,
-            ws,
-        })
+        };
+        Ok(Self { description, ws })
     }
 
     /// Sets [`HarmonicBalanceSettings::kink_blend`] (0 for the exact generalised Jacobian).
@@ -290,35 +158,35 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// # Errors
     /// [`SettingsError::NotPositive`] if `blend` is negative or not finite.
     pub fn set_kink_blend(&mut self, blend: f64) -> Result<(), SettingsError> {
-        if !(blend.is_finite() && blend >= 0.0) {
-            return Err(SettingsError::NotPositive {
-                what: "kink blend (non-negative)",
-                value: blend,
-            });
-        }
-        self.kink_blend = blend;
-        self.ws.invalidate();
+        self.description.set_kink_blend(blend)?;
+        self.ws.samples.invalidate();
         Ok(())
+    }
+
+    /// What the problem is, apart from its frequency and the state of its evaluations: the
+    /// system, basis, law settings and layout, for read-only users.
+    pub fn description(&self) -> &Discretization<B> {
+        &self.description
     }
 
     /// The bar system.
     pub fn system(&self) -> &BarSystem {
-        &self.system
+        self.description.system()
     }
 
     /// The harmonic basis.
     pub fn basis(&self) -> &B {
-        &self.basis
+        self.description.basis()
     }
 
     /// The complementarity parameter `a_c`.
     pub fn complementarity(&self) -> f64 {
-        self.complementarity
+        self.description.complementarity()
     }
 
     /// Number of unknowns (and equations).
     pub fn dimension(&self) -> usize {
-        self.basis.len() * self.unknowns
+        self.description.dimension()
     }
 
     /// Index in `x` of coefficient `i`, bar `bar`, Helmholtz component `which` (0: `A`, 1: `B`),
@@ -329,174 +197,28 @@ impl<B: Basis> NonsmoothSystem<B> {
 
     /// Where each unknown lives.
     pub fn layout(&self) -> Layout {
-        Layout::of(&self.system)
+        self.description.layout()
     }
 
     /// The per-harmonic rows at fundamental frequency `omega` (the problem moves to `omega`).
     pub fn rows_at(&mut self, omega: f64) -> &[HarmonicRows] {
         self.prepare(omega);
-        &self.rows
+        &self.ws.frequency.rows
     }
 
-    /// Rebuilds the per-harmonic rows when `omega` changed.
+    /// Moves to `omega`: the rows are rebuilt and every sample forgotten when it changed.
     fn prepare(&mut self, omega: f64) {
-        if omega == self.omega && !self.rows.is_empty() {
-            return;
-        }
-        self.omega = omega;
-        self.condensed_state = None;
-        self.ws.invalidate();
-        // Rebuild every harmonic's rows in their own storage.
-        let (system, scratch) = (&self.system, &mut self.rows_scratch);
-        let harmonics = self.basis.harmonics() + 1;
-        self.rows.truncate(harmonics);
-        for (h, rows) in self.rows.iter_mut().enumerate() {
-            rows.rebuild(system, h as f64 * omega, scratch);
-            rows.regularise(RANK_TOLERANCE);
-        }
-        for h in self.rows.len()..harmonics {
-            let mut rows = HarmonicRows::new(system, h as f64 * omega);
-            rows.regularise(RANK_TOLERANCE);
-            self.rows.push(rows);
+        if self.ws.frequency.prepare(&self.description, omega) {
+            self.ws.samples.invalidate();
         }
     }
 
-    /// Coefficients of the gap (`gap == true`) or force of law `l`, one per basis function.
-    fn observable_coefficients(
-        &self,
-        x: &[f64],
-        l: usize,
-        gap: bool,
-        derivative: bool,
-        out: &mut [f64],
-    ) {
-        let n = self.unknowns;
-        for (i, o) in out.iter_mut().enumerate() {
-            let h = self.basis.harmonic(i);
-            let rows = &self.rows[h];
-            let row = match (gap, derivative) {
-                (true, false) => rows.gap_row(l),
-                (true, true) => rows.gap_row_derivative(l),
-                (false, false) => rows.force_row(l),
-                (false, true) => rows.force_row_derivative(l),
-            };
-            let scale = if derivative { h as f64 } else { 1.0 };
-            *o = scale * dot(row, &x[i * n..(i + 1) * n]);
-        }
-    }
-
-    /// Samples gap, force, pointwise residual and its generalised gradient of every law
-    /// (law `l` occupies `l * N..(l + 1) * N` of each buffer).
+    /// Makes the workspace's law samples those of `x` (see [`Samples::at`]).
     fn sample_laws(&mut self, x: &[f64]) {
-        if self.ws.sampled.as_deref() == Some(x) {
-            return;
-        }
-        let mut ws = std::mem::take(&mut self.ws);
-        self.synthesize_observables(x, true, &mut ws.coefficients, &mut ws.gap, &mut ws.force);
-        self.evaluate_laws(&mut ws, x);
-        self.ws = ws;
-    }
-
-    /// Time samples of every law's gap and force for the unknowns `x` (with the offsets of
-    /// the observables if `offsets`, else their linear part only, as for a direction).
-    fn synthesize_observables(
-        &self,
-        x: &[f64],
-        offsets: bool,
-        coefficients: &mut [f64],
-        gap: &mut [f64],
-        force: &mut [f64],
-    ) {
-        let n = self.basis.folded_samples();
-        for l in 0..self.laws {
-            let range = l * n..(l + 1) * n;
-            for (is_gap, out) in [(true, &mut gap[range.clone()]), (false, &mut force[range])] {
-                self.observable_coefficients(x, l, is_gap, false, coefficients);
-                self.basis.synthesize_folded(coefficients, out);
-                if offsets {
-                    let (g0, f0) = self.offsets[l];
-                    let offset = if is_gap { g0 } else { f0 };
-                    out.iter_mut().for_each(|v| *v += offset);
-                }
-            }
-        }
-    }
-
-    /// Evaluates every law on the gap and force samples of `ws` (those of the unknowns `x`),
-    /// and marks the samples as those of `x`.
-    fn evaluate_laws(&self, ws: &mut Workspace, x: &[f64]) {
-        let n = self.basis.folded_samples();
-        let blend = self.kink_blend * self.residual_scale();
-        for (l, law) in self.system.laws().enumerate() {
-            let range = l * n..(l + 1) * n;
-            let (gaps, forces) = (&ws.gap[range.clone()], &ws.force[range.clone()]);
-            let (w_gap, w_force) = (&mut ws.w_gap[range.clone()], &mut ws.w_force[range.clone()]);
-            law.sample(
-                gaps,
-                forces,
-                self.complementarity,
-                self.smoothing,
-                LawSamples {
-                    values: &mut ws.values[range],
-                    d_gap: w_gap,
-                    d_force: w_force,
-                },
-            );
-            if blend > 0.0 && self.smoothing == 0.0 {
-                // Residual exact, Jacobian weights from the blended law.
-                law.sample(
-                    gaps,
-                    forces,
-                    self.complementarity,
-                    blend,
-                    LawSamples {
-                        values: &mut ws.scratch,
-                        d_gap: w_gap,
-                        d_force: w_force,
-                    },
-                );
-            }
-        }
-        let mut sampled = ws.sampled.take().unwrap_or_default();
-        sampled.clear();
-        sampled.extend_from_slice(x);
-        ws.sampled = Some(sampled);
-    }
-
-    /// The law block of `F` from the sampled law values, into `f`.
-    fn project_laws(&self, f: &mut [f64]) {
-        let (len, n) = (self.basis.len(), self.basis.folded_samples());
-        let base = len * self.linear_count;
-        for l in 0..self.laws {
-            self.basis.project_folded(
-                &self.ws.values[l * n..(l + 1) * n],
-                &mut f[base + l * len..base + (l + 1) * len],
-            );
-        }
-    }
-
-    /// The Gram matrices `G(w_gap)` and `G(w_force)` of law `l` (after [`Self::sample_laws`]),
-    /// into the workspace ([`Workspace::grams`]): the two halves of the law's Jacobian block.
-    ///
-    /// When the force weight is an affine function of the gap weight (complementarity laws),
-    /// `G(w_force)` is formed from `G(w_gap)` and `G(1)` instead of by a transform.
-    fn law_grams(&self, ws: &mut Workspace, l: usize) {
-        let (n, len) = (self.basis.folded_samples(), self.basis.len());
-        let range = l * n..(l + 1) * n;
-        let (w_gap, w_force) = (&ws.w_gap[range.clone()], &ws.w_force[range]);
-        let grams = l * len * len..(l + 1) * len * len;
-        let gram_gap = &mut ws.gram_gap[grams.clone()];
-        let gram_force = &mut ws.gram_force[grams];
-        self.basis.weighted_gram_folded(w_gap, gram_gap);
-        match affine_relation(w_gap, w_force) {
-            Some((alpha, beta)) => {
-                let terms = self.unit_gram.iter().zip(gram_gap.iter());
-                for (g, (u, w)) in gram_force.iter_mut().zip(terms) {
-                    *g = alpha * u + beta * w;
-                }
-            }
-            None => self.basis.weighted_gram_folded(w_force, gram_force),
-        }
+        let Workspace {
+            frequency, samples, ..
+        } = &mut self.ws;
+        samples.at(&self.description, &frequency.rows, x);
     }
 
     /// Gap samples of law `l` over one period at `omega` (the `N` instants of the grid); the
@@ -506,7 +228,8 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// If `l` is not below the number of unilateral conditions or `x` has the wrong length
     /// ([`crate::modal::law_history`] returns an error instead).
     pub fn gap_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
-        self.history(x, omega, l, true)
+        self.prepare(omega);
+        (self.description).history(&self.ws.frequency.rows, x, l, true)
     }
 
     /// Contact-force samples of law `l` over one period at `omega`.
@@ -515,7 +238,8 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// If `l` is not below the number of unilateral conditions or `x` has the wrong length
     /// ([`crate::modal::law_history`] returns an error instead).
     pub fn force_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
-        self.history(x, omega, l, false)
+        self.prepare(omega);
+        (self.description).history(&self.ws.frequency.rows, x, l, false)
     }
 
     /// Pointwise law residual `r(theta_k)` of law `l` over one period at `omega`.
@@ -526,42 +250,11 @@ impl<B: Basis> NonsmoothSystem<B> {
     pub fn law_residual_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
         let g = self.gap_history(x, omega, l);
         let f = self.force_history(x, omega, l);
-        let law = self.system.laws().nth(l).expect("law index in range");
+        let law = self.system().laws().nth(l).expect("law index in range");
         g.iter()
             .zip(&f)
-            .map(|(&g, &f)| law.residual(g, f, self.complementarity).value)
+            .map(|(&g, &f)| law.residual(g, f, self.complementarity()).value)
             .collect()
-    }
-
-    fn history(&mut self, x: &[f64], omega: f64, l: usize, gap: bool) -> Vec<f64> {
-        self.prepare(omega);
-        let mut c = vec![0.0; self.basis.len()];
-        self.observable_coefficients(x, l, gap, false, &mut c);
-        let mut s = vec![0.0; self.basis.samples()];
-        self.basis.synthesize(&c, &mut s);
-        let offset = if gap {
-            self.offsets[l].0
-        } else {
-            self.offsets[l].1
-        };
-        s.iter_mut().for_each(|v| *v += offset);
-        s
-    }
-
-    fn linear_block(&self, x: &[f64], derivative: bool, f: &mut [f64]) {
-        let (n, rpc) = (self.unknowns, self.linear_count);
-        for i in 0..self.basis.len() {
-            let h = self.basis.harmonic(i);
-            let rows = &self.rows[h];
-            let xi = &x[i * n..(i + 1) * n];
-            for r in 0..rpc {
-                f[i * rpc + r] = if derivative {
-                    h as f64 * dot(rows.linear_row_derivative(r), xi)
-                } else {
-                    dot(rows.linear_row(r), xi)
-                };
-            }
-        }
     }
 }
 
@@ -570,34 +263,37 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
         self.dimension()
     }
 
-    /// Samples `x` afresh: the value depends on `x` and `Omega` alone.
+    /// From a synthesis of `x`: the value depends on `x` and `Omega` alone.
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
-        self.linear_block(x, false, f);
-        self.ws.sampled = None;
-        self.sample_laws(x);
-        self.project_laws(f);
+        let (d, rows) = (&self.description, &self.ws.frequency.rows);
+        d.linear_block(rows, x, false, f);
+        self.ws.samples.synthesis(d, rows, x);
+        self.ws.samples.project(d, f);
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
-        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
-        jac.reset(self.dimension(), self.dimension());
+        self.sample_laws(x);
+        let d = &self.description;
+        let Workspace {
+            frequency, samples, ..
+        } = &mut self.ws;
+        let (len, un, rpc) = (d.basis().len(), d.unknowns, d.linear_count);
+        jac.reset(d.dimension(), d.dimension());
         for i in 0..len {
-            let rows = &self.rows[self.basis.harmonic(i)];
+            let rows = &frequency.rows[d.basis().harmonic(i)];
             for r in 0..rpc {
                 for (c, &v) in rows.linear_row(r).iter().enumerate() {
                     jac[(i * rpc + r, i * un + c)] = v;
                 }
             }
         }
-        self.sample_laws(x);
         let base = len * rpc;
-        let mut ws = std::mem::take(&mut self.ws);
-        for l in 0..self.laws {
-            self.law_grams(&mut ws, l);
-            let (gram_gap, gram_force) = ws.grams(l, len);
+        for l in 0..d.laws {
+            samples.form_grams(d, l);
+            let (gram_gap, gram_force) = samples.grams(l, len);
             // Column by column (the matrix is column-major): contiguous writes.
             for i in 0..len {
-                let rows = &self.rows[self.basis.harmonic(i)];
+                let rows = &frequency.rows[d.basis().harmonic(i)];
                 let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
                 for c in 0..un {
                     let (gc, fc) = (grow[c], frow[c]);
@@ -611,7 +307,6 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
                 }
             }
         }
-        self.ws = ws;
     }
 
     fn structure(&mut self) -> Option<&mut dyn Structured> {
@@ -622,7 +317,7 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
 impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
     /// The fundamental frequency `Omega` (NaN before the first [`Self::set_parameter`]).
     fn parameter(&self) -> f64 {
-        self.omega
+        self.ws.frequency.omega
     }
 
     /// Moves to fundamental frequency `omega`: the per-harmonic rows are rebuilt when it
@@ -632,29 +327,10 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
     }
 
     fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
-        self.linear_block(x, true, df);
         self.sample_laws(x);
-        let (len, n) = (self.basis.len(), self.basis.folded_samples());
-        let base = len * self.linear_count;
-        let mut ws = std::mem::take(&mut self.ws);
-        for l in 0..self.laws {
-            let dg = &mut ws.d_samples;
-            self.observable_coefficients(x, l, true, true, &mut ws.coefficients);
-            self.basis.synthesize_folded(&ws.coefficients, dg);
-            self.observable_coefficients(x, l, false, true, &mut ws.coefficients);
-            self.basis
-                .synthesize_folded(&ws.coefficients, &mut ws.scratch);
-            let (w_gap, w_force) = (
-                &ws.w_gap[l * n..(l + 1) * n],
-                &ws.w_force[l * n..(l + 1) * n],
-            );
-            for (((s, d), wg), wf) in ws.scratch.iter_mut().zip(dg.iter()).zip(w_gap).zip(w_force) {
-                *s = wg * d + wf * *s;
-            }
-            self.basis.project_folded(&ws.scratch, &mut ws.projection);
-            df[base + l * len..base + (l + 1) * len].copy_from_slice(&ws.projection);
-        }
-        self.ws = ws;
+        let (d, rows) = (&self.description, &self.ws.frequency.rows);
+        d.linear_block(rows, x, true, df);
+        self.ws.samples.law_derivative((d, rows), x, df);
     }
 }
 
@@ -662,11 +338,7 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     /// The largest gap of the unilateral laws: residual entries are gaps and forces of that
     /// order.
     fn residual_scale(&self) -> f64 {
-        self.offsets
-            .iter()
-            .map(|o| o.0.abs())
-            .fold(0.0, f64::max)
-            .max(f64::MIN_POSITIVE)
+        self.description.residual_scale()
     }
 
     /// The Newton step with the linear rows condensed (formulation §5): only a dense LU of
@@ -677,12 +349,19 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         rhs: &mut [f64],
         columns: usize,
     ) -> Option<Result<(), SingularStep>> {
-        self.condensed_solve(x, rhs, columns)
+        self.sample_laws(x);
+        let Workspace {
+            frequency,
+            samples,
+            reduced,
+        } = &mut self.ws;
+        reduced.solve((&self.description, frequency), samples, rhs, columns)
     }
 
     /// Along a line search the observables are affine in `t`: the samples of `x` (kept from
     /// its residual) and of `dx` are synthesised once per direction, and each trial costs the
-    /// law evaluation and one projection instead of three transforms.
+    /// law evaluation and one projection instead of three transforms. The samples of the
+    /// trial are kept for a Jacobian-type evaluation there (see [`NonsmoothSystem`]).
     fn residual_along(
         &mut self,
         x: &[f64],
@@ -692,65 +371,14 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         f: &mut [f64],
     ) -> bool {
         point_on_ray(x, dx, t, trial);
-        let mut ws = std::mem::take(&mut self.ws);
-        let same = |v: &Option<Vec<f64>>, w: &[f64]| v.as_deref() == Some(w);
-        if !(same(&ws.along.start, x) && same(&ws.along.direction, dx)) {
-            let along = &mut ws.along;
-            if same(&ws.sampled, x) {
-                // The samples of x move to the line search: the trials overwrite `ws` next.
-                std::mem::swap(&mut along.gap, &mut ws.gap);
-                std::mem::swap(&mut along.force, &mut ws.force);
-                ws.sampled = None;
-            } else {
-                self.synthesize_observables(
-                    x,
-                    true,
-                    &mut ws.coefficients,
-                    &mut along.gap,
-                    &mut along.force,
-                );
-            }
-            self.synthesize_observables(
-                dx,
-                false,
-                &mut ws.coefficients,
-                &mut along.d_gap,
-                &mut along.d_force,
-            );
-            along
-                .linear
-                .resize(self.basis.len() * self.linear_count, 0.0);
-            along
-                .d_linear
-                .resize(self.basis.len() * self.linear_count, 0.0);
-            self.linear_block(x, false, &mut along.linear);
-            self.linear_block(dx, false, &mut along.d_linear);
-            set_key(&mut along.start, x);
-            set_key(&mut along.direction, dx);
-        }
-        let along = &ws.along;
-        for (g, (a, d)) in ws.gap.iter_mut().zip(along.gap.iter().zip(&along.d_gap)) {
-            *g = a + t * d;
-        }
-        for (g, (a, d)) in ws
-            .force
-            .iter_mut()
-            .zip(along.force.iter().zip(&along.d_force))
-        {
-            *g = a + t * d;
-        }
-        for (o, (a, d)) in f.iter_mut().zip(along.linear.iter().zip(&along.d_linear)) {
-            *o = a + t * d;
-        }
-        self.evaluate_laws(&mut ws, trial);
-        self.ws = ws;
-        self.project_laws(f);
+        let (d, rows) = (&self.description, &self.ws.frequency.rows);
+        self.ws.samples.along((d, rows), (x, dx, t), trial, f);
+        self.ws.samples.project(d, f);
         true
     }
 
     fn set_smoothing(&mut self, smoothing: f64) -> bool {
-        self.smoothing = smoothing.max(0.0);
-        self.ws.invalidate();
+        self.ws.samples.set_smoothing(smoothing.max(0.0));
         true
     }
 
@@ -758,81 +386,84 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     /// `EA l (A^2 k^2 + B^2) / 4` of strain energy, so `w_A = EA l (k^2 + 1/l^2)` (the `1/l^2`
     /// keeps rigid displacements weighted) and `w_B = EA l`.
     fn state_weights(&mut self) -> Option<Vec<f64>> {
-        let bars = self.system.bars();
-        let mut w = Vec::with_capacity(self.dimension());
-        for i in 0..self.basis.len() {
-            let n = self.basis.harmonic(i) as f64;
-            for bar in bars {
-                let (l, ea) = (bar.length(), bar.stiffness());
-                let k = bar.wavenumber(n * self.omega);
-                w.push(ea * l * (k * k + 1.0 / (l * l)));
-                w.push(ea * l);
-            }
-        }
-        Some(w)
+        Some(self.description.state_weights(self.ws.frequency.omega))
     }
 
     fn active_set(&mut self, x: &[f64]) -> Option<Vec<usize>> {
         self.sample_laws(x);
-        let n = self.basis.folded_samples();
-        Some(
-            (0..self.laws)
-                .map(|l| {
-                    self.ws.w_gap[l * n..(l + 1) * n]
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, w)| **w != 0.0)
-                        .map(|(k, _)| self.basis.multiplicity(k))
-                        .sum()
-                })
-                .collect(),
-        )
+        Some(self.ws.samples.active_set(&self.description))
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::affine_relation;
-    use crate::fourier::{Basis, CosineBasis};
+    use super::*;
+    use crate::modal::branch_seed;
+    use crate::reference::clamped_bar_with_obstacle;
 
-    #[test]
-    fn complementarity_weights_are_affinely_related() {
-        // Signorini with a_c = 4 (`r = -min(lambda, a_c g)`): gap-branch samples (-4, 0),
-        // force-branch samples (0, -1).
-        let (w_gap, w_force) = ([-4.0, 0.0, 0.0, -4.0], [0.0, -1.0, -1.0, 0.0]);
-        let (alpha, beta) = affine_relation(&w_gap, &w_force).unwrap();
-        assert!((alpha + 1.0).abs() < 1e-15 && (beta + 0.25).abs() < 1e-15);
-        // One branch everywhere: the force weight is a constant.
-        assert_eq!(affine_relation(&[0.0; 3], &[1.0; 3]), Some((1.0, 0.0)));
-        // Not affine: three distinct pairs off one line.
-        assert_eq!(affine_relation(&[0.0, 1.0, 2.0], &[1.0, 0.0, 1.0]), None);
-        assert_eq!(affine_relation(&[0.0, 0.0], &[1.0, 0.5]), None);
+    /// A clamped bar with an obstacle at `T = 3.9`, and a point and a direction there that use
+    /// both branches of the law.
+    fn problem_and_ray() -> (NonsmoothSystem, Vec<f64>, Vec<f64>) {
+        let system = clamped_bar_with_obstacle(1e-3).unwrap();
+        let settings = HarmonicBalanceSettings {
+            harmonics: 12,
+            ..Default::default()
+        };
+        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+        let omega = 2.0 * std::f64::consts::PI / 3.9;
+        let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+        problem.set_parameter(omega);
+        let wiggle = |i: usize, k: usize| ((i * k) % 11) as f64 - 5.0;
+        let x = (seed.iter().enumerate())
+            .map(|(i, s)| 1.7 * s + 2e-5 * wiggle(i, 7))
+            .collect();
+        let dx = (0..seed.len()).map(|i| 1e-6 * wiggle(i, 3)).collect();
+        (problem, x, dx)
+    }
+
+    fn jacobian(problem: &mut NonsmoothSystem, x: &[f64]) -> Vec<f64> {
+        let mut jac = DenseMatrix::zeros(0, 0);
+        problem.jacobian(x, &mut jac);
+        let n = x.len();
+        (0..n * n).map(|k| jac[(k % n, k / n)]).collect()
     }
 
     #[test]
-    fn the_gram_matrix_is_linear_in_the_weight() {
-        // What the shortcut relies on: G(alpha + beta w) = alpha G(1) + beta G(w).
-        let basis = CosineBasis::new(9, 5).unwrap();
-        let (n, len) = (basis.samples(), basis.len());
-        let w: Vec<f64> = (0..n)
-            .map(|k| ((k * 37) % 13) as f64 / 13.0 - 0.3)
-            .collect();
-        let (alpha, beta) = (0.7, -1.9);
-        let combined: Vec<f64> = w.iter().map(|v| alpha + beta * v).collect();
-        let (mut g, mut g1, mut gw) = (
-            vec![0.0; len * len],
-            vec![0.0; len * len],
-            vec![0.0; len * len],
-        );
-        basis.weighted_gram(&combined, &mut g);
-        basis.weighted_gram(&vec![1.0; n], &mut g1);
-        basis.weighted_gram(&w, &mut gw);
-        for ((a, u), b) in g.iter().zip(&g1).zip(&gw) {
-            assert!(
-                (a - (alpha * u + beta * b)).abs() < 1e-13,
-                "{a} vs {}",
-                alpha * u + beta * b
-            );
+    fn a_synthesis_is_a_pure_function_of_the_point() {
+        let (mut problem, x, _) = problem_and_ray();
+        let mut fresh = problem.clone();
+        let mut f = vec![0.0; x.len()];
+        problem.residual(&x, &mut f);
+        // Reused samples of a residual evaluation equal those of a first synthesis.
+        assert_eq!(jacobian(&mut problem, &x), jacobian(&mut fresh, &x));
+    }
+
+    #[test]
+    fn after_a_line_search_the_jacobian_is_that_of_the_trial_samples() {
+        let (mut problem, x, dx) = problem_and_ray();
+        let n = x.len();
+        // Smoothed, so that the law's gradient moves with the samples (the complementarity
+        // law's is piecewise constant: there, samples that agree to rounding give the same
+        // Jacobian unless one of them sits on the kink).
+        problem.set_smoothing(1e-5);
+        let mut fresh = problem.clone();
+        let (mut trial, mut f_along, mut f) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        problem.residual(&x, &mut f);
+        assert!(problem.residual_along(&x, &dx, 0.5, &mut trial, &mut f_along));
+        fresh.residual(&trial, &mut f);
+        let scale = problem.residual_scale();
+        for (a, b) in f_along.iter().zip(&f) {
+            assert!((a - b).abs() <= 1e-12 * scale, "{a:e} vs {b:e}");
         }
+        // The Jacobian at the trial is evaluated at the line search's samples, which agree with
+        // a synthesis to rounding; once the trial's residual is evaluated afresh it is the
+        // synthesis' bit for bit.
+        let (along, synthesised) = (jacobian(&mut problem, &trial), jacobian(&mut fresh, &trial));
+        let size = synthesised.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (a, b) in along.iter().zip(&synthesised) {
+            assert!((a - b).abs() <= 1e-12 * size, "{a:e} vs {b:e}");
+        }
+        problem.residual(&trial, &mut f_along);
+        assert_eq!(jacobian(&mut problem, &trial), synthesised);
     }
 }

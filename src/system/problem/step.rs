@@ -10,11 +10,11 @@
 //! The factorisation is made once per call and serves every right-hand side of the call
 //! (the bordered systems of arclength continuation solve two).
 
-use super::NonsmoothSystem;
+use super::discretization::Discretization;
+use super::state::{Frequency, Samples};
 use crate::fourier::Basis;
 use crate::linalg::{dot_lanes, Lu};
 use crate::solve::SingularStep;
-use crate::system::condense::condense_into;
 use crate::system::rows::dot;
 
 /// Relative pivot threshold of the reduced LU. Stricter than the dense LU's (`1e-13`): the
@@ -38,71 +38,54 @@ pub(super) struct Reduced {
     force_p: Vec<f64>,
 }
 
-impl<B: Basis> NonsmoothSystem<B> {
+impl Reduced {
     /// Solves `J(x) z = r` in place for the `columns` right-hand sides stored one after the
-    /// other in `rhs`. `None` where a harmonic's rows are rank-deficient (the caller falls
-    /// back to the dense Jacobian).
-    pub(super) fn condensed_solve(
+    /// other in `rhs`, at the frequency of `at` and with the law samples of `samples`, which
+    /// the caller has made those of `x`. `None` where a harmonic's rows are rank-deficient
+    /// (the caller falls back to the dense Jacobian).
+    pub(super) fn solve<B: Basis>(
         &mut self,
-        x: &[f64],
+        (d, at): (&Discretization<B>, &mut Frequency),
+        samples: &mut Samples,
         rhs: &mut [f64],
         columns: usize,
     ) -> Option<Result<(), SingularStep>> {
-        if !self.condense() {
+        if !at.condense() {
             return None;
         }
-        self.sample_laws(x);
-        let mut red = std::mem::take(&mut self.reduced);
-        let factored = self.factor_reduced(&mut red);
+        let at = &*at;
+        let factored = self.factor((d, at), samples);
         if factored.is_ok() {
-            let n = self.dimension();
-            for column in rhs.chunks_exact_mut(n).take(columns) {
-                self.solve_reduced(&mut red, column);
+            for column in rhs.chunks_exact_mut(d.dimension()).take(columns) {
+                self.solve_one((d, at), samples, column);
             }
         }
-        self.reduced = red;
         Some(factored)
-    }
-
-    /// Brings the null bases and pseudo-inverses up to date; whether every harmonic's rows
-    /// have full rank.
-    fn condense(&mut self) -> bool {
-        if self.condensed_state.is_none() {
-            self.condensed
-                .resize_with(self.rows.len(), Default::default);
-            let scratch = &mut self.condense_scratch;
-            let all = self
-                .rows
-                .iter()
-                .zip(self.condensed.iter_mut())
-                .fold(true, |ok, (rows, out)| {
-                    condense_into(rows, out, scratch) && ok
-                });
-            self.condensed_state = Some(all);
-        }
-        self.condensed_state == Some(true)
     }
 
     /// Forms every law's Gram matrices and the reduced matrix `N Z` (transposed, in the LU's
     /// storage), and factorises it.
-    fn factor_reduced(&mut self, red: &mut Reduced) -> Result<(), SingularStep> {
-        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
+    fn factor<B: Basis>(
+        &mut self,
+        (d, at): (&Discretization<B>, &Frequency),
+        samples: &mut Samples,
+    ) -> Result<(), SingularStep> {
+        let (len, un, rpc) = (d.basis().len(), d.unknowns, d.linear_count);
         let c = un - rpc;
         let size = len * c;
-        let mut ws = std::mem::take(&mut self.ws);
         // Every entry of the transposed reduced matrix is written below, straight into the
         // LU's storage (one column per law row).
-        let matrix = red.lu.storage(size);
-        red.gap_z.resize(self.laws * len * c, 0.0);
-        red.force_z.resize(self.laws * len * c, 0.0);
-        for l in 0..self.laws {
-            self.law_grams(&mut ws, l);
-            let (gram_gap, gram_force) = ws.grams(l, len);
+        let matrix = self.lu.storage(size);
+        self.gap_z.resize(d.laws * len * c, 0.0);
+        self.force_z.resize(d.laws * len * c, 0.0);
+        for l in 0..d.laws {
+            samples.form_grams(d, l);
+            let (gram_gap, gram_force) = samples.grams(l, len);
             let zs = l * len * c..(l + 1) * len * c;
-            let (gap_z, force_z) = (&mut red.gap_z[zs.clone()], &mut red.force_z[zs]);
+            let (gap_z, force_z) = (&mut self.gap_z[zs.clone()], &mut self.force_z[zs]);
             for i in 0..len {
-                let h = self.basis.harmonic(i);
-                let (null, rows) = (&self.condensed[h].null, &self.rows[h]);
+                let h = d.basis().harmonic(i);
+                let (null, rows) = (&at.condensed[h].null, &at.rows[h]);
                 let (grow, frow) = (rows.gap_row(l), rows.force_row(l));
                 for k in 0..c {
                     let z = &null[k * un..(k + 1) * un];
@@ -133,8 +116,7 @@ impl<B: Basis> NonsmoothSystem<B> {
                 }
             }
         }
-        self.ws = ws;
-        red.lu
+        self.lu
             .factor_stored(REDUCED_PIVOT_TOLERANCE)
             .map_err(|p| SingularStep {
                 pivot: p.pivot,
@@ -144,18 +126,23 @@ impl<B: Basis> NonsmoothSystem<B> {
 
     /// Overwrites one right-hand side `r` (in the layout of the residual) with the solution
     /// `z` (in the layout of the unknowns), with the factorisation of
-    /// [`Self::factor_reduced`].
-    fn solve_reduced(&self, red: &mut Reduced, r: &mut [f64]) {
-        let (len, un, rpc) = (self.basis.len(), self.unknowns, self.linear_count);
+    /// [`Self::factor`].
+    fn solve_one<B: Basis>(
+        &mut self,
+        (d, at): (&Discretization<B>, &Frequency),
+        samples: &Samples,
+        r: &mut [f64],
+    ) {
+        let (len, un, rpc) = (d.basis().len(), d.unknowns, d.linear_count);
         let c = un - rpc;
         let base = len * rpc;
-        red.column.clear();
-        red.column.extend_from_slice(r);
+        self.column.clear();
+        self.column.extend_from_slice(r);
         let z = r;
         // Particular part from the linear rows.
         for i in 0..len {
-            let cd = &self.condensed[self.basis.harmonic(i)];
-            let ri = &red.column[i * rpc..(i + 1) * rpc];
+            let cd = &at.condensed[d.basis().harmonic(i)];
+            let ri = &self.column[i * rpc..(i + 1) * rpc];
             let zi = &mut z[i * un..(i + 1) * un];
             zi.fill(0.0);
             for (row, rr) in ri.iter().enumerate() {
@@ -164,35 +151,35 @@ impl<B: Basis> NonsmoothSystem<B> {
                 }
             }
         }
-        red.rhs.clear();
-        red.rhs.resize(len * c, 0.0);
-        red.gap_p.resize(len, 0.0);
-        red.force_p.resize(len, 0.0);
-        for l in 0..self.laws {
+        self.rhs.clear();
+        self.rhs.resize(len * c, 0.0);
+        self.gap_p.resize(len, 0.0);
+        self.force_p.resize(len, 0.0);
+        for l in 0..d.laws {
             for i in 0..len {
-                let rows = &self.rows[self.basis.harmonic(i)];
+                let rows = &at.rows[d.basis().harmonic(i)];
                 let zi = &z[i * un..(i + 1) * un];
-                red.gap_p[i] = dot(rows.gap_row(l), zi);
-                red.force_p[i] = dot(rows.force_row(l), zi);
+                self.gap_p[i] = dot(rows.gap_row(l), zi);
+                self.force_p[i] = dot(rows.force_row(l), zi);
             }
-            let (gram_gap, gram_force) = self.ws.grams(l, len);
+            let (gram_gap, gram_force) = samples.grams(l, len);
             for j in 0..len {
                 let row = l * len + j;
                 let (gg, gf) = (
                     &gram_gap[j * len..(j + 1) * len],
                     &gram_force[j * len..(j + 1) * len],
                 );
-                red.rhs[row] = red.column[base + row]
-                    - dot_lanes(gg, &red.gap_p)
-                    - dot_lanes(gf, &red.force_p);
+                self.rhs[row] = self.column[base + row]
+                    - dot_lanes(gg, &self.gap_p)
+                    - dot_lanes(gf, &self.force_p);
             }
         }
-        red.lu.solve_transpose_in_place(&mut red.rhs);
+        self.lu.solve_transpose_in_place(&mut self.rhs);
         for i in 0..len {
-            let cd = &self.condensed[self.basis.harmonic(i)];
+            let cd = &at.condensed[d.basis().harmonic(i)];
             let zi = &mut z[i * un..(i + 1) * un];
             for k in 0..c {
-                let b = red.rhs[i * c + k];
+                let b = self.rhs[i * c + k];
                 for (d, n) in zi.iter_mut().zip(&cd.null[k * un..(k + 1) * un]) {
                     *d += b * n;
                 }
