@@ -40,9 +40,8 @@
 //! from the `--retry-depth` earlier converged points and keeps the lowest-energy solution,
 //! which near an internal resonance stays on the backbone rather than on a resonance spike of
 //! the truncated system. It costs about `--retry-depth` extra solves per step and runs serially
-//! (every start is solved anyway); on the clamped bar at `m = 80` with `--retry-depth 2` it
-//! converges 176 steps instead of 169. `--selection first` (the default) keeps the first
-//! accepted solution.
+//! (every start is solved anyway); `docs/performance.md` measures what it gains on the
+//! clamped bar. `--selection first` (the default) keeps the first accepted solution.
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{

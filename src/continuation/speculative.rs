@@ -21,10 +21,10 @@ use std::sync::{mpsc, Arc};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Speculation {
     /// Residual evaluations (line-search trials included) the first attempt spends before the
-    /// retry is launched beside it (default 10). On the clamped bar's backbones a solve that
-    /// converges from the prediction typically needs 3 to 6 evaluations and a failing one 34
-    /// or more (`docs/performance.md`): a small value launches the retry early in hopeless
-    /// steps while leaving quick steps alone; 0 launches it at every step.
+    /// retry is launched beside it (default 10). A solve that converges from the prediction
+    /// needs few evaluations and a failing one many more (`docs/performance.md` has the
+    /// counts): a small value launches the retry early in hopeless steps while leaving quick
+    /// steps alone; 0 launches it with the first attempt at every step.
     pub after_evaluations: usize,
 }
 

@@ -65,21 +65,11 @@ pub struct BackboneOptions {
     /// truncated system the last point can lead to a spike carrying extra energy in a
     /// resonant harmonic, while the lowest-energy solution stays on the backbone.
     ///
-    /// Measured on the clamped bar (default grid, 181 periods; converged points / median
-    /// relative energy error against the exact first mode / fraction of the grid within 5 %):
-    ///
-    /// | `m` | `LowestMeasure`, `retry_depth = 2` | default | numpy/scipy peer (`hybrd`) |
-    /// |-----|------------------------------------|---------|----------------------------|
-    /// | 20  | 176 / 0.0376 / 0.608 | 176 / 0.0376 / 0.608 | 164 / 0.0363 / 0.575 |
-    /// | 40  | 173 / 0.0368 / 0.547 | 170 / 0.0359 / 0.547 | 159 / 0.0342 / 0.530 |
-    /// | 80  | 176 / 0.0558 / 0.470 | 169 / 0.0749 / 0.420 | 169 / 0.0576 / 0.453 |
-    ///
-    /// Identical at `m = 20`, three more points at `m = 40` (median slightly up), and at
-    /// `m = 80`, where resonances are dense, seven more points with a lower median and more
-    /// of the grid within 5 % (better than the peer on all three figures), for about 2 extra
-    /// solves per step (at `m = 80`, about 2.2 times the wall time of the serial default). It
-    /// is not the default: it costs those solves on every step and changes the points of
-    /// existing runs. [`backbone_speculative_with`] runs it serially.
+    /// Near internal resonances, where they are dense (high `m`), it keeps more points on the
+    /// backbone, at the cost of about `retry_depth` extra solves on every step;
+    /// `docs/performance.md` has the measured trade-off on the clamped bar. It is not the
+    /// default for that cost, and because it changes the points of existing runs.
+    /// [`backbone_speculative_with`] runs it serially.
     pub selection: Selection,
     /// Converged points with `E < trivial_energy * E_g` count as collapsed to rest and are
     /// not accepted (default `1e-6`).

@@ -24,7 +24,7 @@ pub struct NewtonOptions {
     /// below `stall_ratio` times its value `K` iterations earlier. On nonsmooth problems a
     /// start outside every solution's basin makes Newton wander between kinks with tiny steps
     /// until the budget runs out; in continuation such a step is skipped anyway, and its
-    /// line searches used to be most of a backbone's time (`docs/performance.md`).
+    /// line searches can dominate a backbone's time (`docs/performance.md`).
     pub stall_window: usize,
     /// Least decrease factor over [`NewtonOptions::stall_window`] iterations (default 0.5,
     /// in `(0, 1]`).
@@ -41,9 +41,8 @@ pub struct NewtonOptions {
     /// Budget of residual evaluations per solve, line-search trials included (default
     /// `usize::MAX`: none; 80 in [`NewtonOptions::fail_fast`]): give up with
     /// [`SolveError::EvaluationBudget`] when a line search has spent it. A hopeless start
-    /// spends its time in long line searches at tiny steps; the solves that converge on the
-    /// clamped bar's backbones use at most 44 (`m = 40`) and 74 (`m = 80`) evaluations, nine
-    /// in ten of them at most 6 and 9 (`docs/performance.md`).
+    /// spends its time in long line searches at tiny steps, while a solve from a converged
+    /// neighbour needs few evaluations (`docs/performance.md` has the measured counts).
     pub max_evaluations: usize,
 }
 
@@ -101,9 +100,8 @@ impl NewtonOptions {
     /// `1e-4`, fifteen iterations to halve its residual or four to cut it by 2 % is outside
     /// every solution's basin in practice, and so is one that has spent 80 residual
     /// evaluations ([`NewtonOptions::max_evaluations`]); the default settings spend most of a
-    /// backbone's time proving it (`docs/performance.md`). On the clamped bar's 181-step
-    /// backbone they converge the same steps as the defaults at `m = 20` and `40` and one
-    /// fewer at `m = 80` (169 of 181), in a half to a third of the time. Not for far starts
+    /// backbone's time proving it (`docs/performance.md` compares the two on the clamped
+    /// bar's backbone: about the same converged steps in much less time). Not for far starts
     /// (a seed, the jumps of [`crate::modal::StallEscape`]): those can need a slow
     /// first phase before converging.
     pub fn fail_fast() -> Self {
@@ -121,7 +119,7 @@ impl NewtonOptions {
 
 /// Semismooth Newton: `J(x) dx = -F(x)` with `J` a generalised Jacobian, then halve the step
 /// until the merit `|F|^2 / 2` decreases enough (Armijo). Converges locally superlinearly on
-/// semismooth systems; on harmonic-balance complementarity it usually stops in 1 to 3
+/// semismooth systems; on harmonic-balance complementarity it usually stops within a few
 /// iterations per continuation step, once the contact set is right.
 ///
 /// Reference: L. Qi and J. Sun, "A nonsmooth version of Newton's method", Mathematical
