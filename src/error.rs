@@ -160,6 +160,10 @@ pub enum SettingsError {
         /// Upper end of the searched range.
         omega_max: f64,
     },
+    /// The buffers a request implies exceed the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+    #[error(transparent)]
+    TooLarge(#[from] OverBudget),
 }
 
 /// Errors of a nonlinear solve.
@@ -313,6 +317,10 @@ pub enum ContinuationError {
         /// Problem dimension.
         expected: usize,
     },
+    /// The values a request implies exceed the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+    #[error(transparent)]
+    TooLarge(#[from] OverBudget),
 }
 
 /// Errors of the time-domain integrator and of the periodicity check ([`crate::verify`]).
@@ -401,6 +409,10 @@ pub enum VerifyError {
     /// The model itself is inconsistent (an end without or with two conditions, a bad gap...).
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The cells or the steps a request implies exceed the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+    #[error(transparent)]
+    TooLarge(#[from] OverBudget),
 }
 
 /// Any error of the crate.
@@ -422,4 +434,46 @@ pub enum Error {
     /// See [`VerifyError`].
     #[error(transparent)]
     Verify(#[from] VerifyError),
+}
+
+/// A request whose buffers would exceed the memory budget
+/// [`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES): raised by
+/// [`check_memory`](crate::fourier::check_memory) and carried by the `TooLarge` variants of
+/// [`SettingsError`], [`ContinuationError`] and [`VerifyError`].
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[error(
+    "{what} needs {requested_bytes:.3e} bytes ({}), more than the memory budget of {budget_bytes} bytes ({})",
+    binary_size(*requested_bytes),
+    binary_size(*budget_bytes as f64)
+)]
+pub struct OverBudget {
+    /// What was requested.
+    pub what: &'static str,
+    /// Bytes the request needs (a float: the sizes that overflow `usize` are reported too).
+    pub requested_bytes: f64,
+    /// The budget in bytes.
+    pub budget_bytes: u64,
+}
+
+/// `bytes` with a binary unit (`1.5 GiB`; in exponent notation beyond the largest unit).
+fn binary_size(bytes: f64) -> String {
+    const UNITS: [&str; 9] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB", "ZiB", "YiB"];
+    let mut value = bytes;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if value < 1024.0 {
+        format!("{value:.1} {}", UNITS[unit])
+    } else {
+        format!("{value:.1e} {}", UNITS[unit])
+    }
+}
+
+/// An over-budget request is a settings error.
+impl From<OverBudget> for Error {
+    fn from(e: OverBudget) -> Self {
+        Error::Settings(e.into())
+    }
 }
