@@ -164,6 +164,43 @@ pub enum SettingsError {
     /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
     #[error(transparent)]
     TooLarge(#[from] OverBudget),
+    /// A fundamental frequency is positive but so small that it is subnormal or that its
+    /// period `2 pi / omega` overflows (see
+    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY)).
+    #[error(
+        "{what} {omega:e} is below {min:e}: it is subnormal or its period 2 pi / omega overflows"
+    )]
+    FrequencyTooSmall {
+        /// Which frequency.
+        what: &'static str,
+        /// The rejected value.
+        omega: f64,
+        /// The smallest admissible value.
+        min: f64,
+    },
+    /// The first grazing energy `E_g` is not a positive, finite, normal number: the gap of
+    /// the law that sets it is too small (its square underflows) or too large (overflows) for
+    /// `f64`, and every `E / E_g` would be NaN or infinite.
+    #[error(
+        "the grazing energy set by law {law} (gap {gap:e}) is {energy:e}, not a positive finite normal number: rescale the gaps"
+    )]
+    GrazingEnergyOutOfRange {
+        /// Index of the unilateral law that sets `E_g`.
+        law: usize,
+        /// Its gap.
+        gap: f64,
+        /// The energy computed.
+        energy: f64,
+    },
+    /// A post-processed quantity came out NaN or infinite although its inputs were valid:
+    /// the unknowns or the frequency are beyond the range that `f64` can evaluate.
+    #[error("{what} is not finite at omega = {omega:e}")]
+    NonFiniteResult {
+        /// Which quantity.
+        what: &'static str,
+        /// The fundamental frequency.
+        omega: f64,
+    },
 }
 
 /// Errors of a nonlinear solve.
