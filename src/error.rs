@@ -160,6 +160,47 @@ pub enum SettingsError {
         /// Upper end of the searched range.
         omega_max: f64,
     },
+    /// The buffers a request implies exceed the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+    #[error(transparent)]
+    TooLarge(#[from] OverBudget),
+    /// A fundamental frequency is positive but so small that it is subnormal or that its
+    /// period `2 pi / omega` overflows (see
+    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY)).
+    #[error(
+        "{what} {omega:e} is below {min:e}: it is subnormal or its period 2 pi / omega overflows"
+    )]
+    FrequencyTooSmall {
+        /// Which frequency.
+        what: &'static str,
+        /// The rejected value.
+        omega: f64,
+        /// The smallest admissible value.
+        min: f64,
+    },
+    /// The first grazing energy `E_g` is not a positive, finite, normal number: the gap of
+    /// the law that sets it is too small (its square underflows) or too large (overflows) for
+    /// `f64`, and every `E / E_g` would be NaN or infinite.
+    #[error(
+        "the grazing energy set by law {law} (gap {gap:e}) is {energy:e}, not a positive finite normal number: rescale the gaps"
+    )]
+    GrazingEnergyOutOfRange {
+        /// Index of the unilateral law that sets `E_g`.
+        law: usize,
+        /// Its gap.
+        gap: f64,
+        /// The energy computed.
+        energy: f64,
+    },
+    /// A post-processed quantity came out NaN or infinite although its inputs were valid:
+    /// the unknowns or the frequency are beyond the range that `f64` can evaluate.
+    #[error("{what} is not finite at omega = {omega:e}")]
+    NonFiniteResult {
+        /// Which quantity.
+        what: &'static str,
+        /// The fundamental frequency.
+        omega: f64,
+    },
 }
 
 /// Errors of a nonlinear solve.
@@ -322,6 +363,10 @@ pub enum ContinuationError {
         /// Problem dimension.
         expected: usize,
     },
+    /// The values a request implies exceed the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+    #[error(transparent)]
+    TooLarge(#[from] OverBudget),
 }
 
 /// Errors of the time-domain integrator and of the periodicity check ([`crate::verify`]).
@@ -410,6 +455,10 @@ pub enum VerifyError {
     /// The model itself is inconsistent (an end without or with two conditions, a bad gap...).
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The cells or the steps a request implies exceed the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+    #[error(transparent)]
+    TooLarge(#[from] OverBudget),
 }
 
 /// Any error of the crate.
@@ -431,4 +480,46 @@ pub enum Error {
     /// See [`VerifyError`].
     #[error(transparent)]
     Verify(#[from] VerifyError),
+}
+
+/// A request whose buffers would exceed the memory budget
+/// [`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES): raised by
+/// [`check_memory`](crate::fourier::check_memory) and carried by the `TooLarge` variants of
+/// [`SettingsError`], [`ContinuationError`] and [`VerifyError`].
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[error(
+    "{what} needs {requested_bytes:.3e} bytes ({}), more than the memory budget of {budget_bytes} bytes ({})",
+    binary_size(*requested_bytes),
+    binary_size(*budget_bytes as f64)
+)]
+pub struct OverBudget {
+    /// What was requested.
+    pub what: &'static str,
+    /// Bytes the request needs (a float: the sizes that overflow `usize` are reported too).
+    pub requested_bytes: f64,
+    /// The budget in bytes.
+    pub budget_bytes: u64,
+}
+
+/// `bytes` with a binary unit (`1.5 GiB`; in exponent notation beyond the largest unit).
+fn binary_size(bytes: f64) -> String {
+    const UNITS: [&str; 9] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB", "ZiB", "YiB"];
+    let mut value = bytes;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if value < 1024.0 {
+        format!("{value:.1} {}", UNITS[unit])
+    } else {
+        format!("{value:.1e} {}", UNITS[unit])
+    }
+}
+
+/// An over-budget request is a settings error.
+impl From<OverBudget> for Error {
+    fn from(e: OverBudget) -> Self {
+        Error::Settings(e.into())
+    }
 }

@@ -25,10 +25,10 @@
 
 use crate::bar::EndRef;
 use crate::error::SettingsError;
-use crate::fourier::{Basis, CosineBasis};
+use crate::fourier::{check_memory, Basis, CosineBasis};
 use crate::modal::diagnostics::{
-    diagnose, displacement_grid, end_history, law_history, EndHistory, FieldGrid, LawHistory,
-    PointDiagnostics,
+    check_finite, check_motion, diagnose, displacement_grid, end_history, law_history, EndHistory,
+    FieldGrid, LawHistory, PointDiagnostics,
 };
 use crate::modal::energy::{energy, energy_at};
 use crate::modal::field::FieldEvaluator;
@@ -49,33 +49,17 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// The motion `x` of `problem` at `omega`.
     ///
     /// # Errors
-    /// [`SettingsError::Length`] if `x` does not have the problem's dimension, and
+    /// [`SettingsError::Length`] if `x` does not have the problem's dimension,
     /// [`SettingsError::NotPositive`] for a non-positive or non-finite `omega` or unknowns
-    /// that are not finite.
+    /// that are not finite, and [`SettingsError::FrequencyTooSmall`] for an `omega` below
+    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY) (subnormal, or with an
+    /// infinite period).
     pub fn new(
         problem: &'a NonsmoothSystem<B>,
         x: &'a [f64],
         omega: f64,
     ) -> Result<Self, SettingsError> {
-        if x.len() != problem.dimension() {
-            return Err(SettingsError::Length {
-                what: "unknowns",
-                got: x.len(),
-                expected: problem.dimension(),
-            });
-        }
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(SettingsError::NotPositive {
-                what: "fundamental frequency",
-                value: omega,
-            });
-        }
-        if let Some(v) = x.iter().find(|v| !v.is_finite()) {
-            return Err(SettingsError::NotPositive {
-                what: "unknowns (finite)",
-                value: *v,
-            });
-        }
+        check_motion(problem, x, omega)?;
         Ok(Self { problem, x, omega })
     }
 
@@ -139,23 +123,33 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// Histories of one bar end over a period on `samples` instants.
     ///
     /// # Errors
-    /// [`SettingsError::Length`] if `end` names a bar the system does not have.
+    /// [`SettingsError::Length`] if `end` names a bar the system does not have;
+    /// [`SettingsError::TooLarge`] if the `4 samples` values do not fit in the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+    /// [`SettingsError::NonFiniteResult`] if a value comes out NaN or infinite.
     pub fn end_history(&self, end: EndRef, samples: usize) -> Result<EndHistory, SettingsError> {
         self.check_bar(end.bar.index())?;
-        Ok(end_history(
+        check_memory("the samples of an end history", 4.0 * samples as f64)?;
+        let h = end_history(
             self.system(),
             self.problem.basis(),
             self.x,
             self.omega,
             end,
             samples,
-        ))
+        );
+        let values = h.time.iter().chain(&h.displacement).chain(&h.strain);
+        check_finite("a value of an end history", self.omega, values)?;
+        Ok(h)
     }
 
     /// `u(x, t)` of bar `bar` on `positions x instants` points over a period.
     ///
     /// # Errors
-    /// [`SettingsError::Length`] if there is no bar `bar`.
+    /// [`SettingsError::Length`] if there is no bar `bar`; [`SettingsError::TooLarge`] if the
+    /// `positions instants` values (with the axes) do not fit in the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+    /// [`SettingsError::NonFiniteResult`] if a value comes out NaN or infinite.
     pub fn displacement_grid(
         &self,
         bar: usize,
@@ -163,7 +157,9 @@ impl<'a, B: Basis> Solution<'a, B> {
         instants: usize,
     ) -> Result<FieldGrid, SettingsError> {
         self.check_bar(bar)?;
-        Ok(displacement_grid(
+        let (p, i) = (positions as f64, instants as f64);
+        check_memory("the values of a displacement grid", p * i + p + i)?;
+        let g = displacement_grid(
             self.system(),
             self.problem.basis(),
             self.x,
@@ -171,7 +167,10 @@ impl<'a, B: Basis> Solution<'a, B> {
             bar,
             positions,
             instants,
-        ))
+        );
+        let values = g.time.iter().chain(&g.position).chain(&g.displacement);
+        check_finite("a value of a displacement grid", self.omega, values)?;
+        Ok(g)
     }
 
     /// Gap, force and pointwise residual of unilateral law `law` over a period.

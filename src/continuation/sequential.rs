@@ -467,10 +467,14 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<P, S> {
     }
 }
 
-/// `steps` equispaced values from `start` to `end` inclusive.
+/// `steps` equispaced values from `start` to `end` inclusive (all finite, even where
+/// `end - start` overflows).
 ///
 /// # Errors
-/// [`ContinuationError::InvalidOption`] for non-finite ends or fewer than 2 steps.
+/// [`ContinuationError::InvalidOption`] for non-finite ends or fewer than 2 steps;
+/// [`ContinuationError::TooLarge`] if the `steps` values do not fit in the memory budget
+/// [`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES) (the error carries the bytes
+/// they would need).
 pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
     for v in [start, end] {
         if !v.is_finite() {
@@ -486,6 +490,18 @@ pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, Continua
             value: steps as f64,
         });
     }
-    let h = (end - start) / (steps - 1) as f64;
-    Ok((0..steps).map(|i| start + h * i as f64).collect())
+    crate::fourier::check_memory("the values of a grid", steps as f64)?;
+    let last = (steps - 1) as f64;
+    let h = (end - start) / last;
+    if (start + h * last).is_finite() {
+        return Ok((0..steps).map(|i| start + h * i as f64).collect());
+    }
+    // `end - start` or the last value overflows (ends near `f64::MAX`): interpolate without
+    // forming them.
+    Ok((0..steps)
+        .map(|i| {
+            let t = i as f64 / last;
+            start * (1.0 - t) + end * t
+        })
+        .collect())
 }

@@ -7,11 +7,67 @@
 
 mod even;
 
-use crate::error::SettingsError;
+use crate::error::{OverBudget, SettingsError};
 use even::{Buffers, EvenTransform};
 use std::cell::Cell;
 use std::fmt::Debug;
 use std::sync::Arc;
+
+/// The memory budget of one request, in bytes: 4 GiB.
+///
+/// Sizes given by the user (harmonics and samples of a basis, values of a grid, time steps
+/// and cells of a march) are checked against it before anything is allocated, so that a
+/// request beyond it is a typed error (a `TooLarge` variant carrying an [`OverBudget`])
+/// rather than an arithmetic overflow or an aborted allocation. On targets whose address
+/// space is smaller, the budget is `isize::MAX` bytes instead (the most a `Vec` can hold).
+pub const MEMORY_BUDGET_BYTES: u64 = 4 << 30;
+
+/// Bytes of one `f64`.
+const DOUBLE_BYTES: f64 = std::mem::size_of::<f64>() as f64;
+
+/// Checks that `doubles` values of type `f64` fit in the memory budget
+/// ([`MEMORY_BUDGET_BYTES`]); `what` names the request in the error.
+///
+/// `doubles` is a float so that a product of sizes cannot overflow before it is checked:
+/// pass `a as f64 * b as f64`, not `a * b`. NaN counts as over the budget.
+///
+/// ```
+/// use nonsmooth_modes::fourier::{check_memory, MEMORY_BUDGET_BYTES};
+///
+/// assert!(check_memory("a small buffer", 1e6).is_ok());
+/// let err = check_memory("a Gram matrix of 100001 coefficients", 100_001f64 * 100_001f64)
+///     .unwrap_err();
+/// assert_eq!(err.budget_bytes, MEMORY_BUDGET_BYTES);
+/// assert!(err.requested_bytes > 8e10);
+/// ```
+///
+/// # Errors
+/// [`OverBudget`] with the bytes requested and the budget. It converts into the `TooLarge`
+/// variant of [`SettingsError`], [`ContinuationError`](crate::ContinuationError) and
+/// [`VerifyError`](crate::verify::VerifyError) (and into [`crate::Error`]) with `?`.
+pub fn check_memory(what: &'static str, doubles: f64) -> Result<(), OverBudget> {
+    let error = over_budget(what, doubles);
+    if error.requested_bytes <= error.budget_bytes as f64 {
+        Ok(())
+    } else {
+        Err(error)
+    }
+}
+
+/// The error of a request of `doubles` values of type `f64` against the budget.
+fn over_budget(what: &'static str, doubles: f64) -> OverBudget {
+    OverBudget {
+        what,
+        requested_bytes: doubles * DOUBLE_BYTES,
+        budget_bytes: MEMORY_BUDGET_BYTES.min(isize::MAX as u64),
+    }
+}
+
+/// Doubles per time sample that a [`CosineBasis`] implies besides its Gram matrix: an upper
+/// estimate of its sine and cosine tables, the FFT plan and scratch (Bluestein's algorithm
+/// for a prime size pads to a power of two above `2 N`), the folded buffers and one period
+/// of samples held by the caller.
+const BASIS_DOUBLES_PER_SAMPLE: f64 = 16.0;
 
 /// A finite real basis of `2 pi`-periodic functions `phi_i(theta)`, with a grid of `N`
 /// equispaced samples `theta_k = 2 pi k / N` on which residuals are projected (Riemann sum).
@@ -42,20 +98,42 @@ pub trait Basis: Debug + Clone + Send + Sync {
     fn samples(&self) -> usize;
 
     /// `phi_i(theta)` for every `i`, written into `out` (length `len()`).
+    ///
+    /// # Panics
+    /// If `out.len() != self.len()`. The lengths of the slices given to the methods of a
+    /// basis are the caller's contract (they run in hot loops and return no `Result`): an
+    /// implementation may panic when they are wrong, as [`CosineBasis`] does. The typed
+    /// errors of the crate are raised at its user-facing entry points, which size these
+    /// slices themselves.
     fn functions_at(&self, theta: f64, out: &mut [f64]);
 
     /// `d phi_i / d theta` for every `i`, written into `out`.
+    ///
+    /// # Panics
+    /// If `out.len() != self.len()` (see [`Basis::functions_at`]).
     fn derivatives_at(&self, theta: f64, out: &mut [f64]);
 
     /// `s_k = sum_i c_i phi_i(theta_k)` for `k = 0..N`.
+    ///
+    /// # Panics
+    /// If `coefficients.len() != self.len()` or `samples.len() != self.samples()` (see
+    /// [`Basis::functions_at`]).
     fn synthesize(&self, coefficients: &[f64], samples: &mut [f64]);
 
     /// The Galerkin projection `R_j = (2/N) sum_k psi_j(theta_k) r_k`, where `psi_j` is the
     /// test function of coefficient `j` (for the cosine basis `psi_j = cos(j theta)`).
+    ///
+    /// # Panics
+    /// If `samples.len() != self.samples()` or `coefficients.len() != self.len()` (see
+    /// [`Basis::functions_at`]).
     fn project(&self, samples: &[f64], coefficients: &mut [f64]);
 
     /// `G[j][i] = (2/N) sum_k psi_j(theta_k) w_k phi_i(theta_k)`, row-major `len x len`: the
     /// projection of `w * phi_i`, i.e. the Jacobian block of a pointwise law with weight `w`.
+    ///
+    /// # Panics
+    /// If `weights.len() != self.samples()` or `gram.len() != self.len()^2` (see
+    /// [`Basis::functions_at`]).
     fn weighted_gram(&self, weights: &[f64], gram: &mut [f64]);
 
     /// Number `S` of folded samples: the grid points `theta_0..theta_S` at which every
@@ -65,25 +143,37 @@ pub trait Basis: Debug + Clone + Send + Sync {
     }
 
     /// Number of grid instants that folded sample `k` stands for (1 by default). They sum
-    /// to `N`.
+    /// to `N`. Meaningful for `k < S` only.
     fn multiplicity(&self, k: usize) -> usize {
         let _ = k;
         1
     }
 
     /// [`Basis::synthesize`] at the `S` folded samples only.
+    ///
+    /// # Panics
+    /// If `coefficients.len() != self.len()` or `samples.len() != self.folded_samples()`
+    /// (see [`Basis::functions_at`]).
     fn synthesize_folded(&self, coefficients: &[f64], samples: &mut [f64]) {
         self.synthesize(coefficients, samples);
     }
 
     /// [`Basis::project`] of the signal with the symmetry of the basis whose folded samples
     /// are `samples`: `R_j = (2/N) sum_k mult_k psi_j(theta_k) r_k` over `k = 0..S`.
+    ///
+    /// # Panics
+    /// If `samples.len() != self.folded_samples()` or `coefficients.len() != self.len()`
+    /// (see [`Basis::functions_at`]).
     fn project_folded(&self, samples: &[f64], coefficients: &mut [f64]) {
         self.project(samples, coefficients);
     }
 
     /// [`Basis::weighted_gram`] of the weight with the symmetry of the basis whose folded
     /// samples are `weights`.
+    ///
+    /// # Panics
+    /// If `weights.len() != self.folded_samples()` or `gram.len() != self.len()^2` (see
+    /// [`Basis::functions_at`]).
     fn weighted_gram_folded(&self, weights: &[f64], gram: &mut [f64]) {
         self.weighted_gram(weights, gram);
     }
@@ -163,9 +253,15 @@ fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
 impl CosineBasis {
     /// `m` harmonics and `n_h` samples per harmonic.
     ///
+    /// The basis implies a Gram matrix of `(m + 1)^2` doubles for each pointwise law and
+    /// about 16 doubles per time sample (`N = n_h m`) of tables, FFT buffers and samples;
+    /// together they must fit in [`MEMORY_BUDGET_BYTES`] (for `n_h = 30` that allows up to
+    /// about 23 000 harmonics).
+    ///
     /// # Errors
     /// [`SettingsError::ZeroHarmonics`] if `m = 0`; [`SettingsError::TooFewSamples`] if
-    /// `n_h < 3`.
+    /// `n_h < 3`; [`SettingsError::TooLarge`] if the basis does not fit in the budget (the
+    /// error carries the bytes it would need).
     pub fn new(harmonics: usize, samples_per_harmonic: usize) -> Result<Self, SettingsError> {
         if harmonics == 0 {
             return Err(SettingsError::ZeroHarmonics);
@@ -176,12 +272,35 @@ impl CosineBasis {
                 min: 3,
             });
         }
-        let n = harmonics * samples_per_harmonic;
+        // Sizes in floating point first: their products cannot overflow there.
+        let len = harmonics as f64 + 1.0;
+        let samples = harmonics as f64 * samples_per_harmonic as f64;
+        let what = "a cosine basis (its Gram matrix, tables and FFT buffers)";
+        let doubles = len * len + BASIS_DOUBLES_PER_SAMPLE * samples;
+        check_memory(what, doubles)?;
+        // Within the budget `N` fits in `usize`; checked all the same.
+        let n = harmonics
+            .checked_mul(samples_per_harmonic)
+            .ok_or_else(|| over_budget(what, doubles))?;
         Ok(Self {
             harmonics,
             samples: n,
             transform: Arc::new(EvenTransform::new(n)),
         })
+    }
+
+    /// The length contract of a slice of coefficients.
+    fn assert_coefficients(&self, len: usize) {
+        assert_eq!(len, self.len(), "one value per coefficient");
+    }
+
+    /// The length contract of a Gram matrix.
+    fn assert_gram(&self, len: usize) {
+        assert_eq!(
+            len,
+            self.len() * self.len(),
+            "a square matrix of coefficients"
+        );
     }
 
     /// The even part `(x_k + x_(N-k)) / 2` of the full-period samples `x`, folded, into
@@ -290,17 +409,20 @@ impl Basis for CosineBasis {
         self.samples
     }
     fn functions_at(&self, theta: f64, out: &mut [f64]) {
+        self.assert_coefficients(out.len());
         for (i, o) in out.iter_mut().enumerate() {
             *o = constant_half(i) * (i as f64 * theta).cos();
         }
     }
     fn derivatives_at(&self, theta: f64, out: &mut [f64]) {
+        self.assert_coefficients(out.len());
         for (i, o) in out.iter_mut().enumerate() {
             *o = -(i as f64) * (i as f64 * theta).sin();
         }
     }
     fn synthesize(&self, coefficients: &[f64], samples: &mut [f64]) {
         let n = self.samples;
+        self.assert_coefficients(coefficients.len());
         assert_eq!(samples.len(), n, "one period of samples");
         with_scratch(|scratch| {
             self.synthesize_into_sums(coefficients, scratch);
@@ -310,6 +432,7 @@ impl Basis for CosineBasis {
         });
     }
     fn project(&self, samples: &[f64], coefficients: &mut [f64]) {
+        self.assert_coefficients(coefficients.len());
         with_scratch(|scratch| {
             self.fold(samples, scratch);
             self.cosine_sums_of_scratch(self.len(), scratch);
@@ -317,6 +440,7 @@ impl Basis for CosineBasis {
         });
     }
     fn weighted_gram(&self, weights: &[f64], gram: &mut [f64]) {
+        self.assert_gram(gram.len());
         with_scratch(|scratch| {
             self.fold(weights, scratch);
             self.cosine_sums_of_scratch(self.moment_sums(), scratch);
@@ -336,6 +460,7 @@ impl Basis for CosineBasis {
         }
     }
     fn synthesize_folded(&self, coefficients: &[f64], samples: &mut [f64]) {
+        self.assert_coefficients(coefficients.len());
         assert_eq!(samples.len(), self.folded_samples(), "one folded period");
         with_scratch(|scratch| {
             self.synthesize_into_sums(coefficients, scratch);
@@ -343,12 +468,16 @@ impl Basis for CosineBasis {
         });
     }
     fn project_folded(&self, samples: &[f64], coefficients: &mut [f64]) {
+        assert_eq!(samples.len(), self.folded_samples(), "one folded period");
+        self.assert_coefficients(coefficients.len());
         with_scratch(|scratch| {
             self.cosine_sums(samples, self.len(), scratch);
             self.project_sums(coefficients, scratch);
         });
     }
     fn weighted_gram_folded(&self, weights: &[f64], gram: &mut [f64]) {
+        assert_eq!(weights.len(), self.folded_samples(), "one folded period");
+        self.assert_gram(gram.len());
         with_scratch(|scratch| {
             self.cosine_sums(weights, self.moment_sums(), scratch);
             self.gram_from_sums(gram, scratch);
@@ -582,6 +711,67 @@ mod tests {
         assert!(Arc::ptr_eq(&a.transform, &b.transform));
         assert_eq!(a, CosineBasis::new(6, 5).unwrap());
         assert_ne!(a, CosineBasis::new(6, 4).unwrap());
+    }
+
+    #[test]
+    fn sizes_beyond_the_memory_budget_are_typed_errors() {
+        let budget = MEMORY_BUDGET_BYTES.min(isize::MAX as u64);
+        // m = 1e5: a Gram matrix of 1e10 doubles.
+        match CosineBasis::new(100_000, 3) {
+            Err(SettingsError::TooLarge(e)) => {
+                assert_eq!(e.budget_bytes, budget);
+                let gram = 100_001f64 * 100_001f64 * 8.0;
+                assert!(e.requested_bytes > gram && e.requested_bytes < 1.01 * gram);
+            }
+            other => panic!("expected TooLarge, got {other:?}"),
+        }
+        // m n_h overflows usize: still a number of bytes, not a wrapped product.
+        for (m, nh) in [
+            (usize::MAX, usize::MAX),
+            (2, usize::MAX),
+            (usize::MAX / 2, 3),
+        ] {
+            match CosineBasis::new(m, nh) {
+                Err(SettingsError::TooLarge(e)) => {
+                    assert!(e.requested_bytes > 1e19, "{e}");
+                }
+                other => panic!("m = {m}, n_h = {nh}: expected TooLarge, got {other:?}"),
+            }
+        }
+        // The documented limit at n_h = 30.
+        assert!(CosineBasis::new(22_900, 30).is_ok());
+        assert!(matches!(
+            CosineBasis::new(23_000, 30),
+            Err(SettingsError::TooLarge(_))
+        ));
+        assert!(check_memory("x", budget as f64 / 8.0).is_ok());
+        assert!(check_memory("x", budget as f64 / 8.0 + 1.0).is_err());
+        assert!(check_memory("x", f64::NAN).is_err());
+        assert!(check_memory("x", f64::INFINITY).is_err());
+    }
+
+    #[test]
+    #[should_panic(expected = "one value per coefficient")]
+    fn short_coefficients_panic() {
+        let b = CosineBasis::new(4, 3).unwrap();
+        let mut s = vec![0.0; b.samples()];
+        b.synthesize(&[1.0, 2.0], &mut s);
+    }
+
+    #[test]
+    #[should_panic(expected = "one folded period")]
+    fn long_folded_samples_panic() {
+        let b = CosineBasis::new(4, 3).unwrap();
+        let mut c = vec![0.0; b.len()];
+        b.project_folded(&vec![0.0; b.samples()], &mut c);
+    }
+
+    #[test]
+    #[should_panic(expected = "a square matrix of coefficients")]
+    fn short_gram_panics() {
+        let b = CosineBasis::new(4, 3).unwrap();
+        let mut g = vec![0.0; b.len()];
+        b.weighted_gram(&vec![1.0; b.samples()], &mut g);
     }
 
     #[test]

@@ -7,7 +7,7 @@
 
 use crate::bar::{End, EndRef};
 use crate::error::{Error, SettingsError};
-use crate::fourier::Basis;
+use crate::fourier::{check_memory, Basis};
 use crate::modal::backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
@@ -15,6 +15,68 @@ use crate::solve::NonlinearSolver;
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
+
+/// The smallest fundamental frequency `Omega` accepted by the post-processing (about
+/// `3.5e-308`): `2 pi / f64::MAX`, rounded up so that the period `2 pi / Omega` is finite.
+/// It is a normal `f64`, so every frequency at or above it is too (a subnormal one has lost
+/// precision).
+pub const MIN_FREQUENCY: f64 = 2.0 * PI / f64::MAX * (1.0 + 4.0 * f64::EPSILON);
+
+/// Checks a fundamental frequency: positive and finite ([`SettingsError::NotPositive`]) and
+/// at least [`MIN_FREQUENCY`] ([`SettingsError::FrequencyTooSmall`]).
+pub(crate) fn check_frequency(omega: f64) -> Result<f64, SettingsError> {
+    let what = "fundamental frequency";
+    if !(omega.is_finite() && omega > 0.0) {
+        Err(SettingsError::NotPositive { what, value: omega })
+    } else if omega < MIN_FREQUENCY {
+        Err(SettingsError::FrequencyTooSmall {
+            what,
+            omega,
+            min: MIN_FREQUENCY,
+        })
+    } else {
+        Ok(omega)
+    }
+}
+
+/// Checks a motion `x` of `problem` at `omega`: the length of `x`
+/// ([`SettingsError::Length`]), the frequency ([`check_frequency`]) and finite unknowns
+/// ([`SettingsError::NotPositive`] naming "unknowns (finite)").
+pub(crate) fn check_motion<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+) -> Result<(), SettingsError> {
+    if x.len() != problem.dimension() {
+        return Err(SettingsError::Length {
+            what: "unknowns",
+            got: x.len(),
+            expected: problem.dimension(),
+        });
+    }
+    check_frequency(omega)?;
+    if let Some(v) = x.iter().find(|v| !v.is_finite()) {
+        return Err(SettingsError::NotPositive {
+            what: "unknowns (finite)",
+            value: *v,
+        });
+    }
+    Ok(())
+}
+
+/// Checks that every value of `values` is finite: [`SettingsError::NonFiniteResult`]
+/// naming `what` otherwise.
+pub(crate) fn check_finite<'v>(
+    what: &'static str,
+    omega: f64,
+    values: impl IntoIterator<Item = &'v f64>,
+) -> Result<(), SettingsError> {
+    if values.into_iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SettingsError::NonFiniteResult { what, omega })
+    }
+}
 
 /// Time histories of one end over a period.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -31,6 +93,9 @@ pub struct EndHistory {
 }
 
 /// Histories of the end `end` over one period, on `samples` instants.
+///
+/// Neither `omega` nor the size of the histories is checked here;
+/// [`Solution::end_history`](crate::solution::Solution::end_history) checks both.
 ///
 /// # Panics
 /// If `end.bar` is not a bar of the system or `x` has the wrong length.
@@ -74,6 +139,9 @@ pub struct FieldGrid {
 }
 
 /// `u(x, t)` of bar `bar` on `positions x instants` points over one period.
+///
+/// Neither `omega` nor the size of the grid is checked here;
+/// [`Solution::displacement_grid`](crate::solution::Solution::displacement_grid) checks both.
 ///
 /// # Panics
 /// If `bar` is out of range or `x` has the wrong length.
@@ -129,7 +197,15 @@ pub struct LawHistory {
 /// gap and force rows ([`HarmonicRows`]) as the residual, evaluated at any phase.
 ///
 /// # Errors
-/// [`SettingsError::Length`] if `law` is out of range or `x` has the wrong length.
+/// [`SettingsError::Length`] if `law` is out of range or `x` has the wrong length;
+/// [`SettingsError::NotPositive`] or [`SettingsError::FrequencyTooSmall`] for an `omega`
+/// that is not positive and finite or below [`MIN_FREQUENCY`], and `NotPositive` for
+/// unknowns that are not finite; [`SettingsError::TooLarge`] if the `4 samples` values of
+/// the histories do not fit in the memory budget
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+/// [`SettingsError::NonFiniteResult`] if an instant, gap, force or residual comes out NaN or
+/// infinite (a frequency whose harmonics overflow or whose period is near `f64::MAX`, huge
+/// unknowns).
 pub fn law_history<B: Basis>(
     problem: &NonsmoothSystem<B>,
     x: &[f64],
@@ -146,13 +222,8 @@ pub fn law_history<B: Basis>(
             expected: laws.len(),
         });
     };
-    if x.len() != problem.dimension() {
-        return Err(SettingsError::Length {
-            what: "unknown vector",
-            got: x.len(),
-            expected: problem.dimension(),
-        });
-    }
+    check_motion(problem, x, omega)?;
+    check_memory("the samples of a law history", 4.0 * samples as f64)?;
     let basis = problem.basis();
     let unknowns = system.unknowns_per_harmonic();
     let rows: Vec<HarmonicRows> = (0..=basis.harmonics())
@@ -181,6 +252,13 @@ pub fn law_history<B: Basis>(
         h.residual
             .push(law_ref.residual(g, l, problem.complementarity()).value);
     }
+    let values = h
+        .time
+        .iter()
+        .chain(&h.gap)
+        .chain(&h.force)
+        .chain(&h.residual);
+    check_finite("a value of a law history", omega, values)?;
     Ok(h)
 }
 
@@ -202,7 +280,10 @@ pub struct PointDiagnostics {
 /// (at least 1; 8 is a good default) and 16 instants for the energy drift.
 ///
 /// # Errors
-/// [`SettingsError::ZeroIndex`] for `refinement = 0`.
+/// [`SettingsError::ZeroIndex`] for `refinement = 0`; the errors of [`law_history`] (a bad
+/// `x` or `omega`, histories of `refinement N` samples beyond the memory budget, a gap or
+/// force that is not finite); [`SettingsError::NonFiniteResult`] if an energy or a
+/// diagnostic comes out NaN or infinite.
 pub fn diagnose<B: Basis>(
     problem: &NonsmoothSystem<B>,
     x: &[f64],
@@ -215,6 +296,10 @@ pub fn diagnose<B: Basis>(
             value: 0,
         });
     }
+    check_motion(problem, x, omega)?;
+    let grid = problem.basis().samples() as f64 * refinement as f64;
+    check_memory("the samples of a law history", 4.0 * grid)?;
+    // Within the budget the product fits in `usize`.
     let samples = problem.basis().samples() * refinement;
     let period = 2.0 * PI / omega;
     let mut residual_norm = Vec::new();
@@ -237,20 +322,24 @@ pub fn diagnose<B: Basis>(
             )
         })
         .collect();
+    check_finite("the energy", omega, &energies)?;
     let (lo, hi) = energies
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &e| {
             (a.min(e), b.max(e))
         });
+    let energy_drift = if energies[0] > 0.0 {
+        (hi - lo) / energies[0]
+    } else {
+        0.0
+    };
+    check_finite("the residual norm R^(m)", omega, &residual_norm)?;
+    check_finite("the energy drift", omega, [&energy_drift])?;
     Ok(PointDiagnostics {
         residual_norm,
         max_penetration,
         min_contact_force,
-        energy_drift: if energies[0] > 0.0 {
-            (hi - lo) / energies[0]
-        } else {
-            0.0
-        },
+        energy_drift,
     })
 }
 

@@ -10,6 +10,7 @@
 use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
+use crate::modal::diagnostics::check_frequency;
 use crate::modal::energy::energy;
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, NonsmoothSystem};
@@ -203,7 +204,10 @@ fn shape_energy(system: &BarSystem, omega: f64, shape: &[f64]) -> f64 {
 /// Clamped bar: `pi^2 g0^2 / 16`; Robin bar `k_s = 0.5`: `0.185515 g0^2`.
 ///
 /// # Errors
-/// [`SettingsError::NoContact`], [`SettingsError::NoGrazing`] or a failed mode search.
+/// [`SettingsError::NoContact`], [`SettingsError::NoGrazing`] or a failed mode search;
+/// [`SettingsError::GrazingEnergyOutOfRange`] if `E_g` is not a positive, finite, normal
+/// number (gaps below about `1e-154` or above about `1e154` for unit bars: `g0^2` underflows
+/// or overflows), naming the law that sets it.
 pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsError> {
     if system.contact_count() == 0 {
         return Err(SettingsError::NoContact);
@@ -231,7 +235,8 @@ pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsE
     }
     let lu = Lu::factor(&q, 1e-12).map_err(|_| SettingsError::NoGrazing { omega: mode.omega })?;
     let rows = HarmonicRows::new(system, mode.omega);
-    let mut best = f64::INFINITY;
+    // The least energy over the laws that the mode moves: (energy, law, gap).
+    let mut best: Option<(f64, usize, f64)> = None;
     for (l, law) in system.laws().enumerate() {
         let g0 = law.gap().offset;
         let c: Vec<f64> = mode
@@ -243,13 +248,18 @@ pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsE
         lu.solve_in_place(&mut y);
         let ctqc = dot(&c, &y);
         if ctqc > 1e-300 {
-            best = best.min(g0 * g0 / ctqc);
+            let energy = g0 * g0 / ctqc;
+            if best.is_none_or(|(e, _, _)| energy < e) {
+                best = Some((energy, l, g0));
+            }
         }
     }
-    if best.is_finite() {
-        Ok((best, mode))
-    } else {
-        Err(SettingsError::NoGrazing { omega: mode.omega })
+    match best {
+        None => Err(SettingsError::NoGrazing { omega: mode.omega }),
+        Some((energy, _, _)) if energy.is_normal() => Ok((energy, mode)),
+        Some((energy, law, gap)) => {
+            Err(SettingsError::GrazingEnergyOutOfRange { law, gap, energy })
+        }
     }
 }
 
@@ -266,13 +276,7 @@ fn check_seed<B: Basis>(
         }
         .into());
     }
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(SettingsError::NotPositive {
-            what: "fundamental frequency",
-            value: omega,
-        }
-        .into());
-    }
+    check_frequency(omega)?;
     let harmonics = problem.basis().harmonics();
     if subharmonic > harmonics {
         return Err(SettingsError::HarmonicOutOfRange {

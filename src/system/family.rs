@@ -15,8 +15,9 @@
 //! ```
 
 use crate::continuation::ContinuationProblem;
-use crate::error::{Error, ModelError, SettingsError};
+use crate::error::{Error, ModelError};
 use crate::linalg::DenseMatrix;
+use crate::modal::diagnostics::check_frequency;
 use crate::solve::{Problem, Structured};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
@@ -60,7 +61,9 @@ impl<F: SystemFamily> ParameterFamily<F> {
     /// [`ParameterFamily::at`] to start at another value.
     ///
     /// # Errors
-    /// A non-positive `omega`, invalid settings, or a family that fails at the probe value.
+    /// An `omega` that is not positive and finite or is below
+    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY), invalid settings, or a
+    /// family that fails at the probe value.
     pub fn new(family: F, settings: HarmonicBalanceSettings, omega: f64) -> Result<Self, Error> {
         Self::at(family, settings, omega, 1.0)
     }
@@ -75,13 +78,7 @@ impl<F: SystemFamily> ParameterFamily<F> {
         omega: f64,
         value: f64,
     ) -> Result<Self, Error> {
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(SettingsError::NotPositive {
-                what: "fundamental frequency",
-                value: omega,
-            }
-            .into());
-        }
+        check_frequency(omega)?;
         let mut system = NonsmoothSystem::new(&family.build(value)?, settings)?;
         system.set_parameter(omega);
         Ok(Self {

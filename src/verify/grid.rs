@@ -1,9 +1,24 @@
 //! The common time step and the cells of each bar (`dx_b = c_b dt`).
 
 use super::{Model, VerifyError};
+use crate::bar::Bar;
+use crate::fourier::check_memory;
 
 /// Relative tolerance under which `l / (c dt)` counts as an integer.
 const INTEGER_TOLERANCE: f64 = 1e-9;
+
+/// Doubles held per cell of the grid by a periodicity check: the initial strain, velocity and
+/// nodal displacement, the two waves (a start and a value per piece) and the snapshots of
+/// the initial and final states (displacement, strain and velocity each), rounded up.
+pub(super) const DOUBLES_PER_CELL: f64 = 16.0;
+
+/// What a grid with too many cells is called in its error.
+const GRID_CELLS: &str = "the cells of a time-domain grid (l / (c dt) per bar)";
+
+/// Checks that `cells` cells in all fit in the memory budget.
+fn check_cells(cells: f64) -> Result<(), VerifyError> {
+    Ok(check_memory(GRID_CELLS, cells * DOUBLES_PER_CELL)?)
+}
 
 /// A common time step `dt` such that every bar `b` holds an integer number of cells
 /// `N_b = l_b / (c_b dt)` of length `dx_b = c_b dt`: then a wave crosses exactly one cell per
@@ -23,6 +38,11 @@ fn check_dt(dt: f64) -> Result<f64, VerifyError> {
     }
 }
 
+/// The travel time `l / c` of a wave across `bar`.
+fn travel_time(bar: &Bar) -> f64 {
+    bar.length() / bar.wave_speed()
+}
+
 /// `l / (c dt)` rounded, if it is an integer within tolerance.
 fn cells_of(travel_time: f64, dt: f64) -> Result<usize, f64> {
     let ratio = travel_time / dt;
@@ -40,15 +60,18 @@ impl Grid {
     /// # Errors
     /// [`VerifyError::InvalidTimeStep`] if `dt` is not positive and finite;
     /// [`VerifyError::NonMatchingGrid`] naming the first bar whose `l / (c dt)` is not an
-    /// integer (within a relative `1e-9`) or is below 1.
+    /// integer (within a relative `1e-9`) or is below 1; [`VerifyError::TooLarge`] if the
+    /// cells of all bars do not fit in the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES), at 16 doubles per
+    /// cell: the initial state, its waves and two snapshots).
     pub fn new(model: &Model, dt: f64) -> Result<Self, VerifyError> {
         let dt = check_dt(dt)?;
-        let cells = model
+        let cells: Vec<usize> = model
             .bars()
             .iter()
             .enumerate()
             .map(|(b, bar)| {
-                let travel_time = bar.length() / bar.wave_speed();
+                let travel_time = travel_time(bar);
                 cells_of(travel_time, dt).map_err(|cells| VerifyError::NonMatchingGrid {
                     bar: b,
                     travel_time,
@@ -57,6 +80,7 @@ impl Grid {
                 })
             })
             .collect::<Result<_, _>>()?;
+        check_cells(cells.iter().map(|&n| n as f64).sum())?;
         Ok(Self { dt, cells })
     }
 
@@ -65,16 +89,19 @@ impl Grid {
     /// bar an integer number of cells is kept. [`Grid::dt`] tells which step was chosen.
     ///
     /// # Errors
-    /// [`VerifyError::InvalidTimeStep`] for a bad `dt`; [`VerifyError::NoAdmissibleGrid`] if
-    /// the bars' travel times are not commensurate enough for any candidate.
+    /// [`VerifyError::InvalidTimeStep`] for a bad `dt`; [`VerifyError::TooLarge`] if the
+    /// cells at step `dt` do not fit in the memory budget (as for [`Grid::new`]);
+    /// [`VerifyError::NoAdmissibleGrid`] if the bars' travel times are not commensurate
+    /// enough for any candidate.
     pub fn nearest(model: &Model, dt: f64) -> Result<Self, VerifyError> {
         let dt = check_dt(dt)?;
-        let first = &model.bars()[0];
-        let tau = first.length() / first.wave_speed();
+        // The cells at `dt` bound the candidates' counts (a tiny `dt` overflows them).
+        check_cells(model.bars().iter().map(|bar| travel_time(bar) / dt).sum())?;
+        let tau = travel_time(&model.bars()[0]);
         let low = (tau / (2.0 * dt)).floor().max(1.0) as usize;
         let high = ((2.0 * tau / dt).ceil() as usize).max(low);
         let mut best: Option<Grid> = None;
-        for n in low..=high.min(low + 1_000_000) {
+        for n in low..=high.min(low.saturating_add(1_000_000)) {
             let candidate = tau / n as f64;
             if let Ok(grid) = Self::new(model, candidate) {
                 let better = best
@@ -152,5 +179,26 @@ mod tests {
             Grid::nearest(&irrational, 0.01),
             Err(VerifyError::NoAdmissibleGrid { .. })
         ));
+    }
+
+    #[test]
+    fn grids_beyond_the_memory_budget_are_typed_errors() {
+        let one = Model::from_system(&crate::reference::clamped_bar_with_obstacle(1e-3).unwrap())
+            .unwrap();
+        // 1e11 cells: an integer count, but 12.8 TB of state.
+        for dt in [1e-11, 1e-300, 5e-324] {
+            assert!(
+                matches!(Grid::nearest(&one, dt), Err(VerifyError::TooLarge(_))),
+                "nearest, dt = {dt}"
+            );
+        }
+        match Grid::new(&one, 1e-11) {
+            Err(VerifyError::TooLarge(e)) => {
+                assert_eq!(e.requested_bytes, 1e11 * DOUBLES_PER_CELL * 8.0);
+            }
+            other => panic!("expected TooLarge, got {other:?}"),
+        }
+        // A million cells is fine.
+        assert_eq!(Grid::new(&one, 1e-6).unwrap().cells(0), 1_000_000);
     }
 }

@@ -5,6 +5,7 @@ use super::state::State;
 use super::wave::{Piece, TINY};
 use super::{Condition, Snapshot, VerifyError};
 use crate::bar::{End, EndRef};
+use crate::fourier::check_memory;
 
 /// How a ground spring is advanced over a piece of constant incoming wave `a`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -398,11 +399,42 @@ pub struct Trajectory {
     pub final_state: State,
 }
 
+/// Checks that the histories of a march of `steps` steps from `initial`, with a snapshot
+/// every `snapshot_every` steps, fit in the memory budget: per step the time and the energy,
+/// the displacement and strain of every bar end and the gap and force of every unilateral
+/// condition; per snapshot the three fields of every cell.
+fn check_history(initial: &State, steps: f64, snapshot_every: usize) -> Result<(), VerifyError> {
+    let model = initial.model();
+    let bars = model.bars().len() as f64;
+    let contacts = model
+        .conditions()
+        .iter()
+        .filter(|c| c.is_unilateral())
+        .count() as f64;
+    let per_step = 2.0 + 4.0 * bars + 2.0 * contacts;
+    let snapshots = if snapshot_every > 0 {
+        steps / snapshot_every as f64 + 1.0
+    } else {
+        0.0
+    };
+    let grid = initial.grid();
+    let cells = (0..grid.bars()).map(|b| grid.cells(b) as f64).sum::<f64>();
+    let per_snapshot = 3.0 * cells + bars + 1.0;
+    let doubles = steps * per_step + snapshots * per_snapshot;
+    Ok(check_memory(
+        "the histories of a march (duration / dt steps)",
+        doubles,
+    )?)
+}
+
 /// Marches `initial` over `duration` (full steps, then one partial step for the remainder)
 /// and records end histories, contact histories, energy and snapshots.
 ///
 /// # Errors
-/// [`VerifyError::InvalidParameter`] if `duration` is negative or not finite.
+/// [`VerifyError::InvalidParameter`] if `duration` is negative or not finite;
+/// [`VerifyError::TooLarge`] if the histories of its `duration / dt` steps (and its
+/// snapshots) do not fit in the memory budget
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
 pub fn march(
     initial: &State,
     duration: f64,
@@ -418,10 +450,11 @@ pub fn march(
     }
     let full = (total + 1e-9).floor();
     let rest = total - full;
-    let mut fractions = vec![1.0; full as usize];
-    if rest > 1e-9 {
-        fractions.push(rest);
-    }
+    let partial = (rest > 1e-9).then_some(rest);
+    check_history(initial, full + 1.0, options.snapshot_every)?;
+    let full = full as usize;
+    let steps = full + usize::from(partial.is_some());
+    let fractions = std::iter::repeat_n(1.0, full).chain(partial);
     let model = initial.model().clone();
     let mut ends: Vec<MarchedEnd> = (0..model.bars().len())
         .flat_map(|b| {
@@ -431,7 +464,7 @@ pub fn march(
         .map(|end| MarchedEnd {
             end,
             displacement: vec![initial.end_displacement(end)],
-            strain: Vec::with_capacity(fractions.len()),
+            strain: Vec::with_capacity(steps),
         })
         .collect();
     let mut contacts: Vec<ContactHistory> = model
@@ -442,7 +475,7 @@ pub fn march(
         .map(|(i, _)| ContactHistory {
             condition: i,
             gap: vec![initial.gap(i).unwrap_or(0.0)],
-            force: Vec::with_capacity(fractions.len()),
+            force: Vec::with_capacity(steps),
         })
         .collect();
     let e0 = initial.energy();
@@ -455,7 +488,7 @@ pub fn march(
     let mut max_penetration = initial.penetration();
     let mut min_contact_force = f64::INFINITY;
     let mut integrator = Integrator::new(initial.clone(), *options);
-    for (k, &f) in fractions.iter().enumerate() {
+    for (k, f) in fractions.enumerate() {
         let summary = integrator.advance_unchecked(f);
         let state = integrator.state();
         times.push(summary.time);

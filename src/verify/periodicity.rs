@@ -63,8 +63,9 @@ pub struct PeriodicityReport {
 /// Marches `initial` over `periods * period` and compares the final state with it.
 ///
 /// # Errors
-/// [`VerifyError::InvalidParameter`] for a period that is not positive and finite or zero
-/// periods.
+/// [`VerifyError::InvalidParameter`] for a period that is not positive and finite, zero
+/// periods or an infinite march (`periods * period` overflows); [`VerifyError::TooLarge`]
+/// if the histories of the march do not fit in the memory budget (see [`march`]).
 pub fn periodicity_of_state(
     initial: &State,
     period: f64,
@@ -157,7 +158,11 @@ pub fn periodicity_of_state(
 ///
 /// # Errors
 /// Unsupported conditions, a grid that does not match the bars, a solution vector of the
-/// wrong length or with NaN ([`VerifyError`]).
+/// wrong length or with NaN, an `omega` that is not positive and finite or is below
+/// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY) ([`VerifyError`]);
+/// [`VerifyError::TooLarge`] if the cells of the grid or the histories of the
+/// `periods 2 pi / (omega dt)` steps do not fit in the memory budget
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
 pub fn periodicity_check<B: Basis>(
     system: &BarSystem,
     basis: &B,

@@ -5,6 +5,7 @@ use super::wave::{distance_squared, Wave};
 use super::{Condition, Grid, Model, VerifyError};
 use crate::bar::{End, EndRef};
 use crate::fourier::Basis;
+use crate::modal::diagnostics::check_frequency;
 use crate::modal::FieldEvaluator;
 use crate::system::BarSystem;
 
@@ -189,7 +190,9 @@ impl State {
     ///
     /// # Errors
     /// [`VerifyError::Length`] if `x` does not match the basis and system,
-    /// [`VerifyError::InvalidParameter`] for a bad `omega` or `theta`, and the errors of
+    /// [`VerifyError::InvalidParameter`] for a bad `theta` or an `omega` that is not positive
+    /// and finite or is below [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY)
+    /// (subnormal, or with an infinite period), and the errors of
     /// [`Model::from_system`] and [`State::from_cells`].
     pub fn from_harmonic_balance<B: Basis>(
         system: &BarSystem,
@@ -208,7 +211,7 @@ impl State {
                 expected,
             });
         }
-        if !(omega.is_finite() && omega > 0.0) {
+        if check_frequency(omega).is_err() {
             return Err(VerifyError::InvalidParameter {
                 what: "fundamental frequency omega",
                 value: omega,

@@ -1,0 +1,538 @@
+//! Sizes and numeric ranges at the edges of `usize` and `f64`: harmonics, samples, steps,
+//! frequencies, time steps and gaps from zero and subnormals up to `usize::MAX`, `f64::MAX`,
+//! infinity and NaN. Every call either returns a typed error or an `Ok` whose numbers are
+//! all finite; none panics or aborts on an allocation. The errors carry the numbers that
+//! explain them.
+
+use nonsmooth_modes::continuation::linspace;
+use nonsmooth_modes::error::OverBudget;
+use nonsmooth_modes::fourier::{check_memory, Basis, CosineBasis, MEMORY_BUDGET_BYTES};
+use nonsmooth_modes::modal::diagnostics::MIN_FREQUENCY;
+use nonsmooth_modes::modal::{
+    backbone, branch_seed, diagnose, grazing_energy, law_history, BackboneOptions, PeriodGrid,
+};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
+};
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::{
+    BarSystem, HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily,
+};
+use nonsmooth_modes::verify::{
+    periodicity_check, periodicity_of_state, Grid, Model, PeriodicityOptions, State, VerifyError,
+};
+use nonsmooth_modes::{ContinuationError, Error, SettingsError, Solution};
+use proptest::prelude::*;
+use std::f64::consts::PI;
+
+const GAP: f64 = 1e-3;
+/// Few harmonics: the properties are about ranges, not accuracy.
+const HARMONICS: usize = 4;
+
+fn settings() -> HarmonicBalanceSettings {
+    HarmonicBalanceSettings {
+        harmonics: HARMONICS,
+        ..Default::default()
+    }
+}
+
+fn clamped() -> BarSystem {
+    clamped_bar_with_obstacle(GAP).unwrap()
+}
+
+/// A motion of the clamped bar with `HARMONICS` harmonics (the exact mode, truncated).
+fn motion() -> Vec<f64> {
+    ClampedFirstMode::new(GAP, 3.6).unknowns(HARMONICS)
+}
+
+fn config() -> ProptestConfig {
+    ProptestConfig {
+        cases: 256,
+        ..ProptestConfig::default()
+    }
+}
+
+/// Sizes that are either small or from `2^40` to `usize::MAX`. The sizes in between are
+/// valid but allocate up to the memory budget (the limits are tested on their own).
+fn small_or_huge_size() -> impl Strategy<Value = usize> {
+    prop_oneof![
+        0usize..64,
+        (40u32..64).prop_map(|e| 1usize << e),
+        (1usize << 40)..=usize::MAX,
+        Just(usize::MAX),
+    ]
+}
+
+/// Special values of `f64`: zeros, infinities, NaN, the extremes.
+fn special() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(0.0),
+        Just(-0.0),
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        Just(f64::MAX),
+        Just(-f64::MAX),
+        Just(f64::MIN_POSITIVE),
+        Just(MIN_FREQUENCY),
+        Just(f64::from_bits(1)),
+    ]
+}
+
+/// Positive subnormals.
+fn subnormal() -> impl Strategy<Value = f64> {
+    (1u64..1 << 52).prop_map(f64::from_bits)
+}
+
+/// `10^e` for `e` uniform in `exponents`.
+fn log_uniform(exponents: std::ops::Range<f64>) -> impl Strategy<Value = f64> {
+    exponents.prop_map(|e| 10f64.powf(e))
+}
+
+/// Every kind of frequency: special values, subnormals, and positive and negative values
+/// log-uniform over the whole range of `f64`.
+fn any_frequency() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        special(),
+        subnormal(),
+        log_uniform(-324.0..308.25),
+        log_uniform(-308.0..308.25).prop_map(|v| -v),
+    ]
+}
+
+/// Values of `f64` out of a slow window: the special values, subnormals, negative values,
+/// tiny ones `10^e` with `e < tiny` and `10^e` with `e >= ordinary` up to `f64::MAX`.
+fn outside_window(tiny: f64, ordinary: f64) -> impl Strategy<Value = f64> {
+    prop_oneof![
+        special(),
+        subnormal(),
+        log_uniform(-324.0..tiny),
+        log_uniform(ordinary..308.25),
+        log_uniform(-308.0..308.25).prop_map(|v| -v),
+    ]
+}
+
+/// Frequencies for a time-domain march: tiny ones (whose march exceeds the memory budget)
+/// and ordinary to huge ones (short marches), and every invalid value. The frequencies in
+/// between are valid and march for millions of steps, too long for a property test.
+fn march_frequency() -> impl Strategy<Value = f64> {
+    outside_window(-8.0, -0.3)
+}
+
+/// Time steps for a grid: tiny steps (cells beyond the budget) and ordinary to huge ones,
+/// and every invalid value. Steps between `1e-8` and `1e-2` are valid but slow.
+fn time_step() -> impl Strategy<Value = f64> {
+    outside_window(-8.5, -2.0)
+}
+
+fn all_finite<'a>(values: impl IntoIterator<Item = &'a f64>) -> bool {
+    values.into_iter().all(|v| v.is_finite())
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    /// Any harmonics and samples: a basis whose `N = m n_h` is exact, or a typed error.
+    #[test]
+    fn cosine_basis_sizes(m in small_or_huge_size(), nh in small_or_huge_size()) {
+        match CosineBasis::new(m, nh) {
+            Ok(basis) => {
+                prop_assert_eq!(basis.samples(), m * nh);
+                prop_assert_eq!(basis.len(), m + 1);
+            }
+            Err(SettingsError::TooLarge(e)) => {
+                prop_assert!(e.requested_bytes > e.budget_bytes as f64);
+                prop_assert!(m >= 1 << 40 || nh >= 1 << 40);
+            }
+            Err(SettingsError::ZeroHarmonics) => prop_assert_eq!(m, 0),
+            Err(SettingsError::TooFewSamples { got, min }) => {
+                prop_assert_eq!((got, min), (nh, 3));
+            }
+            Err(e) => prop_assert!(false, "unexpected error {e:?}"),
+        }
+    }
+
+    /// Any number of values and any ends: the values, all finite, or a typed error.
+    #[test]
+    fn linspace_sizes(
+        start in prop_oneof![special(), log_uniform(-300.0..308.25), any::<f64>()],
+        end in prop_oneof![special(), log_uniform(-300.0..308.25).prop_map(|v| -v), any::<f64>()],
+        steps in small_or_huge_size(),
+    ) {
+        match linspace(start, end, steps) {
+            Ok(values) => {
+                prop_assert_eq!(values.len(), steps);
+                prop_assert!(all_finite(&values), "{start} {end} {steps}: {values:?}");
+                prop_assert_eq!(values[0], start);
+            }
+            Err(ContinuationError::TooLarge(e)) => {
+                prop_assert!(steps > 1 << 29);
+                prop_assert_eq!(e.requested_bytes, 8.0 * steps as f64);
+            }
+            Err(ContinuationError::InvalidOption { .. }) => {
+                prop_assert!(steps < 2 || !start.is_finite() || !end.is_finite());
+            }
+            Err(e) => prop_assert!(false, "unexpected error {e:?}"),
+        }
+    }
+
+    /// A backbone over a period grid of `2^30` steps or more fails before it starts.
+    #[test]
+    fn period_grids_beyond_the_budget(steps in (1usize << 30)..=usize::MAX) {
+        let options = BackboneOptions {
+            grid: PeriodGrid { start: 3.9, end: 3.1, steps },
+            ..Default::default()
+        };
+        let result = backbone(&clamped(), settings(), &options, SemismoothNewton::default());
+        prop_assert!(
+            matches!(result, Err(Error::Continuation(ContinuationError::TooLarge(_)))),
+            "{result:?}"
+        );
+    }
+
+    /// Post-processing at any frequency: finite answers or a typed error.
+    #[test]
+    fn post_processing_frequencies(omega in any_frequency(), refinement in 0usize..4) {
+        let system = clamped();
+        let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+        let x = motion();
+        if let Ok(h) = law_history(&problem, &x, omega, 0, 16) {
+            prop_assert!(all_finite(h.time.iter().chain(&h.gap).chain(&h.force).chain(&h.residual)));
+        }
+        if let Ok(d) = diagnose(&problem, &x, omega, refinement) {
+            prop_assert!(all_finite(&d.residual_norm));
+            prop_assert!(d.max_penetration.is_finite() && d.min_contact_force.is_finite());
+            prop_assert!(d.energy_drift.is_finite());
+        }
+        let below = !(omega.is_finite() && omega >= MIN_FREQUENCY);
+        match Solution::new(&problem, &x, omega) {
+            Ok(s) => {
+                prop_assert!(!below);
+                prop_assert!(s.period().is_finite());
+                if let Ok(h) = s.end_history(system.bar_id(0).unwrap().right(), 8) {
+                    prop_assert!(all_finite(h.time.iter().chain(&h.displacement).chain(&h.strain)));
+                }
+                if let Ok(g) = s.displacement_grid(0, 3, 4) {
+                    prop_assert!(all_finite(g.time.iter().chain(&g.displacement)));
+                }
+            }
+            Err(SettingsError::NotPositive { value, .. }) => {
+                prop_assert!(omega.is_nan() || omega <= 0.0 || omega.is_infinite());
+                prop_assert!(value.to_bits() == omega.to_bits());
+            }
+            Err(SettingsError::FrequencyTooSmall { omega: o, min, .. }) => {
+                prop_assert_eq!(o, omega);
+                prop_assert_eq!(min, MIN_FREQUENCY);
+                prop_assert!(omega > 0.0 && omega < MIN_FREQUENCY);
+            }
+            Err(e) => prop_assert!(false, "unexpected error {e:?}"),
+        }
+        if below {
+            prop_assert!(law_history(&problem, &x, omega, 0, 16).is_err());
+            prop_assert!(diagnose(&problem, &x, omega, refinement.max(1)).is_err());
+            prop_assert!(ParameterFamily::new(clamped_bar_with_obstacle, settings(), omega).is_err());
+        }
+        let mut seeded = NonsmoothSystem::new(&system, settings()).unwrap();
+        if let Ok(seed) = branch_seed(&mut seeded, 1, 1, omega) {
+            prop_assert!(!below);
+            prop_assert!(all_finite(&seed));
+        }
+    }
+
+    /// The periodicity check at any frequency: a finite report or a typed error, never an
+    /// allocation of one entry per step beyond the budget.
+    #[test]
+    fn periodicity_frequencies(omega in march_frequency(), periods in 1usize..3) {
+        let system = clamped();
+        let basis = settings().cosine_basis().unwrap();
+        let options = PeriodicityOptions { dt: 0.05, periods, ..Default::default() };
+        match periodicity_check(&system, &basis, &motion(), omega, &options) {
+            Ok(r) => {
+                prop_assert!(omega >= MIN_FREQUENCY);
+                prop_assert!(all_finite(&[
+                    r.period, r.dt, r.defect, r.initial_norm, r.displacement_defect,
+                    r.initial_energy, r.energy_drift, r.initial_penetration, r.max_penetration,
+                ]));
+            }
+            Err(VerifyError::TooLarge(e)) => {
+                prop_assert!(e.requested_bytes > e.budget_bytes as f64);
+            }
+            Err(VerifyError::InvalidParameter { .. } | VerifyError::NonFinite { .. }) => {}
+            Err(e) => prop_assert!(false, "unexpected error {e:?}"),
+        }
+    }
+
+    /// `2^40` periods or more of an ordinary frequency: the march is over the budget. (Huge
+    /// frequencies would make such marches valid but long.)
+    #[test]
+    fn periodicity_periods(omega in 0.5f64..1e3, periods in (1usize << 40)..=usize::MAX) {
+        let system = clamped();
+        let basis = settings().cosine_basis().unwrap();
+        let options = PeriodicityOptions { dt: 0.05, periods, ..Default::default() };
+        let result = periodicity_check(&system, &basis, &motion(), omega, &options);
+        prop_assert!(matches!(result, Err(VerifyError::TooLarge(_))), "{result:?}");
+    }
+
+    /// Any time step, with or without adjusting the grid: a finite report or a typed error.
+    #[test]
+    fn periodicity_time_steps(dt in time_step(), adjust_grid in any::<bool>()) {
+        let system = clamped();
+        let basis = settings().cosine_basis().unwrap();
+        let options = PeriodicityOptions { dt, adjust_grid, ..Default::default() };
+        match periodicity_check(&system, &basis, &motion(), 2.0 * PI / 3.6, &options) {
+            Ok(r) => {
+                prop_assert!(all_finite(&[r.defect, r.dt, r.energy_drift, r.max_penetration]));
+            }
+            Err(
+                VerifyError::TooLarge(_)
+                | VerifyError::InvalidTimeStep { .. }
+                | VerifyError::NonMatchingGrid { .. }
+                | VerifyError::NoAdmissibleGrid { .. },
+            ) => {}
+            Err(e) => prop_assert!(false, "unexpected error {e:?}"),
+        }
+        let model = Model::from_system(&system).unwrap();
+        for grid in [Grid::new(&model, dt), Grid::nearest(&model, dt)].into_iter().flatten() {
+            prop_assert!(grid.dt().is_finite() && grid.dt() > 0.0);
+        }
+    }
+
+    /// Any gap: a positive, finite, normal `E_g`, or a typed error naming the gap.
+    #[test]
+    fn grazing_energy_gaps(
+        gap in prop_oneof![log_uniform(-300.0..300.0), special(), subnormal()],
+        robin in any::<bool>(),
+    ) {
+        let system = if robin {
+            robin_bar_with_obstacle(0.5, gap)
+        } else {
+            clamped_bar_with_obstacle(gap)
+        };
+        let Ok(system) = system else {
+            prop_assert!(!(gap > 0.0 && gap.is_finite()));
+            return Ok(());
+        };
+        match grazing_energy(&system) {
+            Ok((e_g, _)) => prop_assert!(e_g.is_normal() && e_g > 0.0, "{gap}: {e_g}"),
+            Err(SettingsError::GrazingEnergyOutOfRange { law, gap: g, energy }) => {
+                prop_assert_eq!(law, 0);
+                prop_assert_eq!(g, gap);
+                prop_assert!(!(energy.is_normal() && energy > 0.0));
+                prop_assert!(!(1e-150..=1e150).contains(&gap));
+            }
+            Err(e) => prop_assert!(false, "unexpected error {e:?}"),
+        }
+    }
+}
+
+#[test]
+fn too_large_basis_says_how_much_memory_it_needs() {
+    let e = CosineBasis::new(100_000, 3).unwrap_err();
+    assert!(matches!(e, SettingsError::TooLarge { .. }));
+    let message = e.to_string();
+    for part in [
+        "cosine basis",
+        "8.004e10 bytes",
+        "74.5 GiB",
+        "4294967296 bytes",
+        "4.0 GiB",
+    ] {
+        assert!(message.contains(part), "{part} not in {message}");
+    }
+    // A product that overflows `usize` is reported in bytes too.
+    let message = CosineBasis::new(usize::MAX, usize::MAX)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("4.628e40 bytes"), "{message}");
+    assert!(message.contains("(3.8e16 YiB)"), "{message}");
+}
+
+#[test]
+fn too_large_grid_of_values_says_how_much_memory_it_needs() {
+    let e = linspace(3.9, 3.1, usize::MAX).unwrap_err();
+    assert!(matches!(e, ContinuationError::TooLarge(_)));
+    let message = e.to_string();
+    assert!(message.contains("1.476e20 bytes (128.0 EiB)"), "{message}");
+    let message = linspace(3.9, 3.1, 1 << 40).unwrap_err().to_string();
+    assert!(message.contains("8.796e12 bytes (8.0 TiB)"), "{message}");
+    // The budget holds `2^29` values, not one more.
+    let e = linspace(3.9, 3.1, (1 << 29) + 1).unwrap_err();
+    assert!(e.to_string().contains("4.295e9 bytes (4.0 GiB)"), "{e}");
+}
+
+#[test]
+fn too_large_marches_and_grids_say_how_much_memory_they_need() {
+    let system = clamped();
+    let basis = settings().cosine_basis().unwrap();
+    let options = PeriodicityOptions::default();
+    // Omega = 1e-6: 2.5e9 steps of dt = 1/400, 8 doubles each.
+    let e = periodicity_check(&system, &basis, &motion(), 1e-6, &options).unwrap_err();
+    let VerifyError::TooLarge(over) = &e else {
+        panic!("expected TooLarge, got {e:?}");
+    };
+    let steps = (2.0 * PI / 1e-6 * 400.0).floor() + 1.0;
+    assert_eq!(over.requested_bytes, steps * 8.0 * 8.0);
+    assert!(e.to_string().contains("1.608e11 bytes (149.8 GiB)"), "{e}");
+    // 1e11 cells of dt = 1e-11.
+    let model = Model::from_system(&system).unwrap();
+    let e = Grid::new(&model, 1e-11).unwrap_err();
+    assert!(e.to_string().contains("1.280e13 bytes (11.6 TiB)"), "{e}");
+    // A subnormal step with adjust_grid: the cells overflow, reported as infinite.
+    let e = Grid::nearest(&model, 1e-320).unwrap_err();
+    assert!(e.to_string().contains("needs inf bytes"), "{e}");
+    // Periods that overflow the march.
+    let state = State::from_harmonic_balance(&system, &basis, &motion(), 1.7, 0.0, 0.01).unwrap();
+    let many = PeriodicityOptions {
+        periods: usize::MAX,
+        ..options
+    };
+    assert!(matches!(
+        periodicity_of_state(&state, 3.7, &many),
+        Err(VerifyError::TooLarge(_))
+    ));
+}
+
+#[test]
+fn over_budget_converts_into_every_error() {
+    let over = check_memory("a test request", 1e12).unwrap_err();
+    assert_eq!(
+        over,
+        OverBudget {
+            what: "a test request",
+            requested_bytes: 8e12,
+            budget_bytes: MEMORY_BUDGET_BYTES,
+        }
+    );
+    assert_eq!(
+        over.to_string(),
+        "a test request needs 8.000e12 bytes (7.3 TiB), more than the memory budget of 4294967296 bytes (4.0 GiB)"
+    );
+    let error: Error = over.into();
+    assert_eq!(error, Error::Settings(SettingsError::TooLarge(over)));
+    assert_eq!(error.to_string(), over.to_string());
+    assert_eq!(
+        VerifyError::from(over).to_string(),
+        ContinuationError::from(over).to_string()
+    );
+}
+
+#[test]
+fn tiny_frequencies_are_rejected_with_the_limit() {
+    let system = clamped();
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    let x = motion();
+    let e = Solution::new(&problem, &x, 1e-310).unwrap_err();
+    assert_eq!(
+        e,
+        SettingsError::FrequencyTooSmall {
+            what: "fundamental frequency",
+            omega: 1e-310,
+            min: MIN_FREQUENCY,
+        }
+    );
+    let message = e.to_string();
+    assert!(message.contains("1e-310"), "{message}");
+    assert!(message.contains("3.495137843790463e-308"), "{message}");
+    assert!((2.0 * PI / MIN_FREQUENCY).is_finite());
+    assert!(MIN_FREQUENCY.is_normal());
+    assert!(Solution::new(&problem, &x, MIN_FREQUENCY).is_ok());
+    // Zero and negative frequencies keep their error.
+    for omega in [0.0, -1.0, f64::NAN] {
+        assert!(matches!(
+            Solution::new(&problem, &x, omega),
+            Err(SettingsError::NotPositive { .. })
+        ));
+        assert!(matches!(
+            diagnose(&problem, &x, omega, 8),
+            Err(SettingsError::NotPositive { .. })
+        ));
+        assert!(matches!(
+            law_history(&problem, &x, omega, 0, 8),
+            Err(SettingsError::NotPositive { .. })
+        ));
+    }
+    for omega in [1e-310, 3e-308] {
+        assert!(matches!(
+            diagnose(&problem, &x, omega, 8),
+            Err(SettingsError::FrequencyTooSmall { .. })
+        ));
+        assert!(matches!(
+            ParameterFamily::new(clamped_bar_with_obstacle, settings(), omega),
+            Err(Error::Settings(SettingsError::FrequencyTooSmall { .. }))
+        ));
+        let mut seeded = NonsmoothSystem::new(&system, settings()).unwrap();
+        assert!(matches!(
+            branch_seed(&mut seeded, 1, 1, omega),
+            Err(Error::Settings(SettingsError::FrequencyTooSmall { .. }))
+        ));
+        let basis = settings().cosine_basis().unwrap();
+        assert!(matches!(
+            periodicity_check(&system, &basis, &x, omega, &PeriodicityOptions::default()),
+            Err(VerifyError::InvalidParameter { .. })
+        ));
+    }
+}
+
+#[test]
+fn grazing_energy_out_of_range_names_the_gap() {
+    let e = grazing_energy(&clamped_bar_with_obstacle(1e-300).unwrap()).unwrap_err();
+    assert!(matches!(
+        e,
+        SettingsError::GrazingEnergyOutOfRange { law: 0, gap, energy } if gap == 1e-300 && energy == 0.0
+    ));
+    let message = e.to_string();
+    assert!(message.contains("law 0 (gap 1e-300)"), "{message}");
+    // Subnormal: positive but it has lost precision.
+    let e = grazing_energy(&clamped_bar_with_obstacle(1e-155).unwrap()).unwrap_err();
+    assert!(e.to_string().contains("gap 1e-155"), "{e}");
+    // Overflow.
+    let e = grazing_energy(&clamped_bar_with_obstacle(1e160).unwrap()).unwrap_err();
+    assert!(e.to_string().contains("is inf"), "{e}");
+    // Within range, the value of the formula `pi^2 g0^2 / 16`.
+    let (e_g, _) = grazing_energy(&clamped_bar_with_obstacle(1e-150).unwrap()).unwrap();
+    assert!((e_g / (PI * PI * 1e-300 / 16.0) - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn non_finite_results_name_the_quantity_and_the_frequency() {
+    let system = clamped();
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    // The harmonics of f64::MAX overflow.
+    let e = law_history(&problem, &motion(), f64::MAX, 0, 8).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "a value of a law history is not finite at omega = 1.7976931348623157e308"
+    );
+    assert!(matches!(
+        diagnose(&problem, &motion(), f64::MAX, 8),
+        Err(SettingsError::NonFiniteResult { omega, .. }) if omega == f64::MAX
+    ));
+}
+
+#[test]
+fn huge_post_processing_sizes_are_typed_errors() {
+    let system = clamped();
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    let x = motion();
+    let solution = Solution::new(&problem, &x, 1.7).unwrap();
+    let end = system.bar_id(0).unwrap().right();
+    for samples in [1 << 40, usize::MAX] {
+        assert!(matches!(
+            solution.end_history(end, samples),
+            Err(SettingsError::TooLarge(_))
+        ));
+        assert!(matches!(
+            solution.law_history(0, samples),
+            Err(SettingsError::TooLarge(_))
+        ));
+        assert!(matches!(
+            solution.displacement_grid(0, samples, samples),
+            Err(SettingsError::TooLarge(_))
+        ));
+        assert!(matches!(
+            solution.diagnose(samples),
+            Err(SettingsError::TooLarge(_))
+        ));
+    }
+    assert!(solution.diagnose(8).is_ok());
+}
