@@ -536,3 +536,23 @@ fn huge_post_processing_sizes_are_typed_errors() {
     }
     assert!(solution.diagnose(8).is_ok());
 }
+
+/// The energy of a motion stays finite down to the smallest frequencies: where the wave
+/// numbers' squares underflow to zero, equal squares take the diagonal integrals (no division
+/// by `k_i^2 - k_j^2 = 0`).
+#[test]
+fn energy_is_finite_at_tiny_frequencies() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let basis = CosineBasis::new(8, 30).unwrap();
+    let n = basis.len() * system.unknowns_per_harmonic();
+    let x: Vec<f64> = (0..n).map(|i| 1e-4 * ((i % 5) as f64 - 2.0)).collect();
+    let reference = nonsmooth_modes::modal::energy(&system, &basis, &x, 1e-100);
+    assert!(reference.is_finite() && reference > 0.0);
+    for omega in [1e-160, 1e-200, 1e-300] {
+        let e = nonsmooth_modes::modal::energy(&system, &basis, &x, omega);
+        assert!(
+            (e / reference - 1.0).abs() < 1e-12,
+            "omega {omega:e}: {e:e} vs {reference:e}"
+        );
+    }
+}

@@ -256,7 +256,7 @@ impl Harmonics {
         let (mut strain, mut kinetic) = (0.0, 0.0);
         for j in 0..i {
             let hj = self.get(j);
-            let (int_uu, int_dd) = if hj.k == hi.k {
+            let (int_uu, int_dd) = if hj.k2 == hi.k2 {
                 diagonal.integrals(hi, &hj)
             } else {
                 green(hi, &self.blocks[j / LANES], j % LANES)
