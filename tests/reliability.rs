@@ -12,7 +12,7 @@ use nonsmooth_modes::modal::{
     backbone, branch_seed, diagnose, grazing_energy, law_history, BackboneOptions, PeriodGrid,
 };
 use nonsmooth_modes::reference::{
-    clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
+    clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::{
@@ -554,5 +554,45 @@ fn energy_is_finite_at_tiny_frequencies() {
             (e / reference - 1.0).abs() < 1e-12,
             "omega {omega:e}: {e:e} vs {reference:e}"
         );
+    }
+}
+
+/// A problem whose Gram matrices, reduced matrix or dense Jacobian exceed the memory budget is
+/// a typed error that says how much it needs, before anything is allocated; the paper's sizes
+/// build.
+#[test]
+fn problems_beyond_the_budget_are_typed_errors() {
+    let two = two_bars_in_contact(
+        nonsmooth_modes::bar::Bar::new(0.95, 1.0, 1.0).unwrap(),
+        1e-3,
+    )
+    .unwrap();
+    for harmonics in [20, 80, 640] {
+        let settings = HarmonicBalanceSettings {
+            harmonics,
+            ..Default::default()
+        };
+        assert!(
+            NonsmoothSystem::new(&two, settings).is_ok(),
+            "m = {harmonics}"
+        );
+    }
+    // 20 000 harmonics fit the basis alone but not the problem of two bars (its dense
+    // Jacobian has 80 000^2 entries).
+    let settings = HarmonicBalanceSettings {
+        harmonics: 20_000,
+        samples_per_harmonic: 4,
+        ..Default::default()
+    };
+    assert!(settings.cosine_basis().is_ok());
+    match NonsmoothSystem::new(&two, settings) {
+        Err(Error::Settings(SettingsError::TooLarge(over))) => {
+            assert!(over.requested_bytes > over.budget_bytes as f64);
+            assert!(
+                over.to_string().contains("harmonic-balance problem"),
+                "{over}"
+            );
+        }
+        other => panic!("{:?}", other.map(|p| p.dimension())),
     }
 }

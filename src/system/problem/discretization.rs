@@ -7,7 +7,7 @@
 
 use crate::bc::LawSamples;
 use crate::error::{Error, SettingsError};
-use crate::fourier::{Basis, CosineBasis};
+use crate::fourier::{check_memory, Basis, CosineBasis};
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, Layout};
 
@@ -37,12 +37,27 @@ pub struct Discretization<B: Basis = CosineBasis> {
     unit_gram: Vec<f64>,
 }
 
+/// Doubles a problem of `len` basis functions, `samples` folded samples, `unknowns` per
+/// coefficient and `laws` unilateral laws holds or lets a solver hold, as floats so that the
+/// count cannot overflow: the Gram matrices (the unit one and two per law), the law samples
+/// (ten buffers per law), the reduced matrix of the structured step and the dense Jacobian a
+/// solver forms where the structured step is not available.
+fn problem_doubles(len: usize, samples: usize, unknowns: usize, laws: usize) -> f64 {
+    let (len, samples, unknowns, laws) = (len as f64, samples as f64, unknowns as f64, laws as f64);
+    let dimension = len * unknowns;
+    len * len * (1.0 + 2.0 * laws)
+        + 10.0 * laws * samples
+        + (len * laws).powi(2)
+        + dimension * dimension
+}
+
 impl<B: Basis> Discretization<B> {
     /// `system` with `basis` and complementarity parameter `a_c`, without kink blend.
     ///
     /// # Errors
     /// [`SettingsError::NotPositive`] for a bad `a_c`, [`SettingsError::NoContact`] for a
-    /// linear system.
+    /// linear system, [`SettingsError::TooLarge`] for a problem beyond the memory budget
+    /// ([`crate::fourier::MEMORY_BUDGET_BYTES`]).
     pub(super) fn new(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
         if !(a_c.is_finite() && a_c > 0.0) {
             return Err(SettingsError::NotPositive {
@@ -60,8 +75,13 @@ impl<B: Basis> Discretization<B> {
             .laws()
             .map(|l| (l.gap().offset, l.force().offset))
             .collect();
-        // Laws are evaluated on the basis' folded samples only (the others repeat them).
         let len = basis.len();
+        check_memory(
+            "harmonic-balance problem",
+            problem_doubles(len, basis.folded_samples(), unknowns, laws),
+        )
+        .map_err(SettingsError::TooLarge)?;
+        // Laws are evaluated on the basis' folded samples only (the others repeat them).
         let mut unit_gram = vec![0.0; len * len];
         basis.weighted_gram_folded(&vec![1.0; basis.folded_samples()], &mut unit_gram);
         Ok(Self {

@@ -141,8 +141,9 @@ impl<B: Basis> NonsmoothSystem<B> {
     ///
     /// # Errors
     /// [`SettingsError::NotPositive`] for a bad complementarity parameter `a_c`,
-    /// [`SettingsError::NoContact`] for a
-    /// linear system.
+    /// [`SettingsError::NoContact`] for a linear system, [`SettingsError::TooLarge`] for a
+    /// problem beyond the memory budget ([`crate::fourier::MEMORY_BUDGET_BYTES`]: the Gram
+    /// matrices, law samples, reduced matrix and the dense Jacobian a solver may form).
     pub fn with_basis(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
         let description = Discretization::new(system, basis, a_c)?;
         let ws = Workspace {
