@@ -78,6 +78,18 @@ pub enum ModelError {
         /// Number of unilateral laws (0 or 1).
         laws: usize,
     },
+    /// A condition gives a coefficient (of a linear row or of its law's gap or force), an
+    /// offset or a stored energy that is not finite.
+    #[error("condition `{condition}` gives a non-finite {what}: {value}")]
+    NonFiniteCoefficient {
+        /// Name of the condition.
+        condition: String,
+        /// Where: "linear-row coefficient", "gap observable", "contact-force observable" or
+        /// "stored energy".
+        what: &'static str,
+        /// The value.
+        value: f64,
+    },
 }
 
 /// Errors in harmonic-balance settings or evaluation points.
@@ -102,6 +114,26 @@ pub enum SettingsError {
         what: &'static str,
         /// The rejected value.
         value: f64,
+    },
+    /// A value that may have any sign is NaN or infinite.
+    #[error("{what} must be finite, got {value}")]
+    NotFinite {
+        /// Which value.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A value outside the range in which the computation stays finite.
+    #[error("{what} must lie in [{min:e}, {max:e}], got {value:e}")]
+    OutOfRange {
+        /// Which value.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// The smallest accepted value.
+        min: f64,
+        /// The largest accepted value.
+        max: f64,
     },
     /// A vector has the wrong length.
     #[error("{what} has length {got}, expected {expected}")]

@@ -30,7 +30,7 @@ use crate::modal::diagnostics::{
     check_finite, check_motion, diagnose, displacement_grid, end_history, law_history, EndHistory,
     FieldGrid, LawHistory, PointDiagnostics,
 };
-use crate::modal::energy::{energy, energy_at};
+use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
 use crate::modal::linear::grazing_energy;
 use crate::system::{BarSystem, NonsmoothSystem};
@@ -89,19 +89,34 @@ impl<'a, B: Basis> Solution<'a, B> {
     }
 
     /// The mechanical energy `E` at `t = 0` (formulation §7).
-    pub fn energy(&self) -> f64 {
-        energy(self.system(), self.problem.basis(), self.x, self.omega)
+    ///
+    /// # Errors
+    /// [`SettingsError::NonFiniteResult`] if it exceeds the range of `f64` (a huge motion or
+    /// frequency: the strain energy grows as `(k A)^2`, `k = j Omega / c`).
+    pub fn energy(&self) -> Result<f64, SettingsError> {
+        self.energy_at(0.0)
     }
 
     /// The energy at phase `theta = Omega t` (constant for an exact motion).
-    pub fn energy_at(&self, theta: f64) -> f64 {
-        energy_at(
+    ///
+    /// # Errors
+    /// As [`Solution::energy`]; [`SettingsError::NotFinite`] for a non-finite `theta`.
+    pub fn energy_at(&self, theta: f64) -> Result<f64, SettingsError> {
+        if !theta.is_finite() {
+            return Err(SettingsError::NotFinite {
+                what: "phase theta",
+                value: theta,
+            });
+        }
+        let e = energy_at(
             self.system(),
             self.problem.basis(),
             self.x,
             self.omega,
             theta,
-        )
+        );
+        check_finite("energy", self.omega, [&e])?;
+        Ok(e)
     }
 
     /// `E / E_g`, with `E_g` the system's first grazing energy
@@ -109,10 +124,10 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// stored `E_g` in loops).
     ///
     /// # Errors
-    /// See [`grazing_energy`].
+    /// See [`grazing_energy`] and [`Solution::energy`].
     pub fn energy_normalized(&self) -> Result<f64, SettingsError> {
         let (e_g, _) = grazing_energy(self.system())?;
-        Ok(self.energy() / e_g)
+        Ok(self.energy()? / e_g)
     }
 
     /// Displacement, velocity and strain anywhere in any bar.

@@ -206,3 +206,106 @@ fn a_contact_of_an_end_with_itself_is_rejected_at_the_call() {
         Err(ModelError::RepeatedEnd { end, .. }) if end == bar.right()
     ));
 }
+
+/// How a downstream condition on one end misbehaves.
+#[derive(Debug, Clone, Copy)]
+enum Fault {
+    /// Reads the stiffness of an end of a bar the assembly lacks.
+    ReadsForeignStiffness,
+    /// Puts a term of its row on such an end.
+    RowOnForeignEnd,
+    /// Only at the harmonic `omega = 1`, not at the constant term.
+    RowOnForeignEndAtHarmonic,
+    /// Gives its row a coefficient of this value.
+    Coefficient(f64),
+    /// Gives the derivative of its row's coefficient this value.
+    Derivative(f64),
+    /// Reads the displacement of a foreign end in its stored energy.
+    EnergyOfForeignEnd,
+    /// Stores this energy.
+    Energy(f64),
+}
+
+/// A spring to the ground (the row `u + p = 0`) that misbehaves in one way.
+#[derive(Debug)]
+struct Faulty {
+    end: EndRef,
+    foreign: EndRef,
+    fault: Fault,
+}
+
+impl BoundaryCondition for Faulty {
+    fn name(&self) -> String {
+        format!("faulty ({:?}) at {}", self.fault, self.end)
+    }
+    fn ends(&self) -> Vec<EndRef> {
+        vec![self.end]
+    }
+    fn linear_rows(&self, omega: f64, stiffness: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
+        let mut spring = Term::new(self.end, Quantity::OutwardStrain, stiffness(self.end));
+        let mut u = Term::new(self.end, Quantity::Displacement, 1.0);
+        match self.fault {
+            Fault::ReadsForeignStiffness => spring.coefficient = stiffness(self.foreign),
+            Fault::RowOnForeignEnd => u.end = self.foreign,
+            Fault::RowOnForeignEndAtHarmonic if omega > 0.0 => u.end = self.foreign,
+            Fault::Coefficient(c) => u.coefficient = c,
+            Fault::Derivative(d) => u.d_coefficient = d,
+            _ => {}
+        }
+        rows.push(&[u, spring]);
+    }
+    fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
+        match self.fault {
+            Fault::EnergyOfForeignEnd => displacement(self.foreign).powi(2),
+            Fault::Energy(e) => e,
+            _ => 0.5 * displacement(self.end).powi(2),
+        }
+    }
+}
+
+/// A downstream condition that names an end of a bar the assembly lacks, in a row, a
+/// stiffness it reads or its stored energy, or that gives a non-finite number, is a typed
+/// error at the call (not a panic then or later), and is not added.
+#[test]
+fn a_downstream_condition_is_checked_in_what_it_reads_and_gives() {
+    let foreign = foreign_bar().right();
+    let (mut b, bar) = one_bar();
+    let faulty = |fault| Faulty {
+        end: bar.right(),
+        foreign,
+        fault,
+    };
+    for fault in [
+        Fault::ReadsForeignStiffness,
+        Fault::RowOnForeignEnd,
+        Fault::RowOnForeignEndAtHarmonic,
+        Fault::EnergyOfForeignEnd,
+    ] {
+        assert_unknown_bar(b.add_condition(faulty(fault)), "faulty");
+    }
+    for fault in NOT_FINITE.iter().flat_map(|&v| {
+        [
+            Fault::Coefficient(v),
+            Fault::Derivative(v),
+            Fault::Energy(v),
+        ]
+    }) {
+        match b.add_condition(faulty(fault)) {
+            Err(ModelError::NonFiniteCoefficient {
+                condition, value, ..
+            }) => {
+                assert!(condition.starts_with("faulty"), "{condition}");
+                assert!(!value.is_finite(), "{fault:?}: {value}");
+            }
+            other => panic!("{fault:?}: expected NonFiniteCoefficient, got {other:?}"),
+        }
+    }
+    // Nothing was added, and the well-behaved condition builds.
+    b.dirichlet(bar.left()).unwrap();
+    assert_eq!(
+        b.build().unwrap_err(),
+        ModelError::UnconstrainedEnd { end: bar.right() }
+    );
+    b.add_condition(faulty(Fault::Coefficient(2.0))).unwrap();
+    assert_eq!(b.build().unwrap().conditions().count(), 2);
+}

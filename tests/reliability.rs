@@ -16,7 +16,7 @@ use nonsmooth_modes::reference::{
 };
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::{
-    BarSystem, HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily,
+    BarSystem, HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily, COMPLEMENTARITY_RANGE,
 };
 use nonsmooth_modes::verify::{
     periodicity_check, periodicity_of_state, Grid, Model, PeriodicityOptions, State, VerifyError,
@@ -594,5 +594,92 @@ fn problems_beyond_the_budget_are_typed_errors() {
             );
         }
         other => panic!("{:?}", other.map(|p| p.dimension())),
+    }
+}
+
+/// At huge frequencies the energy of a fixed motion grows as `Omega^2` (its strain energy is
+/// `(k A)^2`-sized, `k = j Omega / c`) and stays finite while that fits in an `f64`; beyond,
+/// `Solution::energy` is a typed error, not NaN.
+#[test]
+fn energy_is_finite_up_to_huge_frequencies_and_a_typed_error_beyond() {
+    let system = clamped();
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    let x: Vec<f64> = (0..problem.dimension())
+        .map(|i| 1e-4 * ((i % 5) as f64 - 2.0))
+        .collect();
+    let energy = |omega: f64| Solution::new(&problem, &x, omega).unwrap().energy();
+    let base = energy(1e10).unwrap();
+    for e in [40, 80, 120, 150] {
+        let omega = 10f64.powi(e);
+        let ratio = energy(omega).unwrap() / base / (omega / 1e10).powi(2);
+        assert!((ratio - 1.0).abs() < 1e-9, "omega 1e{e}: ratio {ratio}");
+    }
+    for omega in [1e160, 1e300, f64::MAX] {
+        match energy(omega) {
+            Err(SettingsError::NonFiniteResult { what, omega: o }) => {
+                assert_eq!((what, o), ("energy", omega));
+            }
+            other => panic!("omega {omega:e}: {other:?}"),
+        }
+    }
+    let mode = Solution::new(&problem, &x, 1.0).unwrap();
+    for theta in [f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            mode.energy_at(theta),
+            Err(SettingsError::NotFinite { .. })
+        ));
+    }
+}
+
+/// `modal::energy` is a low-level function with a documented length contract: it panics,
+/// with a message, on unknowns of the wrong length (`Solution::new` returns
+/// `SettingsError::Length` instead).
+#[test]
+#[should_panic(expected = "modal::energy: the unknowns have the wrong length")]
+fn energy_of_unknowns_of_the_wrong_length_panics_as_documented() {
+    let system = clamped();
+    let basis = CosineBasis::new(HARMONICS, 30).unwrap();
+    let x = vec![0.0; basis.len() * system.unknowns_per_harmonic() + 1];
+    nonsmooth_modes::modal::energy(&system, &basis, &x, 1.0);
+}
+
+/// The complementarity parameter is accepted on `COMPLEMENTARITY_RANGE`, where the residual
+/// and Jacobian of a motion are finite at both ends; beyond, a typed error names the range.
+#[test]
+fn complementarity_parameters_keep_the_residual_finite_or_are_rejected() {
+    use nonsmooth_modes::continuation::ContinuationProblem;
+    use nonsmooth_modes::linalg::DenseMatrix;
+    use nonsmooth_modes::solve::Problem;
+    let (min, max) = COMPLEMENTARITY_RANGE;
+    let system = clamped();
+    let x = motion();
+    for a_c in [min, 1e-3, 4.0, 1e3, max] {
+        let settings = HarmonicBalanceSettings {
+            complementarity: a_c,
+            ..settings()
+        };
+        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+        problem.set_parameter(2.0 * PI / 3.6);
+        let mut f = vec![0.0; x.len()];
+        problem.residual(&x, &mut f);
+        let mut jac = DenseMatrix::zeros(x.len(), x.len());
+        problem.jacobian(&x, &mut jac);
+        assert!(all_finite(&f), "a_c {a_c:e}: residual {f:?}");
+        assert!(jac.is_finite(), "a_c {a_c:e}: Jacobian");
+    }
+    for a_c in [min / 2.0, 1e-300, 5e-324, max * 2.0, 1e300, f64::MAX] {
+        let settings = HarmonicBalanceSettings {
+            complementarity: a_c,
+            ..settings()
+        };
+        match NonsmoothSystem::new(&system, settings) {
+            Err(Error::Settings(SettingsError::OutOfRange {
+                value,
+                min: lo,
+                max: hi,
+                ..
+            })) => assert_eq!((value, lo, hi), (a_c, min, max)),
+            other => panic!("a_c {a_c:e}: {:?}", other.map(|p| p.dimension())),
+        }
     }
 }

@@ -116,8 +116,11 @@ impl LinearRows {
 /// A boundary condition on one or more bar ends.
 ///
 /// Every end it lists needs one equation: `linear_rows` must push as many rows as
-/// `ends().len()` minus one if it has a unilateral law, minus zero otherwise (the assembly
-/// checks this).
+/// `ends().len()` minus one if it has a unilateral law, minus zero otherwise, at every
+/// `omega`. Its rows, observables, stiffness reads and stored energy may name only ends of the
+/// assembly's bars, with finite coefficients. The assembly checks all this at `omega = 0` and
+/// `omega = 1` ([`crate::system::AssemblyBuilder::add_condition`]); a condition that changes
+/// its ends or its row count with `omega` breaks the contract and may panic later.
 ///
 /// # Example: a condition written outside the crate
 ///

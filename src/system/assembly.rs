@@ -1,8 +1,11 @@
 //! Assembly builder and validated bar system.
 
 use crate::bar::{Bar, BarId, EndRef};
-use crate::bc::{BoundaryCondition, Contact, Dirichlet, Neumann, Robin, Signorini, UnilateralLaw};
+use crate::bc::{
+    BoundaryCondition, Contact, Dirichlet, Neumann, Robin, Signorini, Term, UnilateralLaw,
+};
 use crate::error::ModelError;
+use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -51,7 +54,10 @@ impl AssemblyBuilder {
     /// The error of the condition's [`BoundaryCondition::validate`];
     /// [`ModelError::UnknownBar`] if it lists an end of a bar this builder has not added,
     /// [`ModelError::RepeatedEnd`] if it lists an end twice, [`ModelError::EquationCount`] if
-    /// its rows and law do not give one equation per end. The builder is then unchanged.
+    /// its rows and law do not give one equation per end (at `omega = 0` or `1`);
+    /// [`ModelError::UnknownBar`] too if a row, an observable, a stiffness it reads or its
+    /// stored energy names an end of another bar, and [`ModelError::NonFiniteCoefficient`] if
+    /// one of these numbers is not finite. The builder is then unchanged.
     pub fn add_condition(
         &mut self,
         condition: impl BoundaryCondition + 'static,
@@ -111,18 +117,16 @@ impl AssemblyBuilder {
     }
 
     /// Checks one condition on its own: its parameters, that its ends belong to bars of this
-    /// builder and are distinct, and that it gives one equation per end.
+    /// builder and are distinct, and what it gives at the constant term and at one harmonic
+    /// (`omega = 0` and `1`): one equation per end, finite coefficients on ends of this
+    /// builder's bars (its rows, its law's observables and its stored energy are read through
+    /// guards, so a condition written downstream that names a foreign end gets a typed error
+    /// here instead of a panic later).
     fn check(&self, condition: &dyn BoundaryCondition) -> Result<(), ModelError> {
         condition.validate()?;
         let ends = condition.ends();
         for (i, end) in ends.iter().enumerate() {
-            if end.bar.0 >= self.bars.len() {
-                return Err(ModelError::UnknownBar {
-                    condition: condition.name(),
-                    bar: end.bar.0,
-                    bars: self.bars.len(),
-                });
-            }
+            self.known(condition, *end)?;
             if ends[..i].contains(end) {
                 return Err(ModelError::RepeatedEnd {
                     condition: condition.name(),
@@ -130,16 +134,94 @@ impl AssemblyBuilder {
                 });
             }
         }
+        let law = condition.unilateral();
+        let laws = usize::from(law.is_some());
         let mut rows = crate::bc::LinearRows::new();
-        condition.linear_rows(1.0, &|e| self.bars[e.bar.0].stiffness(), &mut rows);
-        let laws = usize::from(condition.unilateral().is_some());
-        if rows.len() + laws != ends.len() {
-            return Err(ModelError::EquationCount {
+        for omega in [0.0, 1.0] {
+            let read = Cell::new(None);
+            let stiffness = |e: EndRef| self.guarded(e, &read, |bar| bar.stiffness());
+            rows.clear();
+            condition.linear_rows(omega, &stiffness, &mut rows);
+            self.read_known(condition, &read)?;
+            if rows.len() + laws != ends.len() {
+                return Err(ModelError::EquationCount {
+                    condition: condition.name(),
+                    ends: ends.len(),
+                    rows: rows.len(),
+                    laws,
+                });
+            }
+            for r in 0..rows.len() {
+                self.check_terms(condition, "linear-row coefficient", rows.row(r))?;
+            }
+        }
+        if let Some(law) = law {
+            for (what, observable) in [
+                ("gap observable", law.gap()),
+                ("contact-force observable", law.force()),
+            ] {
+                finite(condition, what, observable.offset)?;
+                self.check_terms(condition, what, &observable.terms)?;
+            }
+        }
+        let read = Cell::new(None);
+        let energy = condition.stored_energy(&|e| self.guarded(e, &read, |_| 1.0));
+        self.read_known(condition, &read)?;
+        finite(condition, "stored energy", energy)
+    }
+
+    /// [`ModelError::UnknownBar`] unless `end` is an end of a bar of this builder.
+    fn known(&self, condition: &dyn BoundaryCondition, end: EndRef) -> Result<(), ModelError> {
+        if end.bar.0 < self.bars.len() {
+            Ok(())
+        } else {
+            Err(ModelError::UnknownBar {
                 condition: condition.name(),
-                ends: ends.len(),
-                rows: rows.len(),
-                laws,
-            });
+                bar: end.bar.0,
+                bars: self.bars.len(),
+            })
+        }
+    }
+
+    /// `value(bar of end)`, or `1.0` with `end` remembered in `read` when its bar is unknown
+    /// (for the closures handed to a condition, which cannot return an error).
+    fn guarded(
+        &self,
+        end: EndRef,
+        read: &Cell<Option<EndRef>>,
+        value: impl Fn(&Bar) -> f64,
+    ) -> f64 {
+        match self.bars.get(end.bar.0) {
+            Some(bar) => value(bar),
+            None => {
+                read.set(Some(end));
+                1.0
+            }
+        }
+    }
+
+    /// The error of [`AssemblyBuilder::known`] for an end remembered by
+    /// [`AssemblyBuilder::guarded`].
+    fn read_known(
+        &self,
+        condition: &dyn BoundaryCondition,
+        read: &Cell<Option<EndRef>>,
+    ) -> Result<(), ModelError> {
+        read.get().map_or(Ok(()), |end| self.known(condition, end))
+    }
+
+    /// Every term is on an end of this builder's bars, with a finite coefficient and
+    /// derivative.
+    fn check_terms(
+        &self,
+        condition: &dyn BoundaryCondition,
+        what: &'static str,
+        terms: &[Term],
+    ) -> Result<(), ModelError> {
+        for t in terms {
+            self.known(condition, t.end)?;
+            finite(condition, what, t.coefficient)?;
+            finite(condition, what, t.d_coefficient)?;
         }
         Ok(())
     }
@@ -150,7 +232,8 @@ impl AssemblyBuilder {
     /// # Errors
     /// The first [`ModelError`] found, naming the offending end or condition:
     /// [`ModelError::NoBars`], [`ModelError::OverconstrainedEnd`],
-    /// [`ModelError::UnconstrainedEnd`].
+    /// [`ModelError::UnconstrainedEnd`], and the errors of
+    /// [`AssemblyBuilder::add_condition`].
     pub fn build(&self) -> Result<BarSystem, ModelError> {
         if self.bars.is_empty() {
             return Err(ModelError::NoBars);
@@ -180,6 +263,23 @@ impl AssemblyBuilder {
         Ok(BarSystem {
             bars: self.bars.clone(),
             conditions: self.conditions.clone(),
+        })
+    }
+}
+
+/// [`ModelError::NonFiniteCoefficient`] unless `value` is finite.
+fn finite(
+    condition: &dyn BoundaryCondition,
+    what: &'static str,
+    value: f64,
+) -> Result<(), ModelError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ModelError::NonFiniteCoefficient {
+            condition: condition.name(),
+            what,
+            value,
         })
     }
 }
@@ -233,6 +333,11 @@ impl BarSystem {
     }
 
     /// Axial stiffness of the bar owning `end`.
+    ///
+    /// # Panics
+    /// If `end` belongs to a bar this system does not have (an id minted by another builder
+    /// with more bars). The ends that the system's own conditions name are all checked by
+    /// [`AssemblyBuilder::build`].
     pub fn stiffness_at(&self, end: EndRef) -> f64 {
         self.bars[end.bar.0].stiffness()
     }

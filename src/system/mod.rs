@@ -17,4 +17,6 @@ pub mod rows;
 pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};
 pub use layout::Layout;
-pub use problem::{Discretization, HarmonicBalanceSettings, NonsmoothSystem};
+pub use problem::{
+    Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE,
+};

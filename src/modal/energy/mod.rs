@@ -32,6 +32,15 @@ use crate::system::{BarSystem, Layout};
 /// evaluated at `t = 0` (phase `theta = 0`) for the solution `x` of a system with basis
 /// `basis` at fundamental frequency `omega`. With the cosine basis velocities vanish at
 /// `t = 0` and `E` is the potential energy there.
+///
+/// A low-level function for hot loops (it runs once per continuation point): it returns the
+/// number as computed, which is infinite or NaN when the energy exceeds the range of `f64`
+/// (from `Omega ~ 1e150` for unit-sized coefficients) or `omega` is not finite;
+/// [`crate::Solution::energy`] checks its inputs and returns a typed error instead.
+///
+/// # Panics
+/// If `x.len()` is not `basis.len()` times the system's unknowns per harmonic (the
+/// dimension of its [`crate::system::NonsmoothSystem`]).
 pub fn energy<B: Basis>(system: &BarSystem, basis: &B, x: &[f64], omega: f64) -> f64 {
     energy_at(system, basis, x, omega, 0.0)
 }
@@ -39,6 +48,9 @@ pub fn energy<B: Basis>(system: &BarSystem, basis: &B, x: &[f64], omega: f64) ->
 /// The energy of [`energy`] at phase `theta = Omega t` instead of `t = 0`. The exact periodic
 /// motion keeps it constant; a truncated one drifts by the work of its complementarity
 /// residual, which [`crate::modal::diagnostics`] reports.
+///
+/// # Panics
+/// As [`energy`].
 pub fn energy_at<B: Basis>(
     system: &BarSystem,
     basis: &B,
@@ -49,6 +61,11 @@ pub fn energy_at<B: Basis>(
     let len = basis.len();
     let nb = system.bars().len();
     let layout = Layout::of(system);
+    assert_eq!(
+        x.len(),
+        len * system.unknowns_per_harmonic(),
+        "modal::energy: the unknowns have the wrong length"
+    );
     // Two allocations per call: the time weights `w_i = phi_i(theta)`,
     // `v_i = omega phi_i'(theta)` with the end displacements `u_b(0), u_b(l_b)` that the
     // conditions read, and the harmonics of one bar, refilled bar after bar.
@@ -315,7 +332,8 @@ impl Diagonal {
         } = *self;
         let (a1, b1, a2, b2) = (h1.a, h1.b, h2.a, h2.b);
         let int_uu = a1 * a2 * cos2 + b1 * b2 * sin2_over_k2 + (a1 * b2 + a2 * b1) * sc_over_k;
-        let int_dd = a1 * a2 * k.powi(4) * sin2_over_k2 + b1 * b2 * cos2
+        // `k^2 (k^2 sin2_over_k2)`, not `k^4 sin2_over_k2`: finite up to `k ~ 1e154`, not 1e77.
+        let int_dd = a1 * a2 * (k * k * (k * k * sin2_over_k2)) + b1 * b2 * cos2
             - (a1 * b2 + a2 * b1) * k * k * sc_over_k;
         (int_uu, int_dd)
     }

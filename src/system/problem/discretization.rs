@@ -51,18 +51,32 @@ fn problem_doubles(len: usize, samples: usize, unknowns: usize, laws: usize) -> 
         + dimension * dimension
 }
 
+/// The accepted complementarity parameters `a_c`, `[1e-150, 1e150]`: the law compares the
+/// force with `a_c g` and its Jacobian carries `a_c`-weighted Gram sums, which stay finite
+/// for gaps, forces and their sums up to `1e150` (a scale `a_c` far from the ratio of a
+/// force to a gap only makes the law badly conditioned).
+pub const COMPLEMENTARITY_RANGE: (f64, f64) = (1e-150, 1e150);
+
 impl<B: Basis> Discretization<B> {
     /// `system` with `basis` and complementarity parameter `a_c`, without kink blend.
     ///
     /// # Errors
-    /// [`SettingsError::NotPositive`] for a bad `a_c`, [`SettingsError::NoContact`] for a
-    /// linear system, [`SettingsError::TooLarge`] for a problem beyond the memory budget
-    /// ([`crate::fourier::MEMORY_BUDGET_BYTES`]).
+    /// [`SettingsError::NotPositive`] for a non-positive or non-finite `a_c`,
+    /// [`SettingsError::OutOfRange`] for one outside [`COMPLEMENTARITY_RANGE`],
+    /// [`SettingsError::NoContact`] for a linear system, [`SettingsError::TooLarge`] for a
+    /// problem beyond the memory budget ([`crate::fourier::MEMORY_BUDGET_BYTES`]).
     pub(super) fn new(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
+        let what = "complementarity parameter a_c";
         if !(a_c.is_finite() && a_c > 0.0) {
-            return Err(SettingsError::NotPositive {
-                what: "complementarity parameter a_c",
+            return Err(SettingsError::NotPositive { what, value: a_c }.into());
+        }
+        let (min, max) = COMPLEMENTARITY_RANGE;
+        if !(min..=max).contains(&a_c) {
+            return Err(SettingsError::OutOfRange {
+                what,
                 value: a_c,
+                min,
+                max,
             }
             .into());
         }

@@ -28,7 +28,7 @@ mod discretization;
 mod state;
 mod step;
 
-pub use discretization::Discretization;
+pub use discretization::{Discretization, COMPLEMENTARITY_RANGE};
 
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
@@ -47,7 +47,8 @@ pub struct HarmonicBalanceSettings {
     pub harmonics: usize,
     /// Time samples per harmonic `n_h`; the period has `N = n_h m` samples (default 30).
     pub samples_per_harmonic: usize,
-    /// Complementarity parameter `a_c > 0` of `r = -min(lambda, a_c g)` (default 4).
+    /// Complementarity parameter `a_c > 0` of `r = -min(lambda, a_c g)` (default 4), in
+    /// [`COMPLEMENTARITY_RANGE`].
     pub complementarity: f64,
     /// Width, relative to the largest gap, of the band around each kink of the law in which
     /// the Jacobian blends the two one-sided derivatives (default 0: an exact element of the
