@@ -263,12 +263,14 @@ enum Outcome {
     Hang,
 }
 
-/// Runs the binary on `args`; stdout is discarded and stderr goes through a file, so neither
-/// pipe can fill up and block the child.
-fn run_line(binary: &Path, args: &[String], stderr_path: &Path) -> Outcome {
+/// Runs the binary on `args` in the directory `dir` (where an edge value given to `--out`, a
+/// relative path, lands); stdout is discarded and stderr goes through a file, so neither pipe
+/// can fill up and block the child.
+fn run_line(binary: &Path, args: &[String], dir: &Path, stderr_path: &Path) -> Outcome {
     let stderr_file = File::create(stderr_path).expect("create the stderr file");
     let mut child = Command::new(binary)
         .args(args)
+        .current_dir(dir)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(stderr_file)
@@ -472,7 +474,7 @@ fn fuzz(name: &str, lines: usize, seed: u64) {
     let mut report = Report::default();
     for index in 0..lines {
         let args = command_line(&mut rng, &dir.0, index);
-        let outcome = run_line(&binary, &args, &stderr_path);
+        let outcome = run_line(&binary, &args, &dir.0, &stderr_path);
         report.record(&shell_line(&binary, &args), &outcome);
     }
     println!("{} (seed {seed})", report.summary());
