@@ -42,6 +42,19 @@
 //! the truncated system. It costs about `--retry-depth` extra solves per step and runs serially
 //! (every start is solved anyway); `docs/performance.md` measures what it gains on the
 //! clamped bar. `--selection first` (the default) keeps the first accepted solution.
+//!
+//! Limits: requests the library accepts (within its memory budget) but that would run for
+//! hours or days are refused with exit code 2: `--steps` and `--max-steps` at most
+//! [`MAX_POINTS`] (an arclength run whose steps are too small to move the parameter only ends
+//! at `--max-steps`), `--harmonics` at most [`MAX_HARMONICS`], `--samples-per-harmonic` at
+//! most [`MAX_SAMPLES_PER_HARMONIC`]. `--verify` skips, with a message, a point whose march
+//! would take more than [`MAX_VERIFY_STEPS`] time steps (a period over 2500).
+//!
+//! Exit codes: 0 when the run completed (steps that did not converge are reported, not
+//! errors); 1 when the run failed, including values the library rejects (`--steps 0`,
+//! `--gap nan`, sizes over its memory budget, an unwritable `--out`); 2 on a usage error (an
+//! unknown flag, a missing or unparsable value, a value over the example's limits). Every
+//! failure is explained on stderr. `--help` prints the usage on stdout and exits with 0.
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{
@@ -74,6 +87,15 @@ const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
   [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
   [--progress] [--verify]";
+
+/// Largest `--steps` and `--max-steps`.
+const MAX_POINTS: usize = 1_000_000;
+/// Largest `--harmonics` (one solve costs about the cube of it).
+const MAX_HARMONICS: usize = 1_000;
+/// Largest `--samples-per-harmonic`.
+const MAX_SAMPLES_PER_HARMONIC: usize = 10_000;
+/// Most time steps `--verify` marches for one point.
+const MAX_VERIFY_STEPS: f64 = 1e6;
 
 const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,residual_norm,iterations,step_size,event,parameter";
 
@@ -146,7 +168,18 @@ fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
     Ok((parse(a)?, parse(b)?))
 }
 
-fn parse() -> Result<Args, lexopt::Error> {
+/// The count `value` of `--flag`, at most `max`.
+fn at_most(flag: &str, value: std::ffi::OsString, max: usize) -> Result<usize, lexopt::Error> {
+    use lexopt::ValueExt;
+    let n: usize = value.parse()?;
+    if n > max {
+        return Err(format!("--{flag} {n} is over the example's limit of {max}").into());
+    }
+    Ok(n)
+}
+
+/// The arguments of the command line, or `None` when the usage was asked for.
+fn parse() -> Result<Option<Args>, lexopt::Error> {
     use lexopt::prelude::*;
     let mut a = Args {
         system: SystemKind::Clamped,
@@ -191,16 +224,22 @@ fn parse() -> Result<Args, lexopt::Error> {
             Long("length2") => a.length2 = parser.value()?.parse()?,
             Long("speed2") => a.speed2 = parser.value()?.parse()?,
             Long("stiffness-ratio") => a.stiffness_ratio = parser.value()?.parse()?,
-            Long("harmonics") => a.settings.harmonics = parser.value()?.parse()?,
+            Long("harmonics") => {
+                a.settings.harmonics = at_most("harmonics", parser.value()?, MAX_HARMONICS)?
+            }
             Long("samples-per-harmonic") => {
-                a.settings.samples_per_harmonic = parser.value()?.parse()?
+                a.settings.samples_per_harmonic = at_most(
+                    "samples-per-harmonic",
+                    parser.value()?,
+                    MAX_SAMPLES_PER_HARMONIC,
+                )?
             }
             Long("complementarity") => a.settings.complementarity = parser.value()?.parse()?,
             Long("mode") => a.mode = parser.value()?.parse()?,
             Long("subharmonic") => a.subharmonic = parser.value()?.parse()?,
             Long("period-start") => a.period_start = Some(parser.value()?.parse()?),
             Long("period-end") => a.period_end = Some(parser.value()?.parse()?),
-            Long("steps") => a.steps = parser.value()?.parse()?,
+            Long("steps") => a.steps = at_most("steps", parser.value()?, MAX_POINTS)?,
             Long("solver") => {
                 a.dogleg = match parser.value()?.string()?.as_str() {
                     "newton" => false,
@@ -235,7 +274,9 @@ fn parse() -> Result<Args, lexopt::Error> {
             Long("ds") => a.driver.ds = parser.value()?.parse()?,
             Long("ds-min") => a.driver.ds_min = parser.value()?.parse()?,
             Long("ds-max") => a.driver.ds_max = parser.value()?.parse()?,
-            Long("max-steps") => a.driver.max_steps = parser.value()?.parse()?,
+            Long("max-steps") => {
+                a.driver.max_steps = at_most("max-steps", parser.value()?, MAX_POINTS)?
+            }
             Long("omega-range") => a.omega_range = Some(range(&parser.value()?.string()?)?),
             Long("parameter") => {
                 a.parameter = match parser.value()?.string()?.as_str() {
@@ -249,11 +290,11 @@ fn parse() -> Result<Args, lexopt::Error> {
             Long("parameter-range") => a.parameter_range = Some(range(&parser.value()?.string()?)?),
             Long("progress") => a.progress = true,
             Long("verify") => a.verify = true,
-            Short('h') | Long("help") => return Err("help requested".into()),
+            Short('h') | Long("help") => return Ok(None),
             _ => return Err(arg.unexpected()),
         }
     }
-    Ok(a)
+    Ok(Some(a))
 }
 
 /// The system of the command line with `parameter` set to `value` (the other flags fixed).
@@ -308,14 +349,23 @@ impl Sink<'_> {
         let Some(settings) = self.verify else {
             return String::new();
         };
+        let options = PeriodicityOptions {
+            adjust_grid: true,
+            ..Default::default()
+        };
+        let steps = 2.0 * PI / p.omega / options.dt;
+        if steps > MAX_VERIFY_STEPS {
+            eprintln!(
+                "backbone: verification of step {} skipped: its march of {steps:.3e} time steps \
+                 is over the example's limit of {MAX_VERIFY_STEPS:.0e}",
+                p.step
+            );
+            return ",,,".to_string();
+        }
         let report = settings
             .cosine_basis()
             .map_err(|e| e.to_string())
             .and_then(|basis| {
-                let options = PeriodicityOptions {
-                    adjust_grid: true,
-                    ..Default::default()
-                };
                 periodicity_check(system, &basis, &p.x, p.omega, &options)
                     .map_err(|e| e.to_string())
             });
@@ -535,7 +585,11 @@ fn run_parameter(
 
 fn main() -> ExitCode {
     let args = match parse() {
-        Ok(a) => a,
+        Ok(Some(a)) => a,
+        Ok(None) => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
         Err(e) => {
             eprintln!("backbone: {e}\n{USAGE}");
             return ExitCode::from(2);

@@ -1,0 +1,511 @@
+//! Command-line fuzz of the `backbone` example: random command lines, each run as a child
+//! process, must exit with 0 (success), 1 (run failure) or 2 (usage error), never panic, never
+//! die on a signal, explain every failure on stderr and end within [`TIMEOUT`].
+//!
+//! The tests run the example binary that cargo built next to this test
+//! (`<target>/<profile>/examples/backbone`): `cargo test --release` builds it before running
+//! the tests; with a target filter (`--test cli_fuzz`) build it first with
+//! `cargo build --release --example backbone`. A missing or stale binary fails the test.
+//!
+//! `fuzz_short` runs [`SHORT_LINES`] lines; the ignored `fuzz_long` runs `CLI_FUZZ_LINES`
+//! lines (default [`LONG_LINES`]):
+//!
+//! ```text
+//! cargo test --release --all-features --test cli_fuzz -- --ignored --nocapture
+//! ```
+//!
+//! The lines come from a seeded generator (`CLI_FUZZ_SEED` overrides the seed), so a run is
+//! reproducible; every failing line is printed in a form that can be pasted into a shell.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant, SystemTime};
+
+/// A line still running after this long is killed and counted as a hang.
+const TIMEOUT: Duration = Duration::from_secs(120);
+/// Lines of the normal test.
+const SHORT_LINES: usize = 60;
+/// Default lines of the ignored long test.
+const LONG_LINES: usize = 1000;
+
+/// SplitMix64: a small deterministic generator.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `0..n` (`n > 0`).
+    fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+
+    /// Uniform in `lo..=hi`.
+    fn between(&mut self, lo: usize, hi: usize) -> usize {
+        lo + self.below(hi - lo + 1)
+    }
+
+    /// Uniform in `[0, 1)`.
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// True with probability `p`.
+    fn chance(&mut self, p: f64) -> bool {
+        self.unit() < p
+    }
+
+    fn pick<'a>(&mut self, items: &[&'a str]) -> &'a str {
+        items[self.below(items.len())]
+    }
+
+    /// A number in `[lo, hi]`, uniform in its logarithm (both bounds positive).
+    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + self.unit() * (hi.ln() - lo.ln())).exp()
+    }
+}
+
+/// What follows a flag, and which values of it are cheap and valid.
+#[derive(Clone, Copy)]
+enum Value {
+    /// A switch: no value.
+    Switch,
+    /// One of these words.
+    Word(&'static [&'static str]),
+    /// An integer in `lo..=hi`.
+    Count(usize, usize),
+    /// A real in `[lo, hi]` (log-uniform).
+    Real(f64, f64),
+    /// `LO:HI` with both ends in `[lo, hi]`.
+    Range(f64, f64),
+    /// An output file.
+    File,
+}
+
+/// Every flag of the example with its cheap valid values.
+const FLAGS: &[(&str, Value)] = &[
+    ("system", Value::Word(&["ds", "rs", "two-bar"])),
+    ("gap", Value::Real(5e-4, 2e-3)),
+    ("robin-stiffness", Value::Real(0.2, 2.0)),
+    ("length2", Value::Real(0.8, 1.2)),
+    ("speed2", Value::Real(0.8, 1.2)),
+    ("stiffness-ratio", Value::Real(0.5, 2.0)),
+    ("harmonics", Value::Count(1, 30)),
+    ("samples-per-harmonic", Value::Count(2, 48)),
+    ("complementarity", Value::Real(0.5, 10.0)),
+    ("mode", Value::Count(1, 3)),
+    ("subharmonic", Value::Count(1, 3)),
+    ("period-start", Value::Real(0.5, 12.0)),
+    ("period-end", Value::Real(0.5, 12.0)),
+    ("steps", Value::Count(2, 60)),
+    ("solver", Value::Word(&["newton", "dogleg"])),
+    ("newton", Value::Word(&["fail-fast", "full"])),
+    ("retry-depth", Value::Count(0, 5)),
+    ("selection", Value::Word(&["first", "lowest-energy"])),
+    ("serial", Value::Switch),
+    ("out", Value::File),
+    ("method", Value::Word(&["sequential", "arclength"])),
+    ("ds", Value::Real(1e-4, 0.1)),
+    ("ds-min", Value::Real(1e-7, 1e-3)),
+    ("ds-max", Value::Real(1e-2, 0.5)),
+    ("max-steps", Value::Count(1, 300)),
+    ("omega-range", Value::Range(0.5, 3.0)),
+    (
+        "parameter",
+        Value::Word(&["omega", "gap", "robin-stiffness", "stiffness-ratio"]),
+    ),
+    ("parameter-range", Value::Range(1e-4, 5.0)),
+    ("progress", Value::Switch),
+    ("verify", Value::Switch),
+];
+
+/// Edge values tried for any flag that takes a value.
+const EDGES: &[&str] = &[
+    "0",
+    "1",
+    "-1",
+    "-0",
+    "18446744073709551615",
+    "18446744073709551616",
+    // Over the example's limits (points, harmonics, samples) but within the library's budget.
+    "1000001",
+    "20000",
+    // A period whose time-domain verification is over the example's limit.
+    "1e4",
+    "1e300",
+    "1e309",
+    "1e-320",
+    "nan",
+    "inf",
+    "-inf",
+    "",
+    " 3",
+    "0x10",
+    "garbage",
+    "--verify",
+];
+
+/// Edge values tried for `LO:HI` flags.
+const RANGE_EDGES: &[&str] = &[
+    "1:",
+    ":2",
+    ":",
+    "2:1",
+    "1:1",
+    "nan:inf",
+    "-1:1",
+    "1e-320:1e300",
+    "0:1e300",
+    "1:2:3",
+];
+
+/// Arguments the example does not know.
+const UNKNOWN: &[&str] = &[
+    "--bogus",
+    "-x",
+    "positional",
+    "--verify=1",
+    "--Gap",
+    "-",
+    "--",
+    "--help",
+];
+
+/// One random command line (without the program). `dir` is where output files may go.
+fn command_line(rng: &mut Rng, dir: &Path, index: usize) -> Vec<String> {
+    let mut args = Vec::new();
+    for _ in 0..rng.below(7) {
+        if rng.chance(0.04) {
+            args.push(rng.pick(UNKNOWN).to_string());
+            continue;
+        }
+        let (name, value) = FLAGS[rng.below(FLAGS.len())];
+        // `--name=value` is the same flag to the parser.
+        let joined = rng.chance(0.1);
+        let value = match value {
+            Value::Switch => {
+                args.push(format!("--{name}"));
+                continue;
+            }
+            _ if rng.chance(0.12) => edge(rng, value).to_string(),
+            _ => valid(rng, value, dir, index),
+        };
+        if joined {
+            args.push(format!("--{name}={value}"));
+        } else {
+            args.push(format!("--{name}"));
+            args.push(value);
+        }
+    }
+    if args.iter().any(|a| a == "--verify") {
+        // Verification marches every point in time: few points keep the line cheap (later
+        // flags override earlier ones).
+        for flag in ["--steps", "--max-steps"] {
+            args.push(flag.to_string());
+            args.push(rng.between(2, 8).to_string());
+        }
+    }
+    if rng.chance(0.05) {
+        // A flag missing its value.
+        let valued: Vec<&str> = FLAGS
+            .iter()
+            .filter(|(_, v)| !matches!(v, Value::Switch))
+            .map(|(name, _)| *name)
+            .collect();
+        args.push(format!("--{}", rng.pick(&valued)));
+    }
+    args
+}
+
+/// An edge value for a flag taking `value`.
+fn edge(rng: &mut Rng, value: Value) -> &'static str {
+    match value {
+        Value::Range(..) if rng.chance(0.6) => rng.pick(RANGE_EDGES),
+        _ => rng.pick(EDGES),
+    }
+}
+
+/// A valid and cheap value.
+fn valid(rng: &mut Rng, value: Value, dir: &Path, index: usize) -> String {
+    match value {
+        Value::Switch => String::new(),
+        Value::Word(words) => rng.pick(words).to_string(),
+        Value::Count(lo, hi) => rng.between(lo, hi).to_string(),
+        Value::Real(lo, hi) => format!("{:.4e}", rng.log_uniform(lo, hi)),
+        Value::Range(lo, hi) => {
+            let (a, b) = (rng.log_uniform(lo, hi), rng.log_uniform(lo, hi));
+            format!("{:.4e}:{:.4e}", a.min(b), a.max(b))
+        }
+        Value::File => match rng.below(4) {
+            // A directory that does not exist.
+            0 => dir.join("missing").join("out.csv"),
+            // The directory itself.
+            1 => dir.to_path_buf(),
+            _ => dir.join(format!("line-{index}.csv")),
+        }
+        .display()
+        .to_string(),
+    }
+}
+
+/// How a line ended.
+enum Outcome {
+    /// The child exited on its own.
+    Exited { status: ExitStatus, stderr: String },
+    /// Killed after [`TIMEOUT`].
+    Hang,
+}
+
+/// Runs the binary on `args` in the directory `dir` (where an edge value given to `--out`, a
+/// relative path, lands); stdout is discarded and stderr goes through a file, so neither pipe
+/// can fill up and block the child.
+fn run_line(binary: &Path, args: &[String], dir: &Path, stderr_path: &Path) -> Outcome {
+    let stderr_file = File::create(stderr_path).expect("create the stderr file");
+    let mut child = Command::new(binary)
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(stderr_file)
+        .spawn()
+        .expect("spawn the backbone example");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for the child") {
+            break Some(status);
+        }
+        if start.elapsed() > TIMEOUT {
+            // The child may end between the check and the kill: ignore that error.
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    match status {
+        Some(status) => Outcome::Exited {
+            status,
+            stderr: String::from_utf8_lossy(&std::fs::read(stderr_path).unwrap_or_default())
+                .into_owned(),
+        },
+        None => Outcome::Hang,
+    }
+}
+
+/// Counts of a fuzz run and its failing lines.
+#[derive(Default)]
+struct Report {
+    lines: usize,
+    /// Exit code -> lines; `None` for a death by signal.
+    codes: BTreeMap<Option<i32>, usize>,
+    panics: usize,
+    hangs: usize,
+    /// Nonzero exits with an empty stderr.
+    unexplained: usize,
+    /// Each failing line with what went wrong.
+    failures: Vec<String>,
+}
+
+impl Report {
+    fn record(&mut self, line: &str, outcome: &Outcome) {
+        self.lines += 1;
+        let mut problems = Vec::new();
+        match outcome {
+            Outcome::Hang => {
+                self.hangs += 1;
+                problems.push(format!("no exit within {} s", TIMEOUT.as_secs()));
+            }
+            Outcome::Exited { status, stderr } => {
+                let code = status.code();
+                *self.codes.entry(code).or_default() += 1;
+                if stderr.contains("panicked") || code == Some(101) {
+                    self.panics += 1;
+                    problems.push("panic".to_string());
+                }
+                if !matches!(code, Some(0..=2)) {
+                    problems.push(format!("exit status {status}"));
+                }
+                if !status.success() && stderr.trim().is_empty() {
+                    self.unexplained += 1;
+                    problems.push("failure with an empty stderr".to_string());
+                }
+                if !problems.is_empty() {
+                    problems.push(format!("stderr: {}", stderr.trim()));
+                }
+            }
+        }
+        if !problems.is_empty() {
+            self.failures
+                .push(format!("{line}\n    {}", problems.join("\n    ")));
+        }
+    }
+
+    fn count(&self, code: i32) -> usize {
+        self.codes.get(&Some(code)).copied().unwrap_or(0)
+    }
+
+    fn summary(&self) -> String {
+        let other: usize = self
+            .codes
+            .iter()
+            .filter(|(code, _)| !matches!(code, Some(0..=2)))
+            .map(|(_, n)| n)
+            .sum();
+        format!(
+            "cli_fuzz: {} lines; exit 0: {}, exit 1: {}, exit 2: {}, other: {other}; \
+             panics: {}, hangs: {}, unexplained failures: {}",
+            self.lines,
+            self.count(0),
+            self.count(1),
+            self.count(2),
+            self.panics,
+            self.hangs,
+            self.unexplained
+        )
+    }
+}
+
+/// A temporary directory removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let path = std::env::temp_dir().join(format!(
+            "nonsmooth-modes-cli-fuzz-{name}-{}",
+            std::process::id()
+        ));
+        std::fs::create_dir_all(&path).expect("create the temporary directory");
+        Self(path)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The newest modification time of a file or of the files under a directory.
+fn newest(path: &Path) -> SystemTime {
+    let own = std::fs::metadata(path)
+        .and_then(|m| m.modified())
+        .unwrap_or(SystemTime::UNIX_EPOCH);
+    let children = std::fs::read_dir(path)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|entry| newest(&entry.path()));
+    children.fold(own, SystemTime::max)
+}
+
+/// The `backbone` binary of this test's profile; fails the test if it is missing or older
+/// than its sources.
+fn backbone_binary() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test's own path");
+    // The test is `<target>/<profile>/deps/cli_fuzz-<hash>`.
+    let profile = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("the test lives in <target>/<profile>/deps");
+    let binary = profile
+        .join("examples")
+        .join(format!("backbone{}", std::env::consts::EXE_SUFFIX));
+    let release = if profile.ends_with("release") {
+        " --release"
+    } else {
+        ""
+    };
+    let built = std::fs::metadata(&binary)
+        .and_then(|m| m.modified())
+        .unwrap_or_else(|e| {
+            panic!(
+                "the backbone example is not built ({}: {e}): run `cargo build{release} \
+                 --example backbone` first",
+                binary.display()
+            )
+        });
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sources = ["examples/backbone.rs", "src", "Cargo.toml"]
+        .iter()
+        .map(|p| newest(&root.join(p)))
+        .fold(SystemTime::UNIX_EPOCH, SystemTime::max);
+    assert!(
+        built >= sources,
+        "{} is older than its sources: run `cargo build{release} --example backbone` first",
+        binary.display()
+    );
+    binary
+}
+
+/// `args` quoted for a POSIX shell.
+fn shell_line(binary: &Path, args: &[String]) -> String {
+    std::iter::once(binary.display().to_string())
+        .chain(args.iter().cloned())
+        .map(|a| format!("'{}'", a.replace('\'', r"'\''")))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// A number from the environment variable `name`, or `default`.
+fn from_env<T: std::str::FromStr>(name: &str, default: T) -> T {
+    match std::env::var(name) {
+        Ok(text) => text
+            .parse()
+            .unwrap_or_else(|_| panic!("{name} must be a number, got `{text}`")),
+        Err(_) => default,
+    }
+}
+
+/// Runs `lines` random lines from `seed` and fails on any panic, signal, unknown exit code,
+/// unexplained failure or hang; also fails if any of the exit codes 0, 1 and 2 never occurs
+/// (the lines would not be exercising the example).
+fn fuzz(name: &str, lines: usize, seed: u64) {
+    let binary = backbone_binary();
+    let dir = TempDir::new(name);
+    let stderr_path = dir.0.join("stderr.txt");
+    let mut rng = Rng(seed);
+    let mut report = Report::default();
+    for index in 0..lines {
+        let args = command_line(&mut rng, &dir.0, index);
+        let outcome = run_line(&binary, &args, &dir.0, &stderr_path);
+        report.record(&shell_line(&binary, &args), &outcome);
+    }
+    println!("{} (seed {seed})", report.summary());
+    for failure in &report.failures {
+        println!("FAILED: {failure}");
+    }
+    assert!(
+        report.failures.is_empty(),
+        "{} of {lines} lines failed (listed above)",
+        report.failures.len()
+    );
+    for code in 0..=2 {
+        assert!(
+            report.count(code) > 0,
+            "no line exited with {code}: {}",
+            report.summary()
+        );
+    }
+}
+
+#[test]
+fn fuzz_short() {
+    fuzz("short", SHORT_LINES, from_env("CLI_FUZZ_SEED", 0x5eed));
+}
+
+#[test]
+#[ignore = "long: 1,000 lines by default (CLI_FUZZ_LINES)"]
+fn fuzz_long() {
+    fuzz(
+        "long",
+        from_env("CLI_FUZZ_LINES", LONG_LINES),
+        from_env("CLI_FUZZ_SEED", 0x1000_5eed),
+    );
+}
