@@ -254,11 +254,11 @@ impl BoundaryCondition for Faulty {
         }
         rows.push(&[u, spring]);
     }
-    fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
+    fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
         match self.fault {
-            Fault::EnergyOfForeignEnd => displacement(self.foreign).powi(2),
+            Fault::EnergyOfForeignEnd => value(self.foreign, Quantity::Displacement).powi(2),
             Fault::Energy(e) => e,
-            _ => 0.5 * displacement(self.end).powi(2),
+            _ => 0.5 * value(self.end, Quantity::Displacement).powi(2),
         }
     }
 }

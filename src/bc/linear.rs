@@ -101,8 +101,8 @@ impl BoundaryCondition for Robin {
             Term::new(self.end, Quantity::Displacement, self.stiffness),
         ]);
     }
-    fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
-        let u = displacement(self.end);
+    fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
+        let u = value(self.end, Quantity::Displacement);
         0.5 * self.stiffness * u * u
     }
 }

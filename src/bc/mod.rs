@@ -168,14 +168,21 @@ pub trait BoundaryCondition: Debug + Send + Sync {
         None
     }
 
-    /// Potential energy stored in the condition itself (a spring) when the ends have the
-    /// displacements `displacement(end)`; zero by default.
+    /// Potential energy stored in the condition itself (a spring) at one instant of a motion,
+    /// whose end quantities are `value(end, quantity)` (displacement, strain, contact force,
+    /// ...); zero by default.
     ///
-    /// It should be a quadratic form of the displacements: the grazing energy `E_g`
-    /// ([`crate::modal::grazing_energy`]) evaluates it on unit-sized linear mode shapes and
-    /// scales quadratically.
-    fn stored_energy(&self, displacement: &dyn Fn(EndRef) -> f64) -> f64 {
-        let _ = displacement;
+    /// A linear condition's energy should be a quadratic form of the displacements: the
+    /// grazing energy `E_g` ([`crate::modal::grazing_energy`]) evaluates it on unit-sized
+    /// linear mode shapes and scales quadratically. A unilateral condition is left out of
+    /// `E_g` (its contact is open in the linear modes); its spring, if it has one, should
+    /// write its energy from the force it carries, `lambda^2 / (2 k)` for a compliant obstacle
+    /// of stiffness `k`: that energy tends to zero as `k` grows, as the rigid obstacle's,
+    /// whereas `k p^2 / 2` of the harmonic-balance penetration `p` (an approximation error)
+    /// does not.
+    fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
+        let _ = value;
         0.0
     }
 }
+

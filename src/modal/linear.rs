@@ -11,7 +11,7 @@ use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
 use crate::modal::diagnostics::check_frequency;
-use crate::modal::energy::energy;
+use crate::modal::energy::{energy_of, Conditions};
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, NonsmoothSystem};
 
@@ -187,12 +187,13 @@ fn open_mode(system: &BarSystem, mode: usize) -> Result<LinearMode, SettingsErro
     Err(SettingsError::ModeNotFound { mode, omega_max })
 }
 
-/// Potential energy at maximum displacement of the motion `shape cos(omega t)`.
+/// Potential energy at maximum displacement of the motion `shape cos(omega t)`, its contacts
+/// open: the unilateral conditions' stored energies are left out.
 fn shape_energy(system: &BarSystem, omega: f64, shape: &[f64]) -> f64 {
     let basis = CosineBasis::new(1, 3).expect("valid basis");
     let mut x = vec![0.0; shape.len()];
     x.extend_from_slice(shape);
-    energy(system, &basis, &x, omega)
+    energy_of(system, &basis, &x, (omega, 0.0), Conditions::Linear)
 }
 
 /// The first linear grazing energy `E_g` and the first open-contact mode: the least energy of

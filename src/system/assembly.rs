@@ -165,7 +165,7 @@ impl AssemblyBuilder {
             }
         }
         let read = Cell::new(None);
-        let energy = condition.stored_energy(&|e| self.guarded(e, &read, |_| 1.0));
+        let energy = condition.stored_energy(&|e, _| self.guarded(e, &read, |_| 1.0));
         self.read_known(condition, &read)?;
         finite(condition, "stored energy", energy)
     }

@@ -24,8 +24,10 @@
 //! pair with the diagonal closed form for the duplicates.
 
 use crate::bar::{Bar, End, EndRef};
+use crate::bc::Quantity;
 use crate::bem::sinc;
 use crate::fourier::Basis;
+use crate::system::rows::quantity_weights;
 use crate::system::{BarSystem, Layout};
 
 /// Energy `E = sum_b EA_b/2 int (u_t^2/c_b^2 + u_x^2) dx + energy stored in conditions`,
@@ -58,6 +60,26 @@ pub fn energy_at<B: Basis>(
     omega: f64,
     theta: f64,
 ) -> f64 {
+    energy_of(system, basis, x, (omega, theta), Conditions::All)
+}
+
+/// Which conditions' stored energies [`energy_of`] adds.
+#[derive(Clone, Copy, PartialEq)]
+pub(crate) enum Conditions {
+    /// Every condition's.
+    All,
+    /// The linear conditions' only: the energy form of the linear (open-contact) modes.
+    Linear,
+}
+
+/// The energy of [`energy_at`] at `(omega, theta)`, with the stored energies of `conditions`.
+pub(crate) fn energy_of<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    (omega, theta): (f64, f64),
+    conditions: Conditions,
+) -> f64 {
     let len = basis.len();
     let nb = system.bars().len();
     let layout = Layout::of(system);
@@ -67,10 +89,10 @@ pub fn energy_at<B: Basis>(
         "modal::energy: the unknowns have the wrong length"
     );
     // Two allocations per call: the time weights `w_i = phi_i(theta)`,
-    // `v_i = omega phi_i'(theta)` with the end displacements `u_b(0), u_b(l_b)` that the
-    // conditions read, and the harmonics of one bar, refilled bar after bar.
-    let mut buffer = vec![0.0; 2 * len + 2 * nb];
-    let (weights, end_u) = buffer.split_at_mut(2 * len);
+    // `v_i = omega phi_i'(theta)` with the end values `(u, u_x)` at `x = 0` and `x = l_b`
+    // that the conditions read, and the harmonics of one bar, refilled bar after bar.
+    let mut buffer = vec![0.0; 2 * len + 4 * nb];
+    let (weights, ends) = buffer.split_at_mut(2 * len);
     let (w, v) = weights.split_at_mut(len);
     basis.functions_at(theta, w);
     basis.derivatives_at(theta, v);
@@ -92,18 +114,27 @@ pub fn energy_at<B: Basis>(
         let c2 = bar.wave_speed() * bar.wave_speed();
         total += 0.5 * bar.stiffness() * (strain + kinetic / c2);
         let each = || (0..len).map(|i| harmonics.get(i));
-        end_u[2 * b] = each().map(|h| h.w * h.a).sum();
-        end_u[2 * b + 1] = each().map(|h| h.w * h.ul).sum();
+        ends[4 * b] = each().map(|h| h.w * h.a).sum();
+        ends[4 * b + 1] = each().map(|h| h.w * h.b).sum();
+        ends[4 * b + 2] = each().map(|h| h.w * h.ul).sum();
+        ends[4 * b + 3] = each().map(|h| h.w * h.dl).sum();
     }
-    let end_u = &*end_u;
-    let displacement = |e: EndRef| match e.end {
-        End::Left => end_u[2 * e.bar.index()],
-        End::Right => end_u[2 * e.bar.index() + 1],
+    let ends = &*ends;
+    let value = |e: EndRef, quantity: Quantity| {
+        let at = 4 * e.bar.index()
+            + match e.end {
+                End::Left => 0,
+                End::Right => 2,
+            };
+        let (u, strain) = (ends[at], ends[at + 1]);
+        let (wu, wp) = quantity_weights(quantity, e.end, system.stiffness_at(e));
+        wu * u + wp * e.end.normal() * strain
     };
     total
         + system
             .conditions()
-            .map(|c| c.stored_energy(&displacement))
+            .filter(|c| conditions == Conditions::All || c.unilateral().is_none())
+            .map(|c| c.stored_energy(&value))
             .sum::<f64>()
 }
 

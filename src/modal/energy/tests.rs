@@ -55,9 +55,12 @@ fn pairwise_energy_at<B: Basis>(
             harmonics.iter().zip(&phi).map(|(h, w)| w * h.ul).sum(),
         ];
     }
-    let displacement = |e: EndRef| match e.end {
-        End::Left => end_u[e.bar.index()][0],
-        End::Right => end_u[e.bar.index()][1],
+    let displacement = |e: EndRef, q: Quantity| {
+        assert_eq!(q, Quantity::Displacement, "the oracle's conditions are Robin springs");
+        match e.end {
+            End::Left => end_u[e.bar.index()][0],
+            End::Right => end_u[e.bar.index()][1],
+        }
     };
     total
         + system
@@ -317,7 +320,8 @@ fn quadrature_energy(
             }
         }
     }
-    let f = |e: EndRef| {
+    let f = |e: EndRef, q: Quantity| {
+        assert_eq!(q, Quantity::Displacement, "the oracle's conditions are Robin springs");
         let bar = system.bar(e.bar);
         let pos = if e.end == End::Left {
             0.0
@@ -366,5 +370,75 @@ fn small_wavenumber_series_is_continuous() {
             (1.0 - z.sin() / z) / (z * z)
         };
         assert!((one_minus_sinc_over_z2(z) - direct).abs() < 1e-9);
+    }
+}
+
+/// A condition whose stored energy is `scale` times one end quantity: a probe of what
+/// [`energy_at`] hands the conditions.
+#[derive(Debug)]
+struct Probe {
+    end: EndRef,
+    quantity: Quantity,
+    scale: f64,
+}
+
+impl crate::bc::BoundaryCondition for Probe {
+    fn name(&self) -> String {
+        format!("probe of {:?} at {}", self.quantity, self.end)
+    }
+    fn ends(&self) -> Vec<EndRef> {
+        Vec::new()
+    }
+    fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
+        self.scale * value(self.end, self.quantity)
+    }
+}
+
+/// The end quantities that conditions read in their stored energy are the fields' at the
+/// ends, at any phase: displacement, strain, their outward forms and the contact force.
+#[test]
+fn conditions_read_the_end_quantities_of_the_fields() {
+    let mut builder = AssemblyBuilder::new();
+    let bar = builder.add_bar(Bar::new(0.7, 1.9, 2.5).unwrap());
+    builder
+        .robin(bar.left(), 0.8)
+        .unwrap()
+        .signorini(bar.right(), 1e-3)
+        .unwrap();
+    let basis = CosineBasis::new(7, 4).unwrap();
+    let x: Vec<f64> = (0..basis.len() * 2)
+        .map(|i| 1e-3 * (((i * 37) % 11) as f64 - 5.0) / (1.0 + i as f64))
+        .collect();
+    let (omega, theta) = (1.3, 0.7);
+    let plain = builder.build().unwrap();
+    let without = energy_at(&plain, &basis, &x, omega, theta);
+    let fields = FieldEvaluator::new(&plain, &basis, &x, omega);
+    for (end, position) in [(bar.left(), 0.0), (bar.right(), 0.7)] {
+        let at = fields.at(0, position, theta);
+        let n = end.end.normal();
+        let expected = [
+            (Quantity::Displacement, at.displacement),
+            (Quantity::OutwardDisplacement, n * at.displacement),
+            (Quantity::Strain, at.strain),
+            (Quantity::OutwardStrain, n * at.strain),
+            (Quantity::ContactForce, -2.5 * at.strain),
+        ];
+        for (quantity, value) in expected {
+            // A probe constrains no end and gives no row, so the builder accepts it.
+            let mut probed = builder.clone();
+            probed
+                .add_condition(Probe {
+                    end,
+                    quantity,
+                    scale: 1e3,
+                })
+                .unwrap();
+            let system = probed.build().unwrap();
+            let read = (energy_at(&system, &basis, &x, omega, theta) - without) / 1e3;
+            assert!(
+                (read - value).abs() <= 1e-12 * (1.0 + value.abs()),
+                "{quantity:?} at {end}: read {read:e}, field {value:e}"
+            );
+        }
     }
 }
