@@ -421,6 +421,16 @@ pub enum VerifyError {
         /// The rejected value.
         value: f64,
     },
+    /// A number of a finished check is NaN or infinite: the march of a state whose values
+    /// are finite but near the edge of `f64` (a huge motion, a huge gap) can overflow its
+    /// norms and energies.
+    #[error("the {what} of the periodicity check is not finite: {value}")]
+    NonFiniteResult {
+        /// Which quantity of the report.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+    },
     /// A vector of the initial state has the wrong length.
     #[error("{what} of bar {bar} has length {got}, expected {expected}")]
     Length {

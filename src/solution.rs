@@ -109,10 +109,14 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// stored `E_g` in loops).
     ///
     /// # Errors
-    /// See [`grazing_energy`].
+    /// See [`grazing_energy`]; [`SettingsError::NonFiniteResult`] if `E` or `E / E_g` is not
+    /// finite (unknowns so large that their energy overflows: `Solution::new` accepts any
+    /// finite unknowns, but their squares need not be finite).
     pub fn energy_normalized(&self) -> Result<f64, SettingsError> {
         let (e_g, _) = grazing_energy(self.system())?;
-        Ok(self.energy() / e_g)
+        let normalized = self.energy() / e_g;
+        check_finite("the normalised energy E / E_g", self.omega, [&normalized])?;
+        Ok(normalized)
     }
 
     /// Displacement, velocity and strain anywhere in any bar.

@@ -596,3 +596,86 @@ fn problems_beyond_the_budget_are_typed_errors() {
         other => panic!("{:?}", other.map(|p| p.dimension())),
     }
 }
+
+/// Finite unknowns whose energy overflows (a seed scaled to `1e300`): `Solution` accepts
+/// them, and its normalised energy and the periodicity check return typed errors naming the
+/// quantity instead of `Ok(NaN)` (found by `tests/stress.rs`).
+#[test]
+fn overflowing_motions_are_typed_errors() {
+    let system = clamped();
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    let x: Vec<f64> = motion().iter().map(|v| v * 1e300 / GAP).collect();
+    assert!(x.iter().all(|v| v.is_finite()));
+    let omega = 2.0 * PI / 3.6;
+    let solution = Solution::new(&problem, &x, omega).unwrap();
+    assert!(!solution.energy().is_finite());
+    match solution.energy_normalized() {
+        Err(SettingsError::NonFiniteResult { what, omega: o }) => {
+            assert_eq!(o, omega);
+            assert!(what.contains("E / E_g"), "{what}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let options = PeriodicityOptions {
+        dt: 0.05,
+        ..Default::default()
+    };
+    match solution.periodicity_check(&options) {
+        Err(e @ VerifyError::NonFiniteResult { value, .. }) => {
+            assert!(!value.is_finite());
+            assert!(
+                e.to_string()
+                    .contains("of the periodicity check is not finite"),
+                "{e}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // The same motion at an ordinary size still checks.
+    let small: Vec<f64> = x.iter().map(|v| v * 1e-300).collect();
+    let solution = Solution::new(&problem, &small, omega).unwrap();
+    assert!(solution.energy_normalized().unwrap().is_finite());
+    assert!(solution.periodicity_check(&options).is_ok());
+}
+
+/// Parameter values near `±f64::MAX` whose step overflows are refused by the sequential
+/// driver (each point reports its step, which would be infinite), and a parameter branch
+/// from a system without grazing energy is refused like a backbone (found by
+/// `tests/stress.rs`).
+#[test]
+fn overflowing_steps_and_missing_grazing_energy_are_typed_errors() {
+    use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
+    use nonsmooth_modes::modal::{parameter_branch, ParameterSteps};
+    let problem = NonsmoothSystem::new(&clamped(), settings()).unwrap();
+    let start = motion();
+    match Sequential::new(
+        problem,
+        SemismoothNewton::default(),
+        start.clone(),
+        vec![1.0, -f64::MAX, f64::MAX],
+        SequentialOptions::default(),
+    ) {
+        Err(ContinuationError::InvalidOption { what, value }) => {
+            assert_eq!(value, f64::MAX);
+            assert!(what.contains("overflows"), "{what}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    let steps = ParameterSteps::Values(vec![1e-300, 1e-3], Default::default());
+    let result = parameter_branch(
+        clamped_bar_with_obstacle,
+        settings(),
+        (start, 2.0 * PI / 3.6),
+        1e-300,
+        steps,
+        SemismoothNewton::default(),
+        |_, _| std::ops::ControlFlow::Continue(()),
+    );
+    assert!(
+        matches!(
+            result,
+            Err(Error::Settings(SettingsError::GrazingEnergyOutOfRange { gap, .. })) if gap == 1e-300
+        ),
+        "{result:?}"
+    );
+}
