@@ -1208,8 +1208,7 @@ fn post_processing(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let s = HarmonicBalanceSettings {
         harmonics: d
             .size("harmonics", 1..=MAX_HARMONICS)
-            .min(MAX_HARMONICS)
-            .max(1),
+            .clamp(1, MAX_HARMONICS),
         samples_per_harmonic: d.size("samples", 3..=30).clamp(3, 64),
         ..Default::default()
     };
