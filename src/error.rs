@@ -210,6 +210,20 @@ pub enum SettingsError {
         /// The smallest admissible value.
         min: f64,
     },
+    /// A fundamental frequency so high that the phase `k l` of the highest harmonic's wave
+    /// over a bar exceeds [`MAX_PHASE`](crate::system::MAX_PHASE): `sin(k l)` carries no
+    /// significant digit there.
+    #[error(
+        "{what} {omega:e} is above {max:e}: the highest harmonic's phase over a bar exceeds 2^52, where sin and cos carry no significant digit"
+    )]
+    FrequencyTooLarge {
+        /// Which frequency.
+        what: &'static str,
+        /// The rejected value.
+        omega: f64,
+        /// The largest admissible value for this problem.
+        max: f64,
+    },
     /// The first grazing energy `E_g` is not a positive, finite, normal number: the gap of
     /// the law that sets it is too small (its square underflows) or too large (overflows) for
     /// `f64`, and every `E / E_g` would be NaN or infinite.
@@ -451,6 +465,16 @@ pub enum VerifyError {
         /// Index of the cell or node (0 for end values).
         index: usize,
         /// The rejected value.
+        value: f64,
+    },
+    /// A number of a finished check is NaN or infinite: the march of a state whose values
+    /// are finite but near the edge of `f64` (a huge motion, a huge gap) can overflow its
+    /// norms and energies.
+    #[error("the {what} of the periodicity check is not finite: {value}")]
+    NonFiniteResult {
+        /// Which quantity of the report.
+        what: &'static str,
+        /// Its value.
         value: f64,
     },
     /// A vector of the initial state has the wrong length.

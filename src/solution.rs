@@ -124,10 +124,13 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// stored `E_g` in loops).
     ///
     /// # Errors
-    /// See [`grazing_energy`] and [`Solution::energy`].
+    /// See [`grazing_energy`] and [`Solution::energy`]; [`SettingsError::NonFiniteResult`] if
+    /// `E / E_g` is not finite.
     pub fn energy_normalized(&self) -> Result<f64, SettingsError> {
         let (e_g, _) = grazing_energy(self.system())?;
-        Ok(self.energy()? / e_g)
+        let normalized = self.energy()? / e_g;
+        check_finite("the normalised energy E / E_g", self.omega, [&normalized])?;
+        Ok(normalized)
     }
 
     /// Displacement, velocity and strain anywhere in any bar.

@@ -225,9 +225,14 @@ proptest! {
                 prop_assert_eq!(min, MIN_FREQUENCY);
                 prop_assert!(omega > 0.0 && omega < MIN_FREQUENCY);
             }
+            Err(SettingsError::FrequencyTooLarge { omega: o, max, .. }) => {
+                prop_assert_eq!(o, omega);
+                prop_assert_eq!(max, problem.description().max_frequency());
+                prop_assert!(omega > max);
+            }
             Err(e) => prop_assert!(false, "unexpected error {e:?}"),
         }
-        if below {
+        if below || omega > problem.description().max_frequency() {
             prop_assert!(law_history(&problem, &x, omega, 0, 16).is_err());
             prop_assert!(diagnose(&problem, &x, omega, refinement.max(1)).is_err());
             prop_assert!(ParameterFamily::new(clamped_bar_with_obstacle, settings(), omega).is_err());
@@ -496,16 +501,22 @@ fn grazing_energy_out_of_range_names_the_gap() {
 #[test]
 fn non_finite_results_name_the_quantity_and_the_frequency() {
     let system = clamped();
-    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
-    // The harmonics of f64::MAX overflow.
-    let e = law_history(&problem, &motion(), f64::MAX, 0, 8).unwrap_err();
+    let settings = HarmonicBalanceSettings {
+        complementarity: 1e100,
+        ..settings()
+    };
+    let problem = NonsmoothSystem::new(&system, settings).unwrap();
+    // Finite unknowns whose law values `a_c g` overflow.
+    let x: Vec<f64> = motion().iter().map(|v| v / GAP * 1e300).collect();
+    let omega = 2.0;
+    let e = law_history(&problem, &x, omega, 0, 8).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "a value of a law history is not finite at omega = 1.7976931348623157e308"
+        "a value of a law history is not finite at omega = 2e0"
     );
     assert!(matches!(
-        diagnose(&problem, &motion(), f64::MAX, 8),
-        Err(SettingsError::NonFiniteResult { omega, .. }) if omega == f64::MAX
+        diagnose(&problem, &x, omega, 8),
+        Err(SettingsError::NonFiniteResult { omega: o, .. }) if o == omega
     ));
 }
 
@@ -598,30 +609,24 @@ fn problems_beyond_the_budget_are_typed_errors() {
 }
 
 /// At huge frequencies the energy of a fixed motion grows as `Omega^2` (its strain energy is
-/// `(k A)^2`-sized, `k = j Omega / c`) and stays finite while that fits in an `f64`; beyond,
-/// `Solution::energy` is a typed error, not NaN.
+/// `(k A)^2`-sized, `k = j Omega / c`) and `modal::energy` stays finite while that fits in an
+/// `f64` (from `Omega ~ 1e150` it does not: the low-level function returns the number as
+/// computed, `Solution` refuses such frequencies).
 #[test]
-fn energy_is_finite_up_to_huge_frequencies_and_a_typed_error_beyond() {
+fn energy_is_finite_up_to_huge_frequencies() {
     let system = clamped();
-    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
-    let x: Vec<f64> = (0..problem.dimension())
+    let basis = CosineBasis::new(HARMONICS, 30).unwrap();
+    let x: Vec<f64> = (0..basis.len() * system.unknowns_per_harmonic())
         .map(|i| 1e-4 * ((i % 5) as f64 - 2.0))
         .collect();
-    let energy = |omega: f64| Solution::new(&problem, &x, omega).unwrap().energy();
-    let base = energy(1e10).unwrap();
+    let energy = |omega: f64| nonsmooth_modes::modal::energy(&system, &basis, &x, omega);
+    let base = energy(1e10);
     for e in [40, 80, 120, 150] {
         let omega = 10f64.powi(e);
-        let ratio = energy(omega).unwrap() / base / (omega / 1e10).powi(2);
+        let ratio = energy(omega) / base / (omega / 1e10).powi(2);
         assert!((ratio - 1.0).abs() < 1e-9, "omega 1e{e}: ratio {ratio}");
     }
-    for omega in [1e160, 1e300, f64::MAX] {
-        match energy(omega) {
-            Err(SettingsError::NonFiniteResult { what, omega: o }) => {
-                assert_eq!((what, o), ("energy", omega));
-            }
-            other => panic!("omega {omega:e}: {other:?}"),
-        }
-    }
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
     let mode = Solution::new(&problem, &x, 1.0).unwrap();
     for theta in [f64::NAN, f64::INFINITY] {
         assert!(matches!(
@@ -681,5 +686,158 @@ fn complementarity_parameters_keep_the_residual_finite_or_are_rejected() {
             })) => assert_eq!((value, lo, hi), (a_c, min, max)),
             other => panic!("a_c {a_c:e}: {:?}", other.map(|p| p.dimension())),
         }
+    }
+}
+
+/// Finite unknowns whose energy overflows (a seed scaled to `1e300`): `Solution` accepts
+/// them, and its normalised energy and the periodicity check return typed errors naming the
+/// quantity instead of `Ok(NaN)` (found by `tests/stress.rs`).
+#[test]
+fn overflowing_motions_are_typed_errors() {
+    let system = clamped();
+    let problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    let x: Vec<f64> = motion().iter().map(|v| v * 1e300 / GAP).collect();
+    assert!(x.iter().all(|v| v.is_finite()));
+    let omega = 2.0 * PI / 3.6;
+    let solution = Solution::new(&problem, &x, omega).unwrap();
+    for result in [solution.energy(), solution.energy_normalized()] {
+        match result {
+            Err(SettingsError::NonFiniteResult { what, omega: o }) => {
+                assert_eq!((what, o), ("energy", omega));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    let options = PeriodicityOptions {
+        dt: 0.05,
+        ..Default::default()
+    };
+    match solution.periodicity_check(&options) {
+        Err(e @ VerifyError::NonFiniteResult { value, .. }) => {
+            assert!(!value.is_finite());
+            assert!(
+                e.to_string()
+                    .contains("of the periodicity check is not finite"),
+                "{e}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // The same motion at an ordinary size still checks.
+    let small: Vec<f64> = x.iter().map(|v| v * 1e-300).collect();
+    let solution = Solution::new(&problem, &small, omega).unwrap();
+    assert!(solution.energy_normalized().unwrap().is_finite());
+    assert!(solution.periodicity_check(&options).is_ok());
+}
+
+/// Parameter values near `±f64::MAX` whose step overflows are refused by the sequential
+/// driver (each point reports its step, which would be infinite), and a parameter branch
+/// from a system without grazing energy is refused like a backbone (found by
+/// `tests/stress.rs`).
+#[test]
+fn overflowing_steps_and_missing_grazing_energy_are_typed_errors() {
+    use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
+    use nonsmooth_modes::modal::{parameter_branch, ParameterSteps};
+    let problem = NonsmoothSystem::new(&clamped(), settings()).unwrap();
+    let start = motion();
+    match Sequential::new(
+        problem,
+        SemismoothNewton::default(),
+        start.clone(),
+        vec![1.0, -f64::MAX, f64::MAX],
+        SequentialOptions::default(),
+    ) {
+        Err(ContinuationError::InvalidOption { what, value }) => {
+            assert_eq!(value, f64::MAX);
+            assert!(what.contains("overflows"), "{what}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    let steps = ParameterSteps::Values(vec![1e-300, 1e-3], Default::default());
+    let result = parameter_branch(
+        clamped_bar_with_obstacle,
+        settings(),
+        (start, 2.0 * PI / 3.6),
+        1e-300,
+        steps,
+        SemismoothNewton::default(),
+        |_, _| std::ops::ControlFlow::Continue(()),
+    );
+    assert!(
+        matches!(
+            result,
+            Err(Error::Settings(SettingsError::GrazingEnergyOutOfRange { gap, .. })) if gap == 1e-300
+        ),
+        "{result:?}"
+    );
+}
+
+/// Frequencies whose highest harmonic's phase over a bar exceeds `MAX_PHASE` are rejected
+/// by the seeds, `Solution`, the backbones and the post-processing, with the problem's own
+/// limit; at the limit a motion's numbers are finite.
+#[test]
+fn huge_frequencies_are_rejected_with_the_problem_limit() {
+    use nonsmooth_modes::modal::{arclength_backbone, ArclengthBackboneOptions};
+    use nonsmooth_modes::system::MAX_PHASE;
+    let system = clamped();
+    let mut problem = NonsmoothSystem::new(&system, settings()).unwrap();
+    let max = problem.description().max_frequency();
+    // The clamped bar is a unit bar: k l = m Omega.
+    assert_eq!(max, MAX_PHASE / HARMONICS as f64);
+    let x = motion();
+    let at_limit = Solution::new(&problem, &x, max).unwrap();
+    assert!(at_limit.energy().unwrap().is_finite());
+    assert!(branch_seed(&mut problem, 1, 1, max).is_ok());
+    let too_large = |result: Result<(), Error>, what: &str| match result {
+        Err(Error::Settings(SettingsError::FrequencyTooLarge { omega, max: m, .. })) => {
+            assert!(omega > m && m == max, "{what}: {omega:e} vs {m:e}");
+        }
+        other => panic!("{what}: {other:?}"),
+    };
+    for omega in [max * 1.01, 1e300, f64::MAX] {
+        too_large(
+            Solution::new(&problem, &x, omega)
+                .map(|_| ())
+                .map_err(Error::from),
+            "Solution",
+        );
+        too_large(
+            branch_seed(&mut problem, 1, 1, omega).map(|_| ()),
+            "branch_seed",
+        );
+        too_large(
+            law_history(&problem, &x, omega, 0, 1)
+                .map(|_| ())
+                .map_err(Error::from),
+            "law_history",
+        );
+        let grid = PeriodGrid {
+            start: 3.9,
+            end: 2.0 * PI / omega,
+            steps: 3,
+        };
+        let options = BackboneOptions {
+            grid,
+            ..Default::default()
+        };
+        too_large(
+            backbone(&system, settings(), &options, SemismoothNewton::default()).map(|_| ()),
+            "backbone",
+        );
+        let options = ArclengthBackboneOptions {
+            omega_range: (1.0, omega),
+            ..Default::default()
+        };
+        too_large(
+            arclength_backbone(
+                &system,
+                settings(),
+                &options,
+                SemismoothNewton::default(),
+                |_| std::ops::ControlFlow::Continue(()),
+            )
+            .map(|_| ()),
+            "arclength_backbone",
+        );
     }
 }

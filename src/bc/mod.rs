@@ -185,4 +185,3 @@ pub trait BoundaryCondition: Debug + Send + Sync {
         0.0
     }
 }
-

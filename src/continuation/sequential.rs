@@ -142,8 +142,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     /// A driver visiting `values` in order from the guess `start`.
     ///
     /// # Errors
-    /// [`ContinuationError::InvalidOption`] for an empty or non-finite list,
-    /// [`ContinuationError::Dimension`] for a wrong-sized start.
+    /// [`ContinuationError::InvalidOption`] for an empty or non-finite list, or one whose
+    /// step between two successive values overflows; [`ContinuationError::Dimension`] for a
+    /// wrong-sized start.
     pub fn new(
         problem: P,
         solver: S,
@@ -161,6 +162,14 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
             return Err(ContinuationError::InvalidOption {
                 what: "parameter value",
                 value: *v,
+            });
+        }
+        // Each point reports its step `lambda - previous lambda`: finite values near
+        // `±f64::MAX` whose difference overflows would give infinite step sizes.
+        if let Some(w) = values.windows(2).find(|w| !(w[1] - w[0]).is_finite()) {
+            return Err(ContinuationError::InvalidOption {
+                what: "parameter value (its step from the previous one overflows)",
+                value: w[1],
             });
         }
         if start.len() != problem.dimension() {

@@ -3,10 +3,11 @@
 
 use crate::continuation::{
     linspace, Arclength, ArclengthOptions, Branch, Event, Observer, PeriodParametrised, Point,
-    Predictor, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
+    Predictor, Rejection, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
 };
 use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
+use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
@@ -219,6 +220,9 @@ fn drive_backbone<S: NonlinearSolver>(
         }
         .into());
     }
+    for v in [grid.start, grid.end] {
+        check_frequency_of(&problem, 2.0 * PI / v)?;
+    }
     let values = linspace(grid.start, grid.end, grid.steps)?;
     let (e_g, start) = grazing_and_seed(
         &mut problem,
@@ -355,10 +359,34 @@ impl Default for ArclengthBackboneOptions {
     }
 }
 
+/// What an arclength backbone tells its observer: each accepted point and each rejected
+/// corrector step, either of which may stop the run.
+///
+/// Closures `FnMut(&BackbonePoint) -> ControlFlow<()>` observe the points only; implement
+/// the trait to see the rejections too (for instance to stop a run whose shrink factor is
+/// close to 1 after a budget of your own).
+pub trait BackboneObserver {
+    /// Called with every accepted point.
+    fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()>;
+
+    /// Called with every rejected step (default: go on).
+    fn rejected(&mut self, rejection: &Rejection) -> ControlFlow<()> {
+        let _ = rejection;
+        ControlFlow::Continue(())
+    }
+}
+
+impl<F: FnMut(&BackbonePoint) -> ControlFlow<()>> BackboneObserver for F {
+    fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()> {
+        self(point)
+    }
+}
+
 /// Computes a backbone by pseudo-arclength continuation in `Omega` (see
 /// [`Arclength`]): seeds the branch from the linear mode at `start_period`, follows it inside
 /// `omega_range`, jumping past stalls when `options.escape` is set ([`EscapingArclength`]),
-/// and hands every accepted point to `observer`, which may stop the run.
+/// and hands every accepted point to `observer`, which may stop the run
+/// ([`arclength_backbone_observed`] also shows the rejected steps).
 /// Returns `E_g` and the branch summary (points, rejections, end reason).
 ///
 /// # Errors
@@ -368,7 +396,23 @@ pub fn arclength_backbone<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &ArclengthBackboneOptions,
     solver: S,
-    mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+) -> Result<(f64, Branch), Error> {
+    arclength_backbone_observed(system, settings, options, solver, observer)
+}
+
+/// [`arclength_backbone`] whose observer sees every accepted point and every rejected step,
+/// and may stop the run on either
+/// ([`EndReason::StoppedByObserver`](crate::continuation::EndReason::StoppedByObserver)).
+///
+/// # Errors
+/// Invalid settings or options, a failed seed or a failed start.
+pub fn arclength_backbone_observed<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: &ArclengthBackboneOptions,
+    solver: S,
+    mut observer: impl BackboneObserver,
 ) -> Result<(f64, Branch), Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
     if !(options.start_period.is_finite() && options.start_period > 0.0) {
@@ -379,6 +423,10 @@ pub fn arclength_backbone<S: NonlinearSolver>(
         .into());
     }
     let omega0 = 2.0 * PI / options.start_period;
+    let (lo, hi) = options.omega_range;
+    if hi.is_finite() {
+        check_frequency_of(&problem, hi.max(lo))?;
+    }
     let (e_g, start) = grazing_and_seed(&mut problem, options.mode, options.subharmonic, omega0)?;
     let basis = problem.basis().clone();
     let arclength = ArclengthOptions {
@@ -393,13 +441,14 @@ pub fn arclength_backbone<S: NonlinearSolver>(
     let mut driver = Arclength::new(problem, solver, start, omega0, arclength)?
         .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
     let mut see = |step: &Step| match step {
-        Step::Accepted(p) => observer(&BackbonePoint::from_point(
+        Step::Accepted(p) => observer.point(&BackbonePoint::from_point(
             p,
             p.parameter,
             energy(system, &basis, &p.x, p.parameter),
             e_g,
         )),
-        _ => ControlFlow::Continue(()),
+        Step::Rejected(r) => observer.rejected(r),
+        Step::Finished(_) => ControlFlow::Continue(()),
     };
     let branch = match options.escape {
         Some(escape) => EscapingArclength::new(driver, escape)?.run(&mut see),

@@ -39,8 +39,28 @@ pub(crate) fn check_frequency(omega: f64) -> Result<f64, SettingsError> {
     }
 }
 
+/// Checks a fundamental frequency of `problem`: [`check_frequency`], and at most
+/// [`Discretization::max_frequency`](crate::system::Discretization::max_frequency)
+/// ([`SettingsError::FrequencyTooLarge`]).
+pub(crate) fn check_frequency_of<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    omega: f64,
+) -> Result<f64, SettingsError> {
+    check_frequency(omega)?;
+    let max = problem.description().max_frequency();
+    if omega > max {
+        Err(SettingsError::FrequencyTooLarge {
+            what: "fundamental frequency",
+            omega,
+            max,
+        })
+    } else {
+        Ok(omega)
+    }
+}
+
 /// Checks a motion `x` of `problem` at `omega`: the length of `x`
-/// ([`SettingsError::Length`]), the frequency ([`check_frequency`]) and finite unknowns
+/// ([`SettingsError::Length`]), the frequency ([`check_frequency_of`]) and finite unknowns
 /// ([`SettingsError::NotPositive`] naming "unknowns (finite)").
 pub(crate) fn check_motion<B: Basis>(
     problem: &NonsmoothSystem<B>,
@@ -54,7 +74,7 @@ pub(crate) fn check_motion<B: Basis>(
             expected: problem.dimension(),
         });
     }
-    check_frequency(omega)?;
+    check_frequency_of(problem, omega)?;
     if let Some(v) = x.iter().find(|v| !v.is_finite()) {
         return Err(SettingsError::NotPositive {
             what: "unknowns (finite)",

@@ -10,7 +10,7 @@
 use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
-use crate::modal::diagnostics::check_frequency;
+use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::{energy_of, Conditions};
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, NonsmoothSystem};
@@ -277,7 +277,7 @@ fn check_seed<B: Basis>(
         }
         .into());
     }
-    check_frequency(omega)?;
+    check_frequency_of(problem, omega)?;
     let harmonics = problem.basis().harmonics();
     if subharmonic > harmonics {
         return Err(SettingsError::HarmonicOutOfRange {

@@ -10,8 +10,9 @@ pub mod linear;
 mod parameter;
 
 pub use backbone::{
-    arclength_backbone, backbone, backbone_speculative_with, backbone_with,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, PeriodGrid,
+    arclength_backbone, arclength_backbone_observed, backbone, backbone_speculative_with,
+    backbone_with, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint,
+    PeriodGrid,
 };
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,

@@ -36,9 +36,14 @@ pub enum ParameterSteps {
 /// reason it ended: a run that stalls returns what it computed, with
 /// [`EndReason::Stalled`](crate::continuation::EndReason::Stalled).
 ///
+/// A point whose system has no grazing energy (a gap whose `E_g` underflows or overflows,
+/// [`SettingsError::GrazingEnergyOutOfRange`](crate::SettingsError::GrazingEnergyOutOfRange))
+/// reaches the observer with `energy_normalized = NaN`: `E / E_g` is not defined there.
+///
 /// # Errors
-/// A family that rejects `value`, invalid settings or options, or a start where the solver
-/// fails ([`ContinuationError::Start`], arclength only).
+/// A family that rejects `value`, a system at `value` without grazing energy, invalid
+/// settings or options, or a start where the solver fails ([`ContinuationError::Start`],
+/// arclength only).
 pub fn parameter_branch<F, S>(
     family: F,
     settings: HarmonicBalanceSettings,
@@ -54,6 +59,8 @@ where
 {
     let basis = settings.cosine_basis()?;
     let problem = ParameterFamily::at(family.clone(), settings, omega, value)?;
+    // Energies are normalised by `E_g`: a start without one is refused, as by `backbone`.
+    grazing_energy(&family.build(value)?)?;
     // The point in the frame of the system at its parameter value; a value the family
     // rejects is skipped (it is not a point of the branch).
     let mut report = |p: &Point| {

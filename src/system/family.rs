@@ -17,7 +17,7 @@
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, ModelError};
 use crate::linalg::DenseMatrix;
-use crate::modal::diagnostics::check_frequency;
+use crate::modal::diagnostics::check_frequency_of;
 use crate::solve::{Problem, Structured};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
@@ -78,8 +78,8 @@ impl<F: SystemFamily> ParameterFamily<F> {
         omega: f64,
         value: f64,
     ) -> Result<Self, Error> {
-        check_frequency(omega)?;
         let mut system = NonsmoothSystem::new(&family.build(value)?, settings)?;
+        check_frequency_of(&system, omega)?;
         system.set_parameter(omega);
         Ok(Self {
             dimension: system.dimension(),

@@ -18,5 +18,5 @@ pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};
 pub use layout::Layout;
 pub use problem::{
-    Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE,
+    Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE, MAX_PHASE,
 };

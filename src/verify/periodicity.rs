@@ -56,7 +56,8 @@ pub struct PeriodicityReport {
     pub initial_penetration: f64,
     /// Largest penetration over the march, initial state included.
     pub max_penetration: f64,
-    /// Smallest contact force over the march (0 once a contact opens; never negative).
+    /// Smallest contact force over the march (0 once a contact opens; never negative; `+inf`
+    /// for a system without unilateral condition).
     pub min_contact_force: f64,
 }
 
@@ -64,8 +65,10 @@ pub struct PeriodicityReport {
 ///
 /// # Errors
 /// [`VerifyError::InvalidParameter`] for a period that is not positive and finite, zero
-/// periods or an infinite march (`periods * period` overflows); [`VerifyError::TooLarge`]
-/// if the histories of the march do not fit in the memory budget (see [`march`]).
+/// periods, a march shorter than one time step or an infinite march (`periods * period`
+/// overflows); [`VerifyError::TooLarge`]
+/// if the histories of the march do not fit in the memory budget (see [`march`]);
+/// [`VerifyError::NonFiniteResult`] if a number of the report overflows.
 pub fn periodicity_of_state(
     initial: &State,
     period: f64,
@@ -81,6 +84,15 @@ pub fn periodicity_of_state(
         return Err(VerifyError::InvalidParameter {
             what: "number of periods",
             value: 0.0,
+        });
+    }
+    // A march shorter than one step compares the state with itself and samples no contact
+    // force (the smallest force would stay `+inf`).
+    let dt = initial.grid().dt();
+    if period * (options.periods as f64) < dt {
+        return Err(VerifyError::InvalidParameter {
+            what: "period (shorter than the time step)",
+            value: period,
         });
     }
     let trajectory = march(
@@ -102,7 +114,7 @@ pub fn periodicity_of_state(
             change = change.max((u1 - u0).abs());
         }
     }
-    Ok(PeriodicityReport {
+    let report = PeriodicityReport {
         period,
         dt: initial.grid().dt(),
         defect: if initial_norm > 0.0 {
@@ -121,7 +133,31 @@ pub fn periodicity_of_state(
         initial_penetration: initial.penetration(),
         max_penetration: trajectory.max_penetration,
         min_contact_force: trajectory.min_contact_force,
-    })
+    };
+    check_report(&report)?;
+    Ok(report)
+}
+
+/// Every number of a report is finite (but the smallest contact force, `+inf` for a system
+/// without unilateral condition, as in [`march`]), or [`VerifyError::NonFiniteResult`]
+/// names the first that is not: the checks of the initial state let through finite values whose squares,
+/// sums or ratios overflow (unknowns near `f64::MAX`, a gap of `1e300`).
+fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
+    let values = [
+        ("period", r.period),
+        ("time step", r.dt),
+        ("defect", r.defect),
+        ("initial norm", r.initial_norm),
+        ("displacement defect", r.displacement_defect),
+        ("initial energy", r.initial_energy),
+        ("energy drift", r.energy_drift),
+        ("initial penetration", r.initial_penetration),
+        ("largest penetration", r.max_penetration),
+    ];
+    match values.into_iter().find(|(_, v)| !v.is_finite()) {
+        Some((what, value)) => Err(VerifyError::NonFiniteResult { what, value }),
+        None => Ok(()),
+    }
 }
 
 /// The periodicity check of a harmonic-balance point: builds the fields of the solution `x`

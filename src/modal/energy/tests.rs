@@ -56,7 +56,11 @@ fn pairwise_energy_at<B: Basis>(
         ];
     }
     let displacement = |e: EndRef, q: Quantity| {
-        assert_eq!(q, Quantity::Displacement, "the oracle's conditions are Robin springs");
+        assert_eq!(
+            q,
+            Quantity::Displacement,
+            "the oracle's conditions are Robin springs"
+        );
         match e.end {
             End::Left => end_u[e.bar.index()][0],
             End::Right => end_u[e.bar.index()][1],
@@ -321,7 +325,11 @@ fn quadrature_energy(
         }
     }
     let f = |e: EndRef, q: Quantity| {
-        assert_eq!(q, Quantity::Displacement, "the oracle's conditions are Robin springs");
+        assert_eq!(
+            q,
+            Quantity::Displacement,
+            "the oracle's conditions are Robin springs"
+        );
         let bar = system.bar(e.bar);
         let pos = if e.end == End::Left {
             0.0

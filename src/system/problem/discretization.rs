@@ -51,6 +51,11 @@ fn problem_doubles(len: usize, samples: usize, unknowns: usize, laws: usize) -> 
         + dimension * dimension
 }
 
+/// The largest phase `k l` of a harmonic's wave over a bar that the problems accept, `2^52`:
+/// beyond it consecutive `f64` are more than 1 apart, so `sin(k l)` and `cos(k l)` carry no
+/// significant digit (and the energies, of order `(k l)^2`, approach overflow).
+pub const MAX_PHASE: f64 = 4_503_599_627_370_496.0;
+
 /// The accepted complementarity parameters `a_c`, `[1e-150, 1e150]`: the law compares the
 /// force with `a_c g` and its Jacobian carries `a_c`-weighted Gram sums, which stay finite
 /// for gaps, forces and their sums up to `1e150` (a scale `a_c` far from the ratio of a
@@ -156,6 +161,16 @@ impl<B: Basis> Discretization<B> {
     /// Number of unknowns (and equations).
     pub fn dimension(&self) -> usize {
         self.basis.len() * self.unknowns
+    }
+
+    /// The largest fundamental frequency whose highest harmonic `m` keeps the phase
+    /// `k l = m Omega l / c` of every bar at most [`MAX_PHASE`]:
+    /// `MAX_PHASE / (m max_b(l_b / c_b))`.
+    pub fn max_frequency(&self) -> f64 {
+        let slowest = (self.system.bars().iter())
+            .map(|b| b.length() / b.wave_speed())
+            .fold(0.0, f64::max);
+        MAX_PHASE / (self.basis.harmonics().max(1) as f64 * slowest)
     }
 
     /// The largest gap of the unilateral laws: residual entries are gaps and forces of that
