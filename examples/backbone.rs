@@ -3,6 +3,7 @@
 //! ```text
 //! cargo run --release --example backbone -- [--system ds|rs|two-bar] [--gap 1e-3]
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
+//!     [--assembly FILE]
 //!     [--harmonics 20 --samples-per-harmonic 30 --complementarity 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
 //!     [--newton fail-fast|full] [--retry-depth K] [--selection first|lowest-energy] [--serial]
@@ -11,10 +12,32 @@
 //!     [--parameter-range LO:HI] [--progress] [--verify]
 //! ```
 //!
+//! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
+//! (`reference::clamped_bar_with_obstacle`, `robin_bar_with_obstacle`, `two_bars_in_contact`,
+//! set by `--gap`, `--robin-stiffness`, `--length2`, `--speed2`, `--stiffness-ratio`; their
+//! bars are named `1` and `2`). `--assembly FILE` reads any assembly from a TOML or JSON file
+//! instead (`io::assembly`, which documents the schema; `examples/assemblies/` has the three
+//! shorthands as files and a three-bar chain). It needs the `serde` feature
+//! (`cargo run --release --features serde --example backbone -- --assembly FILE`; without it
+//! the flag is refused with that command), excludes `--system` and the shorthands' value
+//! flags (the values are in the file) and continues in the period only (`--parameter omega`).
+//! A file that cannot be read or built is a usage error, explained on stderr.
+//!
+//! Default periods: the shorthands keep the grids they have always had (`ds` and `two-bar`
+//! 3.95 -> 3.05, `rs` 9.5 -> 6.0, whatever the mode). For a file they come from the system's
+//! own linear mode `i = --mode` (open contacts, `modal::open_mode`): with `T_i = 2 pi / omega_i`
+//! rounded to 6 significant digits and `K = --subharmonic`, the periods go from
+//! `K T_i 79/80` down to `K T_i 61/80` (181 steps by default), from just below the linear
+//! period into the strongly nonlinear range. For the clamped bar `T_1 = 4`, which gives the
+//! paper's grid 3.95 -> 3.05 exactly (`4 * 79 / 80` and `4 * 61 / 80` round to the doubles of
+//! 3.95 and 3.05), so `--assembly examples/assemblies/clamped.toml` writes the same CSV as
+//! `--system ds`, byte for byte. `--period-start` and `--period-end` override either default.
+//!
 //! Columns: `step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,
 //! residual_norm,iterations,step_size,event,parameter` (`exact_energy_normalized` is the exact
-//! first mode of the clamped bar, formulation §9, for `--system ds --mode 1` and empty
-//! otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the
+//! first mode of the clamped bar, formulation §9, when the system is the clamped bar —
+//! `--system ds` or a file with the same bars and conditions — with `--mode 1 --subharmonic 1`,
+//! and empty otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the
 //! continued parameter's value). `--verify` marches every point one period in time with the
 //! exact integrator (`verify::periodicity_check`, `dt = 1/400`) and adds the columns
 //! `periodicity_defect,displacement_defect,max_penetration`.
@@ -53,7 +76,8 @@
 //! Exit codes: 0 when the run completed (steps that did not converge are reported, not
 //! errors); 1 when the run failed, including values the library rejects (`--steps 0`,
 //! `--gap nan`, sizes over its memory budget, an unwritable `--out`); 2 on a usage error (an
-//! unknown flag, a missing or unparsable value, a value over the example's limits). Every
+//! unknown flag, a missing or unparsable value, a value over the example's limits, `--system`
+//! with `--assembly`, an assembly file that cannot be read or built). Every
 //! failure is explained on stderr. `--help` prints the usage on stdout and exits with 0.
 
 use nonsmooth_modes::bar::Bar;
@@ -61,8 +85,9 @@ use nonsmooth_modes::continuation::{
     linspace, ArclengthOptions, Event, Selection, SequentialOptions, Speculation,
 };
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, backbone_speculative_with, backbone_with, parameter_branch,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
+    arclength_backbone, backbone, backbone_speculative_with, backbone_with, open_mode,
+    parameter_branch, ArclengthBackboneOptions, BackboneOptions, BackbonePoint, ParameterSteps,
+    PeriodGrid,
 };
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
@@ -79,7 +104,8 @@ use std::ops::ControlFlow;
 use std::process::ExitCode;
 
 const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
-  [--length2 L --speed2 C --stiffness-ratio R] [--harmonics M] [--samples-per-harmonic NH]
+  [--length2 L --speed2 C --stiffness-ratio R] | [--assembly FILE.toml|FILE.json]
+  [--harmonics M] [--samples-per-harmonic NH]
   [--complementarity AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
   [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K]
   [--selection first|lowest-energy] [--serial] [--out FILE]
@@ -99,12 +125,23 @@ const MAX_VERIFY_STEPS: f64 = 1e6;
 
 const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,residual_norm,iterations,step_size,event,parameter";
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone)]
 enum SystemKind {
     Clamped,
     Robin,
     TwoBar,
+    /// Read from `--assembly`.
+    File(BarSystem),
 }
+
+/// The flags that set a value of a `--system` shorthand, refused with `--assembly`.
+const SHORTHAND_VALUES: [&str; 5] = [
+    "gap",
+    "robin-stiffness",
+    "length2",
+    "speed2",
+    "stiffness-ratio",
+];
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Parameter {
@@ -145,16 +182,54 @@ struct Args {
     verify: bool,
 }
 
-/// Default period range per system: just below the linear period of the chosen mode
-/// down to a strongly nonlinear period.
-fn default_periods(system: SystemKind) -> (f64, f64) {
-    match system {
+/// Default period range: just below the linear period of the chosen mode down to a strongly
+/// nonlinear period; the shorthands' fixed grids, or for a file the rule of the header
+/// (`K T_i 79/80 -> K T_i 61/80`, `T_i` rounded to 6 significant digits).
+fn default_periods(a: &Args) -> Result<(f64, f64), Box<dyn std::error::Error>> {
+    Ok(match &a.system {
         SystemKind::Clamped => (3.95, 3.05),
         // Robin k = 0.5: omega_1 = 0.653271, T_1 = 9.618
         SystemKind::Robin => (9.5, 6.0),
         // bar 1 clamped-free: T_1 = 4
         SystemKind::TwoBar => (3.95, 3.05),
-    }
+        SystemKind::File(system) => {
+            let omega = open_mode(system, a.mode)?.omega;
+            // Rounded so that a linear period computed to 1e-13 lands on its decimal value
+            // (4.000000000000001 -> 4) and the grid on round numbers.
+            let period: f64 = format!("{:.5e}", 2.0 * PI / omega).parse()?;
+            let period = a.subharmonic as f64 * period;
+            (period * 79.0 / 80.0, period * 61.0 / 80.0)
+        }
+    })
+}
+
+/// The gap of the clamped bar with obstacle if `system` is that system (the same bars and the
+/// same conditions, compared by their names, which carry their ends and values): its exact
+/// first mode is then known.
+fn clamped_gap(system: &BarSystem) -> Option<f64> {
+    let gap = system.laws().next()?.gap().offset;
+    let reference = clamped_bar_with_obstacle(gap).ok()?;
+    let names = |s: &BarSystem| s.conditions().map(|c| c.name()).collect::<Vec<_>>();
+    (system.bars() == reference.bars() && names(system) == names(&reference)).then_some(gap)
+}
+
+/// The system of the file at `path`.
+#[cfg(feature = "serde")]
+fn load_assembly(path: &str) -> Result<BarSystem, lexopt::Error> {
+    nonsmooth_modes::io::assembly::Assembly::from_path(path)
+        .map(|assembly| assembly.into_system())
+        .map_err(|e| format!("--assembly {path}: {e}").into())
+}
+
+/// Without the `serde` feature there is no file parser: the flag is refused with the command
+/// that has one.
+#[cfg(not(feature = "serde"))]
+fn load_assembly(path: &str) -> Result<BarSystem, lexopt::Error> {
+    Err(format!(
+        "--assembly needs the `serde` feature: cargo run --release --features serde \
+         --example backbone -- --assembly {path}"
+    )
+    .into())
 }
 
 fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
@@ -208,10 +283,19 @@ fn parse() -> Result<Option<Args>, lexopt::Error> {
         progress: false,
         verify: false,
     };
+    let mut assembly = None;
+    let mut system_given = false;
+    let mut values_given = Vec::new();
     let mut parser = lexopt::Parser::from_env();
     while let Some(arg) = parser.next()? {
+        if let Long(flag) = arg {
+            if let Some(name) = SHORTHAND_VALUES.iter().find(|&&v| v == flag) {
+                values_given.push(*name);
+            }
+        }
         match arg {
             Long("system") => {
+                system_given = true;
                 a.system = match parser.value()?.string()?.as_str() {
                     "ds" => SystemKind::Clamped,
                     "rs" => SystemKind::Robin,
@@ -219,6 +303,7 @@ fn parse() -> Result<Option<Args>, lexopt::Error> {
                     other => return Err(format!("unknown system `{other}`").into()),
                 }
             }
+            Long("assembly") => assembly = Some(parser.value()?.string()?),
             Long("gap") => a.gap = parser.value()?.parse()?,
             Long("robin-stiffness") => a.robin_stiffness = parser.value()?.parse()?,
             Long("length2") => a.length2 = parser.value()?.parse()?,
@@ -294,6 +379,21 @@ fn parse() -> Result<Option<Args>, lexopt::Error> {
             _ => return Err(arg.unexpected()),
         }
     }
+    if let Some(path) = assembly {
+        if system_given {
+            return Err("--assembly and --system exclude each other".into());
+        }
+        if let Some(flag) = values_given.first() {
+            return Err(format!(
+                "--{flag} sets a value of a --system shorthand; with --assembly the values are in the file"
+            )
+            .into());
+        }
+        if a.parameter != Parameter::Omega {
+            return Err("--parameter other than omega needs a --system shorthand".into());
+        }
+        a.system = SystemKind::File(load_assembly(&path)?);
+    }
     Ok(Some(a))
 }
 
@@ -312,6 +412,8 @@ fn build_system(a: &Args, parameter: Parameter, value: f64) -> Result<BarSystem,
         SystemKind::TwoBar => {
             two_bars_in_contact(Bar::new(a.length2, a.speed2, a.stiffness_ratio)?, a.gap)
         }
+        // A file's system has no parameter to vary (refused by `parse`).
+        SystemKind::File(system) => Ok(system),
     }
 }
 
@@ -426,7 +528,10 @@ impl Sink<'_> {
 
 fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::error::Error>> {
     let system = build_system(a, Parameter::Omega, f64::NAN)?;
-    let (t0, t1) = default_periods(a.system);
+    let (t0, t1) = match (a.period_start, a.period_end) {
+        (Some(t0), Some(t1)) => (t0, t1),
+        _ => default_periods(a)?,
+    };
     let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
     let extra = if a.verify {
         ",periodicity_defect,displacement_defect,max_penetration"
@@ -437,11 +542,9 @@ fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::err
     let mut sink = Sink {
         out,
         verify: a.verify.then_some(a.settings),
-        exact: (a.system == SystemKind::Clamped
-            && a.mode == 1
-            && a.subharmonic == 1
-            && a.parameter != Parameter::Gap)
-            .then_some(a.gap),
+        exact: (a.mode == 1 && a.subharmonic == 1 && a.parameter != Parameter::Gap)
+            .then(|| clamped_gap(&system))
+            .flatten(),
         total: 0,
         converged: 0,
         error: None,
@@ -517,7 +620,7 @@ fn run_parameter(
     let value = parameter_value(a, parameter);
     let system = build_system(a, parameter, value)?;
     // Reach the branch at `period` from the system's default start.
-    let start_period = default_periods(a.system).0;
+    let start_period = default_periods(a)?.0;
     let options = BackboneOptions {
         grid: PeriodGrid {
             start: start_period,

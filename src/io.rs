@@ -1,4 +1,8 @@
-//! Writing results: CSV without dependencies, JSON behind the `serde` feature.
+//! Writing results: CSV without dependencies, JSON behind the `serde` feature; with it too,
+//! assemblies read from and written to TOML or JSON files ([`assembly`]).
+
+#[cfg(feature = "serde")]
+pub mod assembly;
 
 use crate::continuation::Event;
 use crate::modal::BackbonePoint;

@@ -36,7 +36,7 @@
 //! | [`modal::diagnose`], [`modal::FieldEvaluator`] | residual norm `R^(m)`, penetration, fields, histories of a point |
 //! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |
 //! | [`mod@reference`] | the paper's systems and exact solutions |
-//! | [`io`] | CSV, and JSON with the `serde` feature |
+//! | [`io`] | CSV, and JSON with the `serde` feature; with it, assemblies from TOML/JSON files |
 //! | [`sweep::backbones`] | many backbones at once; in parallel with the `parallel` feature (rayon), results identical to the serial run |
 //!
 //! ## Features
@@ -44,7 +44,7 @@
 //! | feature | adds |
 //! |---|---|
 //! | `parallel` | [`sweep::backbones`] on rayon's thread pool |
-//! | `serde` | `Serialize` on points, branches and diagnostics; `io::to_json` |
+//! | `serde` | `Serialize` on points, branches and diagnostics; `io::to_json`; assemblies read from and written to TOML or JSON files (`io::assembly`) |
 //! | `plot` | the `plot` module: SVG figures |
 //! | `proptest` | the `strategies` module: proptest strategies |
 //!

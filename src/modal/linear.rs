@@ -158,9 +158,14 @@ fn null_vectors(system: &BarSystem, omega: f64, state: ContactState) -> Vec<Vec<
         .collect()
 }
 
-/// The `mode`-th natural frequency of the open-contact system (1-based), searching up to
-/// growing bounds.
-fn open_mode(system: &BarSystem, mode: usize) -> Result<LinearMode, SettingsError> {
+/// The `mode`-th natural frequency of the open-contact system (1-based) with its shapes: the
+/// linear mode that [`branch_seed`] seeds NSM `mode` from. It is searched below growing
+/// bounds (up to 32 times `(mode + 1) pi c / l` of the bar with the lowest `pi c / l`).
+///
+/// # Errors
+/// [`SettingsError::ZeroIndex`] for `mode = 0`; [`SettingsError::ModeNotFound`] if the search
+/// ends without it.
+pub fn open_mode(system: &BarSystem, mode: usize) -> Result<LinearMode, SettingsError> {
     if mode == 0 {
         return Err(SettingsError::ZeroIndex {
             what: "mode number",
