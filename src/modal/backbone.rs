@@ -33,7 +33,8 @@ pub struct PeriodGrid {
 
 impl Default for PeriodGrid {
     /// The paper's grid for the first mode of the clamped bar: `T` from 3.95 to 3.05 in 181
-    /// steps.
+    /// steps. Other systems: [`PeriodGrid::for_mode`], the same rule on their own linear
+    /// period.
     fn default() -> Self {
         Self {
             start: 3.95,
@@ -326,7 +327,8 @@ pub fn backbone<S: NonlinearSolver>(
 /// Options of [`arclength_backbone`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArclengthBackboneOptions {
-    /// Period at which the branch is seeded (default 3.95, the clamped bar's first mode).
+    /// Period at which the branch is seeded (default 3.95, the clamped bar's first mode;
+    /// [`ArclengthBackboneOptions::for_mode`] derives it and `omega_range` from any system).
     pub start_period: f64,
     /// The run stays inside this range of `Omega` (default `[2 pi / 3.96, 2 pi / 3.05]`).
     pub omega_range: (f64, f64),

@@ -2,6 +2,7 @@
 //! system, branch seeds, backbones, and branches in a system parameter.
 
 mod backbone;
+mod defaults;
 pub mod diagnostics;
 pub mod energy;
 mod escape;
@@ -14,6 +15,7 @@ pub use backbone::{
     backbone_with, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint,
     PeriodGrid,
 };
+pub use defaults::linear_period;
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,
 };
