@@ -841,3 +841,39 @@ fn huge_frequencies_are_rejected_with_the_problem_limit() {
         );
     }
 }
+
+/// A dogleg whose trust radius shrinks to zero (a tiny initial radius and a subnormal minimum
+/// radius that underflows relative to a small solution) gives up with a typed error instead
+/// of shrinking forever (found by `tests/stress.rs`, seed `0x1234abcd`, case 2403).
+#[test]
+fn a_dogleg_whose_radius_reaches_zero_gives_up() {
+    use nonsmooth_modes::continuation::ContinuationProblem;
+    use nonsmooth_modes::solve::{Dogleg, DoglegOptions, NonlinearSolver};
+    use nonsmooth_modes::SolveError;
+    let gap = 1.4e-6;
+    let system = clamped_bar_with_obstacle(gap).unwrap();
+    let settings = HarmonicBalanceSettings {
+        harmonics: 1,
+        samples_per_harmonic: 31,
+        ..Default::default()
+    };
+    let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
+    let omega = 2.0 * PI / 3.6;
+    let mut x: Vec<f64> = branch_seed(&mut problem, 1, 1, omega)
+        .unwrap()
+        .iter()
+        .map(|v| 1.7 * v)
+        .collect();
+    problem.set_parameter(omega);
+    let solver = Dogleg::new(DoglegOptions {
+        initial_radius: 1e-300,
+        min_radius: 5e-324,
+        ..Default::default()
+    })
+    .unwrap();
+    match solver.solve(&mut problem, &mut x) {
+        Ok(info) => assert!(info.residual_norm.is_finite()),
+        Err(SolveError::TrustRegion { radius, .. }) => assert!(radius >= 0.0),
+        Err(e) => assert!(!e.to_string().is_empty()),
+    }
+}

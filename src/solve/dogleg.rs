@@ -172,7 +172,9 @@ impl NonlinearSolver for Dogleg {
                         r = rt;
                         break;
                     }
-                    if radius < o.min_radius * reference {
+                    // A radius of zero (a zero-length step, or a minimum radius that
+                    // underflows relative to a tiny `reference`) cannot shrink below it.
+                    if radius < o.min_radius * reference || radius == 0.0 {
                         factored?;
                         return Err(SolveError::TrustRegion {
                             iteration,
