@@ -147,3 +147,67 @@ fn seed_from_a_known_mode_equals_the_searched_seed() {
         ));
     }
 }
+
+/// Rigid-body modes: none for a clamped bar; one (a translation) for a free-free bar between
+/// two walls while its contacts are open, none once they close; one for the middle bar of a
+/// chain held only by contacts; two for two free bars touching only each other. Each shape
+/// is a translation: `B = 0` (no strain) in every bar's affine field `A + B x`.
+#[test]
+fn rigid_body_modes_with_their_multiplicity() {
+    use nonsmooth_modes::modal::rigid_body_modes;
+    use nonsmooth_modes::system::AssemblyBuilder;
+    let count = |system: &nonsmooth_modes::system::BarSystem, state| {
+        rigid_body_modes(system, state).map_or(0, |m| {
+            assert_eq!(m.omega, 0.0);
+            for shape in &m.shapes {
+                for pair in shape.chunks(2) {
+                    assert!(pair[1].abs() < 1e-12, "a strained rigid mode: {shape:?}");
+                }
+            }
+            m.shapes.len()
+        })
+    };
+    let clamped = clamped_bar_with_obstacle(1e-3).unwrap();
+    assert_eq!(count(&clamped, ContactState::Open), 0);
+
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::unit());
+    b.signorini(bar.left(), 1e-3)
+        .unwrap()
+        .signorini(bar.right(), 1e-3)
+        .unwrap();
+    let walls = b.build().unwrap();
+    assert_eq!(count(&walls, ContactState::Open), 1);
+    assert_eq!(count(&walls, ContactState::Closed), 0);
+
+    let mut b = AssemblyBuilder::new();
+    let (one, two, three) = (
+        b.add_bar(Bar::unit()),
+        b.add_bar(Bar::unit()),
+        b.add_bar(Bar::unit()),
+    );
+    b.dirichlet(one.left())
+        .unwrap()
+        .contact(one.right(), two.left(), 1e-3)
+        .unwrap()
+        .contact(two.right(), three.left(), 1e-3)
+        .unwrap()
+        .robin(three.right(), 0.5)
+        .unwrap();
+    let chain = b.build().unwrap();
+    assert_eq!(count(&chain, ContactState::Open), 1);
+    assert_eq!(count(&chain, ContactState::Closed), 0);
+
+    let mut b = AssemblyBuilder::new();
+    let (one, two) = (b.add_bar(Bar::unit()), b.add_bar(Bar::unit()));
+    b.neumann(one.left())
+        .unwrap()
+        .contact(one.right(), two.left(), 1e-3)
+        .unwrap()
+        .neumann(two.right())
+        .unwrap();
+    let floating = b.build().unwrap();
+    assert_eq!(count(&floating, ContactState::Open), 2);
+    // Closed, the two bars move together: one translation.
+    assert_eq!(count(&floating, ContactState::Closed), 1);
+}

@@ -123,6 +123,20 @@ pub fn natural_frequencies(
     Ok(modes)
 }
 
+/// The rigid-body modes of the linear system in `state`: the motions at zero frequency, one
+/// shape per independent rigid motion (a bar held only by contacts translates freely while
+/// they are open), or `None` if the system has none. [`natural_frequencies`] lists the modes
+/// of positive frequency only; nonsmooth modes are numbered from those.
+///
+/// At `omega = 0` each bar's field is affine, `u = A + B x`; a rigid-body mode is an affine
+/// field per bar that satisfies every condition row (and, in `state`, the contact rows).
+pub fn rigid_body_modes(system: &BarSystem, state: ContactState) -> Option<LinearMode> {
+    (singularity(system, 0.0, state) <= 1e-8).then(|| LinearMode {
+        omega: 0.0,
+        shapes: null_vectors(system, 0.0, state),
+    })
+}
+
 fn golden_minimum(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));

@@ -23,7 +23,7 @@ pub use energy::{energy, energy_at};
 pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};
 pub use linear::{
-    branch_seed, grazing_energy, natural_frequencies, open_mode, seed_from_mode, ContactState,
-    LinearMode,
+    branch_seed, grazing_energy, natural_frequencies, open_mode, rigid_body_modes, seed_from_mode,
+    ContactState, LinearMode,
 };
 pub use parameter::{parameter_branch, ParameterSteps};
