@@ -432,7 +432,7 @@ fn backbone_binary() -> PathBuf {
             )
         });
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sources = ["examples/backbone.rs", "src", "Cargo.toml"]
+    let sources = ["examples/backbone", "src", "Cargo.toml"]
         .iter()
         .map(|p| newest(&root.join(p)))
         .fold(SystemTime::UNIX_EPOCH, SystemTime::max);

@@ -1,0 +1,239 @@
+//! The command line: its flags and their defaults, the parser with its validation, the
+//! example's limits and the usage text.
+
+use crate::systems::{load_assembly, SystemKind};
+use nonsmooth_modes::continuation::{ArclengthOptions, Selection};
+use nonsmooth_modes::system::HarmonicBalanceSettings;
+
+pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
+  [--length2 L --speed2 C --stiffness-ratio R] | [--assembly FILE.toml|FILE.json]
+  [--harmonics M] [--samples-per-harmonic NH]
+  [--complementarity AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
+  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K]
+  [--selection first|lowest-energy] [--serial] [--out FILE]
+  [--method sequential|arclength]
+  [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
+  [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
+  [--progress] [--verify]";
+
+/// Largest `--steps` and `--max-steps`.
+pub const MAX_POINTS: usize = 1_000_000;
+/// Largest `--harmonics` (one solve costs about the cube of it).
+pub const MAX_HARMONICS: usize = 1_000;
+/// Largest `--samples-per-harmonic`.
+pub const MAX_SAMPLES_PER_HARMONIC: usize = 10_000;
+/// Most time steps `--verify` marches for one point.
+pub const MAX_VERIFY_STEPS: f64 = 1e6;
+
+/// The flags that set a value of a `--system` shorthand, refused with `--assembly`.
+const SHORTHAND_VALUES: [&str; 5] = [
+    "gap",
+    "robin-stiffness",
+    "length2",
+    "speed2",
+    "stiffness-ratio",
+];
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Parameter {
+    Omega,
+    Gap,
+    RobinStiffness,
+    StiffnessRatio,
+}
+
+#[derive(Debug, Clone)]
+pub struct Args {
+    pub system: SystemKind,
+    pub gap: f64,
+    pub robin_stiffness: f64,
+    pub length2: f64,
+    pub speed2: f64,
+    pub stiffness_ratio: f64,
+    pub settings: HarmonicBalanceSettings,
+    pub mode: usize,
+    pub subharmonic: usize,
+    pub period_start: Option<f64>,
+    pub period_end: Option<f64>,
+    pub steps: usize,
+    pub dogleg: bool,
+    /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
+    pub fail_fast: Option<bool>,
+    pub retry_depth: usize,
+    pub selection: Selection,
+    /// No speculative retry on a second thread.
+    pub serial: bool,
+    pub out: Option<String>,
+    pub arclength: bool,
+    pub driver: ArclengthOptions,
+    pub omega_range: Option<(f64, f64)>,
+    pub parameter: Parameter,
+    pub parameter_range: Option<(f64, f64)>,
+    pub progress: bool,
+    pub verify: bool,
+}
+
+fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
+    let (a, b) = text
+        .split_once(':')
+        .ok_or_else(|| format!("expected LO:HI, got `{text}`"))?;
+    let parse = |v: &str| {
+        v.parse::<f64>()
+            .map_err(|e| lexopt::Error::from(format!("`{v}`: {e}")))
+    };
+    Ok((parse(a)?, parse(b)?))
+}
+
+/// The count `value` of `--flag`, at most `max`.
+fn at_most(flag: &str, value: std::ffi::OsString, max: usize) -> Result<usize, lexopt::Error> {
+    use lexopt::ValueExt;
+    let n: usize = value.parse()?;
+    if n > max {
+        return Err(format!("--{flag} {n} is over the example's limit of {max}").into());
+    }
+    Ok(n)
+}
+
+/// The arguments of the command line, or `None` when the usage was asked for.
+pub fn parse() -> Result<Option<Args>, lexopt::Error> {
+    use lexopt::prelude::*;
+    let mut a = Args {
+        system: SystemKind::Clamped,
+        gap: 1e-3,
+        robin_stiffness: 0.5,
+        length2: 0.95,
+        speed2: 1.0,
+        stiffness_ratio: 1.0,
+        settings: HarmonicBalanceSettings::default(),
+        mode: 1,
+        subharmonic: 1,
+        period_start: None,
+        period_end: None,
+        steps: 181,
+        dogleg: false,
+        fail_fast: None,
+        retry_depth: 1,
+        selection: Selection::FirstConverged,
+        serial: false,
+        out: None,
+        arclength: false,
+        driver: ArclengthOptions::default(),
+        omega_range: None,
+        parameter: Parameter::Omega,
+        parameter_range: None,
+        progress: false,
+        verify: false,
+    };
+    let mut assembly = None;
+    let mut system_given = false;
+    let mut values_given = Vec::new();
+    let mut parser = lexopt::Parser::from_env();
+    while let Some(arg) = parser.next()? {
+        if let Long(flag) = arg {
+            if let Some(name) = SHORTHAND_VALUES.iter().find(|&&v| v == flag) {
+                values_given.push(*name);
+            }
+        }
+        match arg {
+            Long("system") => {
+                system_given = true;
+                a.system = match parser.value()?.string()?.as_str() {
+                    "ds" => SystemKind::Clamped,
+                    "rs" => SystemKind::Robin,
+                    "two-bar" => SystemKind::TwoBar,
+                    other => return Err(format!("unknown system `{other}`").into()),
+                }
+            }
+            Long("assembly") => assembly = Some(parser.value()?.string()?),
+            Long("gap") => a.gap = parser.value()?.parse()?,
+            Long("robin-stiffness") => a.robin_stiffness = parser.value()?.parse()?,
+            Long("length2") => a.length2 = parser.value()?.parse()?,
+            Long("speed2") => a.speed2 = parser.value()?.parse()?,
+            Long("stiffness-ratio") => a.stiffness_ratio = parser.value()?.parse()?,
+            Long("harmonics") => {
+                a.settings.harmonics = at_most("harmonics", parser.value()?, MAX_HARMONICS)?
+            }
+            Long("samples-per-harmonic") => {
+                a.settings.samples_per_harmonic = at_most(
+                    "samples-per-harmonic",
+                    parser.value()?,
+                    MAX_SAMPLES_PER_HARMONIC,
+                )?
+            }
+            Long("complementarity") => a.settings.complementarity = parser.value()?.parse()?,
+            Long("mode") => a.mode = parser.value()?.parse()?,
+            Long("subharmonic") => a.subharmonic = parser.value()?.parse()?,
+            Long("period-start") => a.period_start = Some(parser.value()?.parse()?),
+            Long("period-end") => a.period_end = Some(parser.value()?.parse()?),
+            Long("steps") => a.steps = at_most("steps", parser.value()?, MAX_POINTS)?,
+            Long("solver") => {
+                a.dogleg = match parser.value()?.string()?.as_str() {
+                    "newton" => false,
+                    "dogleg" => true,
+                    other => return Err(format!("unknown solver `{other}`").into()),
+                }
+            }
+            Long("newton") => {
+                a.fail_fast = match parser.value()?.string()?.as_str() {
+                    "fail-fast" => Some(true),
+                    "full" => Some(false),
+                    other => return Err(format!("unknown Newton budget `{other}`").into()),
+                }
+            }
+            Long("retry-depth") => a.retry_depth = parser.value()?.parse()?,
+            Long("selection") => {
+                a.selection = match parser.value()?.string()?.as_str() {
+                    "first" => Selection::FirstConverged,
+                    "lowest-energy" => Selection::LowestMeasure,
+                    other => return Err(format!("unknown selection `{other}`").into()),
+                }
+            }
+            Long("serial") => a.serial = true,
+            Long("out") => a.out = Some(parser.value()?.string()?),
+            Long("method") => {
+                a.arclength = match parser.value()?.string()?.as_str() {
+                    "sequential" => false,
+                    "arclength" => true,
+                    other => return Err(format!("unknown method `{other}`").into()),
+                }
+            }
+            Long("ds") => a.driver.ds = parser.value()?.parse()?,
+            Long("ds-min") => a.driver.ds_min = parser.value()?.parse()?,
+            Long("ds-max") => a.driver.ds_max = parser.value()?.parse()?,
+            Long("max-steps") => {
+                a.driver.max_steps = at_most("max-steps", parser.value()?, MAX_POINTS)?
+            }
+            Long("omega-range") => a.omega_range = Some(range(&parser.value()?.string()?)?),
+            Long("parameter") => {
+                a.parameter = match parser.value()?.string()?.as_str() {
+                    "omega" => Parameter::Omega,
+                    "gap" => Parameter::Gap,
+                    "robin-stiffness" => Parameter::RobinStiffness,
+                    "stiffness-ratio" => Parameter::StiffnessRatio,
+                    other => return Err(format!("unknown parameter `{other}`").into()),
+                }
+            }
+            Long("parameter-range") => a.parameter_range = Some(range(&parser.value()?.string()?)?),
+            Long("progress") => a.progress = true,
+            Long("verify") => a.verify = true,
+            Short('h') | Long("help") => return Ok(None),
+            _ => return Err(arg.unexpected()),
+        }
+    }
+    if let Some(path) = assembly {
+        if system_given {
+            return Err("--assembly and --system exclude each other".into());
+        }
+        if let Some(flag) = values_given.first() {
+            return Err(format!(
+                "--{flag} sets a value of a --system shorthand; with --assembly the values are in the file"
+            )
+            .into());
+        }
+        if a.parameter != Parameter::Omega {
+            return Err("--parameter other than omega needs a --system shorthand".into());
+        }
+        a.system = SystemKind::File(load_assembly(&path)?);
+    }
+    Ok(Some(a))
+}

@@ -1,0 +1,126 @@
+//! Backbone of a nonsmooth mode by sequential continuation in the period, written as CSV.
+//!
+//! ```text
+//! cargo run --release --example backbone -- [--system ds|rs|two-bar] [--gap 1e-3]
+//!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
+//!     [--assembly FILE]
+//!     [--harmonics 20 --samples-per-harmonic 30 --complementarity 4] [--mode 1] [--subharmonic 1]
+//!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
+//!     [--newton fail-fast|full] [--retry-depth K] [--selection first|lowest-energy] [--serial]
+//!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
+//!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
+//!     [--parameter-range LO:HI] [--progress] [--verify]
+//! ```
+//!
+//! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
+//! (`reference::clamped_bar_with_obstacle`, `robin_bar_with_obstacle`, `two_bars_in_contact`,
+//! set by `--gap`, `--robin-stiffness`, `--length2`, `--speed2`, `--stiffness-ratio`; their
+//! bars are named `1` and `2`). `--assembly FILE` reads any assembly from a TOML or JSON file
+//! instead (`io::assembly`, which documents the schema; `examples/assemblies/` has the three
+//! shorthands as files and a three-bar chain). It needs the `serde` feature
+//! (`cargo run --release --features serde --example backbone -- --assembly FILE`; without it
+//! the flag is refused with that command), excludes `--system` and the shorthands' value
+//! flags (the values are in the file) and continues in the period only (`--parameter omega`).
+//! A file that cannot be read or built is a usage error, explained on stderr.
+//!
+//! Default periods: the shorthands keep the grids they have always had (`ds` and `two-bar`
+//! 3.95 -> 3.05, `rs` 9.5 -> 6.0, whatever the mode). For a file they come from the system's
+//! own linear mode `i = --mode` (open contacts, `modal::open_mode`): with `T_i = 2 pi / omega_i`
+//! rounded to 6 significant digits and `K = --subharmonic`, the periods go from
+//! `K T_i 79/80` down to `K T_i 61/80` (181 steps by default), from just below the linear
+//! period into the strongly nonlinear range. For the clamped bar `T_1 = 4`, which gives the
+//! paper's grid 3.95 -> 3.05 exactly (`4 * 79 / 80` and `4 * 61 / 80` round to the doubles of
+//! 3.95 and 3.05), so `--assembly examples/assemblies/clamped.toml` writes the same CSV as
+//! `--system ds`, byte for byte. `--period-start` and `--period-end` override either default.
+//!
+//! Columns: `step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,
+//! residual_norm,iterations,step_size,event,parameter` (`exact_energy_normalized` is the exact
+//! first mode of the clamped bar, formulation §9, when the system is the clamped bar —
+//! `--system ds` or a file with the same bars and conditions — with `--mode 1 --subharmonic 1`,
+//! and empty otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the
+//! continued parameter's value). `--verify` marches every point one period in time with the
+//! exact integrator (`verify::periodicity_check`, `dt = 1/400`) and adds the columns
+//! `periodicity_defect,displacement_defect,max_penetration`.
+//!
+//! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
+//! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
+//! escape from internal-resonance stalls. `--parameter gap|robin-stiffness|stiffness-ratio`
+//! continues in that parameter at the fixed period `--period-start` inside
+//! `--parameter-range` (default: a decade either side), starting from the branch point at that
+//! period (reached by a short sequential run from the system's default start).
+//!
+//! Newton's budget: `--newton fail-fast` (`NewtonOptions::fail_fast`, the default of sequential
+//! runs: each step starts from a converged neighbour and a failed step is skipped) or
+//! `--newton full` (`NewtonOptions::default`, the default of arclength runs, whose stall
+//! escapes solve from far starts). A failed sequential step is retried from up to
+//! `--retry-depth` earlier converged points (`SequentialOptions::retry_depth`, default 1; 0
+//! switches the retry off). Where the machine has more than one core, the first retry runs on
+//! a second thread beside the first attempt (`backbone_speculative_with`; the same points, bit
+//! for bit); `--serial` keeps everything on one thread.
+//!
+//! `--selection lowest-energy` (`Selection::LowestMeasure` through
+//! `BackboneOptions::selection`; period runs only) solves every step from the prediction and
+//! from the `--retry-depth` earlier converged points and keeps the lowest-energy solution,
+//! which near an internal resonance stays on the backbone rather than on a resonance spike of
+//! the truncated system. It costs about `--retry-depth` extra solves per step and runs serially
+//! (every start is solved anyway); `docs/performance.md` measures what it gains on the
+//! clamped bar. `--selection first` (the default) keeps the first accepted solution.
+//!
+//! Limits: requests the library accepts (within its memory budget) but that would run for
+//! hours or days are refused with exit code 2: `--steps` and `--max-steps` at most
+//! [`MAX_POINTS`] (an arclength run whose steps are too small to move the parameter only ends
+//! at `--max-steps`), `--harmonics` at most [`MAX_HARMONICS`], `--samples-per-harmonic` at
+//! most [`MAX_SAMPLES_PER_HARMONIC`]. `--verify` skips, with a message, a point whose march
+//! would take more than [`MAX_VERIFY_STEPS`] time steps (a period over 2500).
+//!
+//! Exit codes: 0 when the run completed (steps that did not converge are reported, not
+//! errors); 1 when the run failed, including values the library rejects (`--steps 0`,
+//! `--gap nan`, sizes over its memory budget, an unwritable `--out`); 2 on a usage error (an
+//! unknown flag, a missing or unparsable value, a value over the example's limits, `--system`
+//! with `--assembly`, an assembly file that cannot be read or built). Every
+//! failure is explained on stderr. `--help` prints the usage on stdout and exits with 0.
+//!
+//! [`MAX_POINTS`]: args::MAX_POINTS
+//! [`MAX_HARMONICS`]: args::MAX_HARMONICS
+//! [`MAX_SAMPLES_PER_HARMONIC`]: args::MAX_SAMPLES_PER_HARMONIC
+//! [`MAX_VERIFY_STEPS`]: args::MAX_VERIFY_STEPS
+
+mod args;
+mod output;
+mod runs;
+mod systems;
+
+use args::{parse, USAGE};
+use runs::run;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let args = match parse() {
+        Ok(Some(a)) => a,
+        Ok(None) => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("backbone: {e}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = match &args.out {
+        Some(path) => match std::fs::File::create(path) {
+            Ok(f) => run(&args, &mut std::io::BufWriter::new(f)),
+            Err(e) => Err(e.into()),
+        },
+        None => run(&args, &mut std::io::stdout().lock()),
+    };
+    match result {
+        Ok((total, converged)) => {
+            eprintln!("backbone: {converged} of {total} steps converged");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("backbone: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

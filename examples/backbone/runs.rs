@@ -1,0 +1,176 @@
+//! The runs: sequential or arclength in the period, and continuation in a system parameter.
+
+use crate::args::{Args, Parameter};
+use crate::output::{Sink, HEADER};
+use crate::systems::{build_system, clamped_gap, default_periods, parameter_value};
+use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
+use nonsmooth_modes::modal::{
+    arclength_backbone, backbone, backbone_speculative_with, backbone_with, parameter_branch,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
+};
+use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
+// A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
+use nonsmooth_modes::sweep::Solver;
+use std::f64::consts::PI;
+use std::io::Write;
+use std::ops::ControlFlow;
+
+pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std::error::Error>> {
+    let system = build_system(a, Parameter::Omega, f64::NAN)?;
+    let (t0, t1) = match (a.period_start, a.period_end) {
+        (Some(t0), Some(t1)) => (t0, t1),
+        _ => default_periods(a)?,
+    };
+    let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
+    let extra = if a.verify {
+        ",periodicity_defect,displacement_defect,max_penetration"
+    } else {
+        ""
+    };
+    writeln!(out, "{HEADER}{extra}")?;
+    let mut sink = Sink {
+        out,
+        verify: a.verify.then_some(a.settings),
+        exact: (a.mode == 1 && a.subharmonic == 1 && a.parameter != Parameter::Gap)
+            .then(|| clamped_gap(&system))
+            .flatten(),
+        total: 0,
+        converged: 0,
+        error: None,
+        progress: a.progress,
+    };
+    let solver = if a.dogleg {
+        Solver::Dogleg(Dogleg::default())
+    } else if a.fail_fast.unwrap_or(!a.arclength) {
+        // Sequential steps start from a converged neighbour: give up early.
+        Solver::Newton(SemismoothNewton::new(NewtonOptions::fail_fast())?)
+    } else {
+        // Arclength's stall escapes solve from far starts: the full budget.
+        Solver::Newton(SemismoothNewton::default())
+    };
+    if a.parameter != Parameter::Omega {
+        run_parameter(a, t0, solver, &mut sink)?;
+    } else if a.arclength {
+        let (lo, hi) = (2.0 * PI / t0, 2.0 * PI / t1);
+        let options = ArclengthBackboneOptions {
+            start_period: t0,
+            omega_range: a.omega_range.unwrap_or((lo.min(hi) * 0.999, lo.max(hi))),
+            mode: a.mode,
+            subharmonic: a.subharmonic,
+            arclength: ArclengthOptions {
+                direction: if t1 < t0 { 1.0 } else { -1.0 },
+                ..a.driver
+            },
+            ..Default::default()
+        };
+        let (_, branch) = arclength_backbone(&system, a.settings, &options, solver, |p| {
+            sink.row(&system, p, f64::NAN)
+        })?;
+        eprintln!(
+            "backbone: arclength ended: {:?}; {} rejected steps",
+            branch.end, branch.rejections
+        );
+    } else {
+        let options = BackboneOptions {
+            grid: PeriodGrid {
+                start: t0,
+                end: t1,
+                steps: a.steps,
+            },
+            mode: a.mode,
+            subharmonic: a.subharmonic,
+            retry_depth: a.retry_depth,
+            selection: a.selection,
+            ..Default::default()
+        };
+        let see = |p: &BackbonePoint| sink.row(&system, p, f64::NAN);
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        if a.serial || cores < 2 {
+            backbone_with(&system, a.settings, &options, solver, see)?;
+        } else {
+            let speculation = Speculation::default();
+            backbone_speculative_with(&system, a.settings, &options, speculation, solver, see)?;
+        }
+    }
+    if let Some(e) = sink.error {
+        return Err(e.into());
+    }
+    Ok((sink.total, sink.converged))
+}
+
+/// Continuation in a system parameter at the fixed period `period`.
+fn run_parameter(
+    a: &Args,
+    period: f64,
+    solver: Solver,
+    sink: &mut Sink<'_>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let parameter = a.parameter;
+    let value = parameter_value(a, parameter);
+    let system = build_system(a, parameter, value)?;
+    // Reach the branch at `period` from the system's default start.
+    let start_period = default_periods(a)?.0;
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: start_period,
+            end: period,
+            steps: ((start_period - period).abs() / 0.005).ceil().max(1.0) as usize + 1,
+        },
+        mode: a.mode,
+        subharmonic: a.subharmonic,
+        ..Default::default()
+    };
+    let reached = backbone(&system, a.settings, &options, SemismoothNewton::default())?;
+    let start = reached
+        .iter()
+        .rev()
+        .find(|p| p.converged)
+        .ok_or("no converged point on the way to the starting period")?
+        .clone();
+    let family = move |v: f64| build_system(a, parameter, v);
+    let (lo, hi) = a.parameter_range.unwrap_or((value / 10.0, value * 10.0));
+    let steps = if a.arclength {
+        ParameterSteps::Arclength(ArclengthOptions {
+            parameter_range: (lo, hi),
+            ..a.driver
+        })
+    } else {
+        // Sequential parameter runs go from the current value to the far end of the range.
+        let far = if (hi - value).abs() >= (value - lo).abs() {
+            hi
+        } else {
+            lo
+        };
+        let options = SequentialOptions {
+            retry_depth: a.retry_depth,
+            ..Default::default()
+        };
+        ParameterSteps::Values(linspace(value, far, a.steps)?, options)
+    };
+    let branch = parameter_branch(
+        family,
+        a.settings,
+        (start.x, start.omega),
+        value,
+        steps,
+        solver,
+        |v, point| match build_system(a, parameter, v) {
+            Ok(system) => sink.row(&system, point, v),
+            Err(_) => ControlFlow::Continue(()),
+        },
+    )?;
+    eprintln!(
+        "backbone: {} ended: {:?}; {} rejected steps",
+        if a.arclength {
+            "arclength"
+        } else {
+            "sequential"
+        },
+        branch.end,
+        branch.rejections
+    );
+    match branch.end.error() {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
+    }
+}
