@@ -3,13 +3,12 @@
 
 use crate::args::{Args, Parameter};
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::open_mode;
+use nonsmooth_modes::modal::PeriodGrid;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
 use nonsmooth_modes::system::BarSystem;
 use nonsmooth_modes::ModelError;
-use std::f64::consts::PI;
 
 #[derive(Debug, Clone)]
 pub enum SystemKind {
@@ -31,12 +30,8 @@ pub fn default_periods(a: &Args) -> Result<(f64, f64), Box<dyn std::error::Error
         // bar 1 clamped-free: T_1 = 4
         SystemKind::TwoBar => (3.95, 3.05),
         SystemKind::File(system) => {
-            let omega = open_mode(system, a.mode)?.omega;
-            // Rounded so that a linear period computed to 1e-13 lands on its decimal value
-            // (4.000000000000001 -> 4) and the grid on round numbers.
-            let period: f64 = format!("{:.5e}", 2.0 * PI / omega).parse()?;
-            let period = a.subharmonic as f64 * period;
-            (period * 79.0 / 80.0, period * 61.0 / 80.0)
+            let grid = PeriodGrid::for_mode(system, a.mode, a.subharmonic)?;
+            (grid.start, grid.end)
         }
     })
 }
