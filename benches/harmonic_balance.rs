@@ -65,7 +65,7 @@ fn two_points(system: &BarSystem, m: usize) -> (BackbonePoint, BackbonePoint) {
     let pick = if converged.len() >= 2 {
         &converged
     } else {
-        &points
+        &points.points
     };
     let n = pick.len();
     (pick[n - 2].clone(), pick[n - 1].clone())

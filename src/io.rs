@@ -150,6 +150,7 @@ mod tests {
             energy: 1e-6,
             energy_normalized: 2.25,
             converged: true,
+            status: crate::modal::PointStatus::Converged,
             residual_norm: 1e-15,
             iterations: 2,
             x: vec![0.0, 1e-3],

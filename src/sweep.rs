@@ -37,7 +37,7 @@
 //! ```
 
 use crate::error::{Error, SolveError};
-use crate::modal::{backbone, BackboneOptions, BackbonePoint};
+use crate::modal::{backbone, Backbone, BackboneOptions};
 use crate::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo, SolveMonitor};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 
@@ -95,7 +95,7 @@ impl<S: NonlinearSolver + Clone> SweepJob<S> {
     ///
     /// # Errors
     /// See [`modal::backbone`](fn@crate::modal::backbone).
-    pub fn run(&self) -> Result<Vec<BackbonePoint>, Error> {
+    pub fn run(&self) -> Result<Backbone, Error> {
         backbone(
             &self.system,
             self.settings,
@@ -108,7 +108,7 @@ impl<S: NonlinearSolver + Clone> SweepJob<S> {
 /// Computes every job's backbone, in the order of `jobs`: in parallel on rayon's global
 /// thread pool with the `parallel` feature, sequentially without it. Results do not depend on
 /// the number of threads.
-pub fn backbones<S>(jobs: &[SweepJob<S>]) -> Vec<Result<Vec<BackbonePoint>, Error>>
+pub fn backbones<S>(jobs: &[SweepJob<S>]) -> Vec<Result<Backbone, Error>>
 where
     S: NonlinearSolver + Clone + Send + Sync,
 {
@@ -125,7 +125,7 @@ where
 
 /// [`backbones`] one job after the other on the calling thread, whatever the features (the
 /// reference the parallel sweep is checked against).
-pub fn backbones_serial<S>(jobs: &[SweepJob<S>]) -> Vec<Result<Vec<BackbonePoint>, Error>>
+pub fn backbones_serial<S>(jobs: &[SweepJob<S>]) -> Vec<Result<Backbone, Error>>
 where
     S: NonlinearSolver + Clone,
 {

@@ -54,7 +54,7 @@ fn paper_grid_backbone(solver: impl NonlinearSolver) -> Vec<BackbonePoint> {
         assert!(p.x.iter().all(|v| v.is_finite()));
         assert!((p.omega * p.period - 2.0 * PI).abs() < 1e-12);
     }
-    points
+    points.points
 }
 
 /// Acceptance (formulation §9): on the paper's 181-point grid with `m = 20`, `n_h = 30`,

@@ -31,7 +31,7 @@ use nonsmooth_modes::modal::{
     arclength_backbone_observed, backbone, backbone_speculative_with, backbone_with, branch_seed,
     diagnose, energy, grazing_energy, law_history, natural_frequencies, parameter_branch,
     ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint, ContactState,
-    EscapingArclength, ParameterSteps, PeriodGrid, StallEscape,
+    EscapingArclength, ParameterSteps, PeriodGrid, PointStatus, StallEscape,
 };
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
@@ -222,19 +222,25 @@ impl Checks {
     }
 
     fn backbone_point(&mut self, what: &str, p: &BackbonePoint) {
-        self.finite(
-            what,
-            [
-                &p.period,
-                &p.omega,
-                &p.energy,
-                &p.energy_normalized,
-                &p.residual_norm,
-                &p.step_size,
-            ],
-        );
+        let fields = [
+            ("period", p.period),
+            ("omega", p.omega),
+            ("energy", p.energy),
+            ("E/E_g", p.energy_normalized),
+            ("residual norm", p.residual_norm),
+            ("step size", p.step_size),
+        ];
+        for (name, value) in fields {
+            self.finite(&format!("{what} {name} ({})", p.status.label()), [&value]);
+        }
         self.finite(what, &p.x);
         self.events(what, &p.events);
+        if p.converged != (p.status == PointStatus::Converged) {
+            self.no_end.push(format!(
+                "{what}: converged = {} but status {:?}",
+                p.converged, p.status
+            ));
+        }
     }
 
     fn solve_info(&mut self, what: &str, info: &SolveInfo, x: &[f64]) {
@@ -921,18 +927,23 @@ fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let solver = solver(d, c)?;
     let mut points = Vec::new();
     let stop = stop_policy(d, true);
-    let mut seen = 0;
+    let (mut seen, mut stopped) = (0, false);
     let collect = |p: &BackbonePoint| {
         points.push(p.clone());
         seen += 1;
-        match stop {
-            Stop::FirstPoint => ControlFlow::Break(()),
-            Stop::FirstRejection if !p.converged => ControlFlow::Break(()),
-            Stop::After(n) if seen >= n => ControlFlow::Break(()),
-            _ => ControlFlow::Continue(()),
+        stopped = match stop {
+            Stop::FirstPoint => true,
+            Stop::FirstRejection => !p.converged,
+            Stop::After(n) => seen >= n,
+            Stop::Never => false,
+        };
+        if stopped {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
         }
     };
-    let e_g = match d.pick("backbone", &["with", "speculative", "plain"]) {
+    let run = match d.pick("backbone", &["with", "speculative", "plain"]) {
         "with" => backbone_with(&system, s, &options, solver, collect),
         "speculative" => {
             let speculation = Speculation {
@@ -940,13 +951,18 @@ fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
             };
             backbone_speculative_with(&system, s, &options, speculation, solver, collect)
         }
-        _ => backbone(&system, s, &options, solver).map(|p| {
-            points = p;
-            1.0
+        _ => backbone(&system, s, &options, solver).map(|b| {
+            points = b.points;
+            (b.grazing_energy, b.end)
         }),
     };
-    let e_g = typed(c, "backbone", e_g)?;
+    let (e_g, end) = typed(c, "backbone", run)?;
     c.finite("E_g", [&e_g]);
+    // A run stopped by the observer says so (the plain form's observer never stops it).
+    if (end == EndReason::StoppedByObserver) != stopped {
+        c.no_end
+            .push(format!("backbone: {} points, end {end:?}", points.len()));
+    }
     points.iter().for_each(|p| c.backbone_point("backbone", p));
     Ok(())
 }

@@ -48,7 +48,7 @@ fn pair(harmonics: usize, a_c: f64, grid: PeriodGrid) -> (Vec<BackbonePoint>, Ve
         ..Default::default()
     };
     let one = backbone(&single, settings, &options, SemismoothNewton::default()).unwrap();
-    (two, one)
+    (two.points, one.points)
 }
 
 /// Both systems are the same problem: with `v_A = v_B = v` the two-bar gap `g0 - 2v` is twice

@@ -34,7 +34,9 @@
 //! `--system ds`, byte for byte. `--period-start` and `--period-end` override either default.
 //!
 //! Columns: `step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,
-//! residual_norm,iterations,step_size,event,parameter` (`exact_energy_normalized` is the exact
+//! status,residual_norm,iterations,step_size,event,parameter` (`status` is `converged`,
+//! `solver-failed` or `collapsed-to-rest`: `modal::PointStatus`; every step computed is
+//! written, also when the run then stalls and exits with code 1; `exact_energy_normalized` is the exact
 //! first mode of the clamped bar, formulation §9, when the system is the clamped bar —
 //! `--system ds` or a file with the same bars and conditions — with `--mode 1 --subharmonic 1`,
 //! and empty otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the

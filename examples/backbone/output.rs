@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
 
-pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,residual_norm,iterations,step_size,event,parameter";
+pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,status,residual_norm,iterations,step_size,event,parameter";
 
 fn events(events: &[Event]) -> String {
     events
@@ -88,7 +88,7 @@ impl Sink<'_> {
         }
         let verification = self.verification(system, p);
         let line = format!(
-            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{:.3e},{},{:.6e},{},{}{}",
+            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}",
             p.step,
             p.period,
             p.omega,
@@ -96,6 +96,7 @@ impl Sink<'_> {
             p.energy_normalized,
             exact.map(|e| format!("{e:.10e}")).unwrap_or_default(),
             p.converged,
+            p.status.label(),
             p.residual_norm,
             p.iterations,
             p.step_size,

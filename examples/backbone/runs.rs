@@ -85,11 +85,15 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         };
         let see = |p: &BackbonePoint| sink.row(&system, p, f64::NAN);
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        if a.serial || cores < 2 {
-            backbone_with(&system, a.settings, &options, solver, see)?;
+        let (_, end) = if a.serial || cores < 2 {
+            backbone_with(&system, a.settings, &options, solver, see)?
         } else {
             let speculation = Speculation::default();
-            backbone_speculative_with(&system, a.settings, &options, speculation, solver, see)?;
+            backbone_speculative_with(&system, a.settings, &options, speculation, solver, see)?
+        };
+        // Every point computed is written; a run that stalled then exits non-zero.
+        if let (None, Some(e)) = (&sink.error, end.error()) {
+            return Err(e.into());
         }
     }
     if let Some(e) = sink.error {

@@ -296,7 +296,7 @@ pub fn run(system: &BarSystem, m: usize, branch: &Branch<'_>) -> Res<Run> {
     Ok(Run {
         label: branch.label.to_string(),
         m,
-        points,
+        points: points.points,
         exact: None,
     })
 }

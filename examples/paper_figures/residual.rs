@@ -9,6 +9,7 @@ use crate::common::{
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{
     convergence_study, diagnose, energy, grazing_energy, law_history, BackbonePoint, PeriodGrid,
+    PointStatus,
 };
 use nonsmooth_modes::plot::{
     histories_panel, Figure, LegendPosition, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
@@ -190,6 +191,7 @@ fn exact_seeded_point(m: usize, period: f64) -> Res<Option<BackbonePoint>> {
         energy: e,
         energy_normalized: e / e_g,
         converged: true,
+        status: PointStatus::Converged,
         residual_norm: info.residual_norm,
         iterations: info.iterations,
         x,

@@ -139,7 +139,8 @@ pub struct Point {
     /// Value of the continuation parameter (the period under [`PeriodParametrised`], the
     /// frequency for a harmonic-balance system, the system parameter of a family).
     pub parameter: f64,
-    /// Solution (the last iterate when the step failed).
+    /// Solution (the last iterate when the step failed; the last converged solution when that
+    /// iterate's residual is not finite, as after a diverged solve).
     pub x: Vec<f64>,
     /// `|F(x, lambda)|_2`.
     pub residual_norm: f64,

@@ -405,6 +405,14 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
                 let mut f = vec![0.0; x.len()];
                 self.problem.set_parameter(lambda);
                 self.problem.residual(&x, &mut f);
+                // A solve that diverged leaves an iterate without a finite residual: the
+                // point reports the last converged solution instead (at `lambda`).
+                let x = if norm(&f).is_finite() {
+                    x
+                } else {
+                    self.problem.residual(&self.last, &mut f);
+                    self.last.clone()
+                };
                 let iterations = match (&error, solved) {
                     (_, Some(info)) => info.iterations,
                     (Some(SolveError::MaxIterations { iterations, .. }), _) => *iterations,

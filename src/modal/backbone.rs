@@ -2,16 +2,15 @@
 //! period, with energies normalised by the first grazing energy.
 
 use crate::continuation::{
-    linspace, Arclength, ArclengthOptions, Branch, Event, Observer, PeriodParametrised, Point,
+    linspace, Arclength, ArclengthOptions, Branch, EndReason, Observer, PeriodParametrised,
     Predictor, Rejection, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
 };
-use crate::error::{ContinuationError, Error, SettingsError};
-use crate::fourier::Basis;
+use crate::error::{ContinuationError, Error};
 use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
-use crate::solution::Solution;
+use crate::modal::point::{Backbone, BackbonePoint};
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
@@ -93,80 +92,21 @@ impl Default for BackboneOptions {
     }
 }
 
-/// One point of a backbone.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct BackbonePoint {
-    /// Step number.
-    pub step: usize,
-    /// Period `T`.
-    pub period: f64,
-    /// Fundamental angular frequency `Omega = 2 pi / T`.
-    pub omega: f64,
-    /// Energy `E` (formulation §7).
-    pub energy: f64,
-    /// `E / E_g`.
-    pub energy_normalized: f64,
-    /// The solver converged to a motion that touches (not the state of rest).
-    pub converged: bool,
-    /// `|F|_2` at the returned unknowns.
-    pub residual_norm: f64,
-    /// Solver iterations.
-    pub iterations: usize,
-    /// The unknowns (layout of [`NonsmoothSystem`]).
-    pub x: Vec<f64>,
-    /// Step used to reach the point (period increment, or arclength `ds`).
-    pub step_size: f64,
-    /// Events detected there (folds, jumps, grazing).
-    pub events: Vec<Event>,
-}
-
-impl BackbonePoint {
-    /// The point as a [`Solution`] of `problem` (the problem the backbone was computed for),
-    /// to ask it for fields, histories, diagnostics and the time-domain check.
-    ///
-    /// # Errors
-    /// See [`Solution::new`]: a point whose unknowns do not fit `problem`.
-    pub fn solution<'a, B: Basis>(
-        &'a self,
-        problem: &'a NonsmoothSystem<B>,
-    ) -> Result<Solution<'a, B>, SettingsError> {
-        Solution::new(problem, &self.x, self.omega)
-    }
-
-    /// The backbone view of a continuation point at fundamental frequency `omega`, with its
-    /// energy `energy` and the grazing energy `e_g` used for normalisation.
-    pub fn from_point(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
-        Self {
-            step: p.step,
-            period: 2.0 * PI / omega,
-            omega,
-            energy,
-            energy_normalized: energy / e_g,
-            converged: p.converged,
-            residual_norm: p.residual_norm,
-            iterations: p.iterations,
-            x: p.x.clone(),
-            step_size: p.step_size,
-            events: p.events.clone(),
-        }
-    }
-}
-
 /// Computes a backbone with the constant + cosine basis: seeds the branch from the linear mode
-/// at the first period and continues sequentially in the period, handing each point to
-/// `observer` (which may stop the run). Returns the first grazing energy `E_g` used for
-/// normalisation.
+/// at the first period and continues sequentially in the period, handing each point,
+/// converged or not, to `observer` (which may stop the run). Returns the first grazing energy
+/// `E_g` used for normalisation and why the run ended (a stalled run is
+/// [`EndReason::Stalled`], not an error: its points have been handed over).
 ///
 /// # Errors
-/// Invalid settings or options, a failed seed, or a stalled run.
+/// Invalid settings or options, or a failed seed: nothing was computed.
 pub fn backbone_with<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
-) -> Result<f64, Error> {
+) -> Result<(f64, EndReason), Error> {
     let run = |mut driver: Sequential<_, S>, see: &mut dyn Observer| driver.run(see);
     drive_backbone(system, settings, options, solver, run, observer)
 }
@@ -186,7 +126,7 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
     speculation: Speculation,
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
-) -> Result<f64, Error> {
+) -> Result<(f64, EndReason), Error> {
     let run = |driver: Sequential<_, S>, see: &mut dyn Observer| {
         Speculative::new(driver, speculation).run(see)
     };
@@ -202,7 +142,7 @@ fn drive_backbone<S: NonlinearSolver>(
     solver: S,
     run: impl FnOnce(Sequential<PeriodParametrised<NonsmoothSystem>, S>, &mut dyn Observer) -> Branch,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
-) -> Result<f64, Error> {
+) -> Result<(f64, EndReason), Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
     let grid = options.grid;
     for v in [grid.start, grid.end] {
@@ -283,10 +223,7 @@ fn drive_backbone<S: NonlinearSolver>(
         let e = known.unwrap_or_else(|| energy(system, &basis, &p.x, omega));
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
     });
-    match branch.end.error() {
-        Some(e) => Err(e.into()),
-        None => Ok(e_g),
-    }
+    Ok((e_g, branch.end))
 }
 
 /// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
@@ -306,7 +243,8 @@ fn grazing_and_seed(
     Ok((e_g, seed))
 }
 
-/// [`backbone_with`] collecting every point.
+/// [`backbone_with`] collecting every point: a run that stalls returns what it computed, with
+/// its end reason ([`Backbone::error`]).
 ///
 /// # Errors
 /// See [`backbone_with`].
@@ -315,13 +253,17 @@ pub fn backbone<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
-) -> Result<Vec<BackbonePoint>, Error> {
+) -> Result<Backbone, Error> {
     let mut points = Vec::new();
-    backbone_with(system, settings, options, solver, |p| {
+    let (grazing_energy, end) = backbone_with(system, settings, options, solver, |p| {
         points.push(p.clone());
         ControlFlow::Continue(())
     })?;
-    Ok(points)
+    Ok(Backbone {
+        grazing_energy,
+        points,
+        end,
+    })
 }
 
 /// Options of [`arclength_backbone`].

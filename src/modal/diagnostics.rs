@@ -8,9 +8,10 @@
 use crate::bar::{End, EndRef};
 use crate::error::{Error, SettingsError};
 use crate::fourier::{check_memory, Basis};
-use crate::modal::backbone::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use crate::modal::backbone::{backbone, BackboneOptions, PeriodGrid};
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
+use crate::modal::point::BackbonePoint;
 use crate::solve::NonlinearSolver;
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};

@@ -9,11 +9,11 @@ mod escape;
 pub mod field;
 pub mod linear;
 mod parameter;
+mod point;
 
 pub use backbone::{
     arclength_backbone, arclength_backbone_observed, backbone, backbone_speculative_with,
-    backbone_with, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint,
-    PeriodGrid,
+    backbone_with, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PeriodGrid,
 };
 pub use defaults::linear_period;
 pub use diagnostics::{
@@ -27,3 +27,4 @@ pub use linear::{
     ContactState, LinearMode,
 };
 pub use parameter::{parameter_branch, ParameterSteps};
+pub use point::{Backbone, BackbonePoint, PointStatus};

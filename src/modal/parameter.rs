@@ -10,9 +10,9 @@ use crate::continuation::{
     Arclength, ArclengthOptions, Branch, Point, Sequential, SequentialOptions, Step,
 };
 use crate::error::{ContinuationError, Error};
-use crate::modal::backbone::BackbonePoint;
 use crate::modal::energy::energy;
 use crate::modal::linear::grazing_energy;
+use crate::modal::point::BackbonePoint;
 use crate::solve::NonlinearSolver;
 use crate::system::{HarmonicBalanceSettings, ParameterFamily, SystemFamily};
 use std::ops::ControlFlow;

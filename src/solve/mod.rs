@@ -227,8 +227,28 @@ pub(crate) fn point_on_ray(x: &[f64], dx: &[f64], t: f64, out: &mut [f64]) {
     }
 }
 
+/// The Euclidean norm, finite whenever the entries are: the plain sum of squares, and when it
+/// overflows (entries beyond about `1e154`) the sum rescaled by the largest entry. Bit for bit
+/// the plain formula wherever that is finite.
 pub(crate) fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+    let plain = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if plain.is_finite() {
+        return plain;
+    }
+    let scale = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if !scale.is_finite() {
+        // An infinite entry (or NaN, which `max` skips but the plain sum kept).
+        return if v.iter().any(|x| x.is_nan()) {
+            f64::NAN
+        } else {
+            f64::INFINITY
+        };
+    }
+    scale
+        * v.iter()
+            .map(|x| (x / scale) * (x / scale))
+            .sum::<f64>()
+            .sqrt()
 }
 
 /// Buffers of one solve. They live in a thread-local cache between solves, so that a

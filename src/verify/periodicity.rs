@@ -179,6 +179,7 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
 ///     ..Default::default()
 /// };
 /// let point = backbone(&system, settings, &options, SemismoothNewton::default())?
+///     .points
 ///     .pop()
 ///     .unwrap();
 /// let basis = settings.cosine_basis()?;

@@ -363,15 +363,19 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             return Step::Finished(EndReason::MaxSteps);
         }
         let n = self.problem.dimension();
-        let direction = match (self.options.predictor, &self.previous) {
+        let secant = match (self.options.predictor, &self.previous) {
             (TangentPredictor::Secant, Some(prev)) => {
                 let mut d: Vec<f64> = self.y.iter().zip(prev).map(|(a, b)| a - b).collect();
                 let len = self.metric.norm(&d);
-                d.iter_mut().for_each(|v| *v /= len);
-                d
+                // Two equal points (a step far below rounding) have no secant.
+                (len > 0.0 && len.is_finite()).then(|| {
+                    d.iter_mut().for_each(|v| *v /= len);
+                    d
+                })
             }
-            _ => self.tangent.clone(),
+            _ => None,
         };
+        let direction = secant.unwrap_or_else(|| self.tangent.clone());
         let predicted: Vec<f64> = self
             .y
             .iter()

@@ -1,0 +1,159 @@
+//! The points of a backbone and what a backbone run returns: every point it computed, each
+//! with its status, and the reason it ended. A run that stalls or is stopped keeps its points.
+
+use crate::continuation::{EndReason, Event, Point};
+use crate::error::{ContinuationError, SettingsError, SolveError};
+use crate::fourier::Basis;
+use crate::solution::Solution;
+use crate::system::NonsmoothSystem;
+use std::f64::consts::PI;
+
+/// One point of a backbone.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct BackbonePoint {
+    /// Step number.
+    pub step: usize,
+    /// Period `T`.
+    pub period: f64,
+    /// Fundamental angular frequency `Omega = 2 pi / T`.
+    pub omega: f64,
+    /// Energy `E` (formulation §7).
+    pub energy: f64,
+    /// `E / E_g`.
+    pub energy_normalized: f64,
+    /// The solver converged to a motion that touches (not the state of rest):
+    /// `status == PointStatus::Converged`.
+    pub converged: bool,
+    /// What became of the step: converged, solver failed (with its error), or collapsed to
+    /// the state of rest.
+    pub status: PointStatus,
+    /// `|F|_2` at the returned unknowns.
+    pub residual_norm: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// The unknowns (layout of [`NonsmoothSystem`]).
+    pub x: Vec<f64>,
+    /// Step used to reach the point (period increment, or arclength `ds`).
+    pub step_size: f64,
+    /// Events detected there (folds, jumps, grazing).
+    pub events: Vec<Event>,
+}
+
+impl BackbonePoint {
+    /// The point as a [`Solution`] of `problem` (the problem the backbone was computed for),
+    /// to ask it for fields, histories, diagnostics and the time-domain check.
+    ///
+    /// # Errors
+    /// See [`Solution::new`]: a point whose unknowns do not fit `problem`.
+    pub fn solution<'a, B: Basis>(
+        &'a self,
+        problem: &'a NonsmoothSystem<B>,
+    ) -> Result<Solution<'a, B>, SettingsError> {
+        Solution::new(problem, &self.x, self.omega)
+    }
+
+    /// The backbone view of a continuation point at fundamental frequency `omega`, with its
+    /// energy `energy` and the grazing energy `e_g` used for normalisation.
+    pub fn from_point(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
+        Self {
+            step: p.step,
+            period: 2.0 * PI / omega,
+            omega,
+            energy,
+            energy_normalized: energy / e_g,
+            converged: p.converged,
+            status: PointStatus::of(p),
+            residual_norm: p.residual_norm,
+            iterations: p.iterations,
+            x: p.x.clone(),
+            step_size: p.step_size,
+            events: p.events.clone(),
+        }
+    }
+}
+
+/// What became of one step of a backbone.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum PointStatus {
+    /// The solver converged to a motion of the branch.
+    Converged,
+    /// The solver failed; the point holds its last iterate.
+    SolverFailed(SolveError),
+    /// The solver converged to a motion whose energy is below the backbone's trivial-energy
+    /// floor ([`BackboneOptions::trivial_energy`](crate::modal::BackboneOptions::trivial_energy)
+    /// times `E_g`): the state of rest, which is not a point of the branch.
+    CollapsedToRest,
+}
+
+impl PointStatus {
+    /// The status of a continuation point of a backbone, whose acceptance test is the
+    /// trivial-energy floor.
+    pub fn of(point: &Point) -> Self {
+        match (&point.error, point.converged) {
+            (_, true) => Self::Converged,
+            (Some(e), false) => Self::SolverFailed(e.clone()),
+            (None, false) => Self::CollapsedToRest,
+        }
+    }
+
+    /// A short label for tables: `converged`, `solver-failed` or `collapsed-to-rest`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::SolverFailed(_) => "solver-failed",
+            Self::CollapsedToRest => "collapsed-to-rest",
+        }
+    }
+}
+
+/// A backbone run: the grazing energy `E_g` its energies are normalised by, every point it
+/// computed (converged or not, in step order) and why it ended. It derefs to its points.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Backbone {
+    /// The first grazing energy `E_g`.
+    pub grazing_energy: f64,
+    /// Every point, converged or not.
+    pub points: Vec<BackbonePoint>,
+    /// Why the run ended.
+    pub end: EndReason,
+}
+
+impl Backbone {
+    /// The converged points.
+    pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
+        self.points.iter().filter(|p| p.converged)
+    }
+
+    /// The error of a run that ended on one (a stall, too many rejections, a step below the
+    /// minimum), `None` for a run that completed or was stopped by its observer.
+    pub fn error(&self) -> Option<ContinuationError> {
+        self.end.error()
+    }
+}
+
+impl std::ops::Deref for Backbone {
+    type Target = [BackbonePoint];
+    fn deref(&self) -> &[BackbonePoint] {
+        &self.points
+    }
+}
+
+impl IntoIterator for Backbone {
+    type Item = BackbonePoint;
+    type IntoIter = std::vec::IntoIter<BackbonePoint>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.points.into_iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a Backbone {
+    type Item = &'a BackbonePoint;
+    type IntoIter = std::slice::Iter<'a, BackbonePoint>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.points.iter()
+    }
+}
