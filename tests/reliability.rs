@@ -691,7 +691,7 @@ fn complementarity_parameters_keep_the_residual_finite_or_are_rejected() {
 
 /// Finite unknowns whose energy overflows (a seed scaled to `1e300`): `Solution` accepts
 /// them, and its normalised energy and the periodicity check return typed errors naming the
-/// quantity instead of `Ok(NaN)` (found by `tests/stress.rs`).
+/// quantity instead of `Ok(NaN)` (found by `tests/stress/`).
 #[test]
 fn overflowing_motions_are_typed_errors() {
     let system = clamped();
@@ -733,7 +733,7 @@ fn overflowing_motions_are_typed_errors() {
 /// Parameter values near `±f64::MAX` whose step overflows are refused by the sequential
 /// driver (each point reports its step, which would be infinite), and a parameter branch
 /// from a system without grazing energy is refused like a backbone (found by
-/// `tests/stress.rs`).
+/// `tests/stress/`).
 #[test]
 fn overflowing_steps_and_missing_grazing_energy_are_typed_errors() {
     use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
@@ -844,7 +844,7 @@ fn huge_frequencies_are_rejected_with_the_problem_limit() {
 
 /// A dogleg whose trust radius shrinks to zero (a tiny initial radius and a subnormal minimum
 /// radius that underflows relative to a small solution) gives up with a typed error instead
-/// of shrinking forever (found by `tests/stress.rs`, seed `0x1234abcd`, case 2403).
+/// of shrinking forever (found by `tests/stress/`, seed `0x1234abcd`, case 2403).
 #[test]
 fn a_dogleg_whose_radius_reaches_zero_gives_up() {
     use nonsmooth_modes::continuation::ContinuationProblem;

@@ -1,0 +1,121 @@
+//! What a case found beyond its result: non-finite numbers in `Ok` results, runs without a
+//! consistent end reason, typed errors that do not display; and which inputs are moderate
+//! enough for the plain-number evaluators to be checked.
+
+use nonsmooth_modes::continuation::{Branch, EndReason, Event, Point};
+use nonsmooth_modes::modal::{BackbonePoint, PointStatus};
+use nonsmooth_modes::solve::SolveInfo;
+use nonsmooth_modes::system::BarSystem;
+
+/// The findings of one case beyond its result: non-finite numbers in `Ok` results and runs
+/// whose end reason is missing or contradicts what happened.
+#[derive(Default)]
+pub(crate) struct Checks {
+    pub(crate) non_finite: Vec<String>,
+    pub(crate) no_end: Vec<String>,
+}
+
+impl Checks {
+    pub(crate) fn finite<'a>(&mut self, what: &str, values: impl IntoIterator<Item = &'a f64>) {
+        if let Some(v) = values.into_iter().find(|v| !v.is_finite()) {
+            self.non_finite.push(format!("{what} has {v}"));
+        }
+    }
+
+    pub(crate) fn point(&mut self, what: &str, p: &Point) {
+        self.finite(what, [&p.parameter, &p.residual_norm, &p.step_size]);
+        self.finite(what, &p.x);
+        self.events(what, &p.events);
+    }
+
+    fn events(&mut self, what: &str, events: &[Event]) {
+        for e in events {
+            match e {
+                Event::Fold { parameter } => self.finite(what, [parameter]),
+                Event::Jump { ratio } => self.finite(what, [ratio]),
+                _ => {}
+            }
+        }
+    }
+
+    pub(crate) fn backbone_point(&mut self, what: &str, p: &BackbonePoint) {
+        let fields = [
+            ("period", p.period),
+            ("omega", p.omega),
+            ("energy", p.energy),
+            ("E/E_g", p.energy_normalized),
+            ("residual norm", p.residual_norm),
+            ("step size", p.step_size),
+        ];
+        for (name, value) in fields {
+            self.finite(&format!("{what} {name} ({})", p.status.label()), [&value]);
+        }
+        self.finite(what, &p.x);
+        self.events(what, &p.events);
+        if p.converged != (p.status == PointStatus::Converged) {
+            self.no_end.push(format!(
+                "{what}: converged = {} but status {:?}",
+                p.converged, p.status
+            ));
+        }
+    }
+
+    pub(crate) fn solve_info(&mut self, what: &str, info: &SolveInfo, x: &[f64]) {
+        self.finite(what, [&info.residual_norm]);
+        self.finite(what, x);
+    }
+
+    /// The points of a branch, and its end reason against whether the observer stopped it.
+    pub(crate) fn branch(&mut self, what: &str, branch: &Branch, stopped: bool) {
+        for p in &branch.points {
+            self.point(what, p);
+        }
+        let by_observer = branch.end == EndReason::StoppedByObserver;
+        if by_observer != stopped {
+            self.no_end.push(format!(
+                "{what}: observer stopped = {stopped}, end = {:?}",
+                branch.end
+            ));
+        }
+    }
+
+    /// A typed error: it displays (the message is the user's explanation).
+    pub(crate) fn error(&mut self, what: &str, e: &impl std::fmt::Display) -> String {
+        let message = e.to_string();
+        if message.is_empty() {
+            self.no_end
+                .push(format!("{what}: an error with an empty message"));
+        }
+        message
+    }
+}
+
+/// The result of a case's main call: `Err` carries the typed error's message.
+pub(crate) type CaseResult = Result<(), String>;
+
+/// Turns a typed error into the case's result, after checking that it displays.
+pub(crate) fn typed<T, E: std::fmt::Display>(
+    c: &mut Checks,
+    what: &str,
+    r: Result<T, E>,
+) -> Result<T, String> {
+    r.map_err(|e| format!("{what}: {}", c.error(what, &e)))
+}
+
+/// Whether `v` is finite and zero or of moderate size (`1e-100` to `1e100`).
+fn moderate(v: f64) -> bool {
+    v.is_finite() && (v == 0.0 || (1e-30..=1e30).contains(&v.abs()))
+}
+
+/// Whether a motion `x` at `omega` of `system` has moderate numbers only, so that the true
+/// values of the plain-number evaluators (`energy`, the field) are representable: they
+/// return numbers, not results, and are checked only there, while every `Result` API is
+/// checked whatever its inputs.
+pub(crate) fn moderate_motion(system: &BarSystem, x: &[f64], omega: f64) -> bool {
+    let bars = system.bars().iter().all(|b| {
+        [b.length(), b.wave_speed(), b.stiffness()]
+            .into_iter()
+            .all(moderate)
+    });
+    bars && x.iter().all(|&v| moderate(v)) && omega > 0.0 && moderate(omega)
+}
