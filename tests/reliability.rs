@@ -877,3 +877,46 @@ fn a_dogleg_whose_radius_reaches_zero_gives_up() {
         Err(e) => assert!(!e.to_string().is_empty()),
     }
 }
+
+/// A grid whose end is below the rounding of its start (`1e300 -> 4.19`) ends at its end and
+/// stays between its ends (the steps alone would end at 0, a period of zero; found by
+/// `tests/stress/`, seed `0x1234abcd`, case 20735); ordinary grids keep their steps.
+#[test]
+fn grids_end_at_their_end_whatever_the_scale_of_their_start() {
+    for (start, end) in [
+        (1e300, 4.188),
+        (4.188, 1e300),
+        (-1e300, 1e-3),
+        (1e-320, 1e300),
+    ] {
+        let values = linspace(start, end, 5).unwrap();
+        assert_eq!(values[0], start);
+        assert_eq!(values[4], end, "{start:e} -> {end:e}: {values:?}");
+        let (lo, hi) = (start.min(end), start.max(end));
+        assert!(values.iter().all(|v| (lo..=hi).contains(v)), "{values:?}");
+    }
+    let paper = linspace(3.95, 3.05, 181).unwrap();
+    let h = (3.05 - 3.95) / 180.0;
+    assert!(paper
+        .iter()
+        .enumerate()
+        .all(|(i, &v)| v == 3.95 + h * i as f64));
+}
+
+/// A law whose gap exceeds `MAX_OFFSET` (motions reaching it would have energies beyond
+/// `f64`) is refused by the problem with the limit; `1e150` itself builds.
+#[test]
+fn gaps_beyond_the_offset_limit_are_refused_by_the_problem() {
+    use nonsmooth_modes::system::MAX_OFFSET;
+    assert!(
+        NonsmoothSystem::new(&clamped_bar_with_obstacle(MAX_OFFSET).unwrap(), settings()).is_ok()
+    );
+    for gap in [1e151, 1e300, f64::MAX] {
+        match NonsmoothSystem::new(&clamped_bar_with_obstacle(gap).unwrap(), settings()) {
+            Err(Error::Settings(SettingsError::OutOfRange { value, max, .. })) => {
+                assert_eq!((value, max), (gap, MAX_OFFSET));
+            }
+            other => panic!("gap {gap:e}: {:?}", other.map(|p| p.dimension())),
+        }
+    }
+}

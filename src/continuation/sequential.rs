@@ -510,11 +510,13 @@ pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, Continua
     crate::fourier::check_memory("the values of a grid", steps as f64)?;
     let last = (steps - 1) as f64;
     let h = (end - start) / last;
-    if (start + h * last).is_finite() {
+    let reached = start + h * last;
+    if reached.is_finite() && (reached - end).abs() <= 4.0 * f64::EPSILON * end.abs() {
         return Ok((0..steps).map(|i| start + h * i as f64).collect());
     }
-    // `end - start` or the last value overflows (ends near `f64::MAX`): interpolate without
-    // forming them.
+    // `end - start` or the last value overflows (ends near `f64::MAX`), or the steps lose
+    // `end` to rounding (`1e300 -> 4` would end at 0): interpolate, which ends at `end`
+    // exactly and keeps every value between the ends.
     Ok((0..steps)
         .map(|i| {
             let t = i as f64 / last;

@@ -18,5 +18,6 @@ pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};
 pub use layout::Layout;
 pub use problem::{
-    Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE, MAX_PHASE,
+    Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE, MAX_OFFSET,
+    MAX_PHASE,
 };

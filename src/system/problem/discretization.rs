@@ -56,6 +56,10 @@ fn problem_doubles(len: usize, samples: usize, unknowns: usize, laws: usize) -> 
 /// significant digit (and the energies, of order `(k l)^2`, approach overflow).
 pub const MAX_PHASE: f64 = 4_503_599_627_370_496.0;
 
+/// The largest gap (or force offset) of a unilateral law that a problem accepts, `1e150`: the
+/// energy of a motion reaching it, of order `EA g^2 / l`, must stay within `f64`.
+pub const MAX_OFFSET: f64 = 1e150;
+
 /// The accepted complementarity parameters `a_c`, `[1e-150, 1e150]`: the law compares the
 /// force with `a_c g` and its Jacobian carries `a_c`-weighted Gram sums, which stay finite
 /// for gaps, forces and their sums up to `1e150` (a scale `a_c` far from the ratio of a
@@ -67,7 +71,8 @@ impl<B: Basis> Discretization<B> {
     ///
     /// # Errors
     /// [`SettingsError::NotPositive`] for a non-positive or non-finite `a_c`,
-    /// [`SettingsError::OutOfRange`] for one outside [`COMPLEMENTARITY_RANGE`],
+    /// [`SettingsError::OutOfRange`] for one outside [`COMPLEMENTARITY_RANGE`] or a law whose
+    /// gap or force offset exceeds [`MAX_OFFSET`] in magnitude,
     /// [`SettingsError::NoContact`] for a linear system, [`SettingsError::TooLarge`] for a
     /// problem beyond the memory budget ([`crate::fourier::MEMORY_BUDGET_BYTES`]).
     pub(super) fn new(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
@@ -90,10 +95,23 @@ impl<B: Basis> Discretization<B> {
             return Err(SettingsError::NoContact.into());
         }
         let unknowns = system.unknowns_per_harmonic();
-        let offsets = system
+        let offsets: Vec<(f64, f64)> = system
             .laws()
             .map(|l| (l.gap().offset, l.force().offset))
             .collect();
+        // Motions that reach a gap beyond `MAX_OFFSET` have energies beyond `f64`.
+        if let Some(&v) = (offsets.iter())
+            .flat_map(|(g, f)| [g, f])
+            .find(|v| v.abs() > MAX_OFFSET)
+        {
+            return Err(SettingsError::OutOfRange {
+                what: "gap or force offset of a unilateral law",
+                value: v,
+                min: -MAX_OFFSET,
+                max: MAX_OFFSET,
+            }
+            .into());
+        }
         let len = basis.len();
         check_memory(
             "harmonic-balance problem",

@@ -28,7 +28,7 @@ mod discretization;
 mod state;
 mod step;
 
-pub use discretization::{Discretization, COMPLEMENTARITY_RANGE, MAX_PHASE};
+pub use discretization::{Discretization, COMPLEMENTARITY_RANGE, MAX_OFFSET, MAX_PHASE};
 
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
