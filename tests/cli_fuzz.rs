@@ -108,6 +108,7 @@ const FLAGS: &[(&str, Value)] = &[
     ("solver", Value::Word(&["newton", "dogleg"])),
     ("newton", Value::Word(&["fail-fast", "full"])),
     ("retry-depth", Value::Count(0, 5)),
+    ("max-failures", Value::Count(0, 50)),
     ("selection", Value::Word(&["first", "lowest-energy"])),
     ("serial", Value::Switch),
     ("out", Value::File),

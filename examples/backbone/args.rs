@@ -3,13 +3,14 @@
 
 use crate::systems::{load_assembly, SystemKind};
 use nonsmooth_modes::continuation::{ArclengthOptions, Selection};
+use nonsmooth_modes::modal::BackboneOptions;
 use nonsmooth_modes::system::HarmonicBalanceSettings;
 
 pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] | [--assembly FILE.toml|FILE.json]
   [--harmonics M] [--samples-per-harmonic NH]
   [--complementarity AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
-  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K]
+  [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
   [--selection first|lowest-energy] [--serial] [--out FILE]
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
@@ -60,6 +61,8 @@ pub struct Args {
     /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
     pub fail_fast: Option<bool>,
     pub retry_depth: usize,
+    /// Consecutive failed steps before a sequential run ends as stalled.
+    pub max_failures: usize,
     pub selection: Selection,
     /// No speculative retry on a second thread.
     pub serial: bool,
@@ -113,6 +116,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         dogleg: false,
         fail_fast: None,
         retry_depth: 1,
+        max_failures: BackboneOptions::default().max_consecutive_failures,
         selection: Selection::FirstConverged,
         serial: false,
         out: None,
@@ -181,6 +185,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
                 }
             }
             Long("retry-depth") => a.retry_depth = parser.value()?.parse()?,
+            Long("max-failures") => a.max_failures = parser.value()?.parse()?,
             Long("selection") => {
                 a.selection = match parser.value()?.string()?.as_str() {
                     "first" => Selection::FirstConverged,

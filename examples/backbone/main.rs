@@ -6,7 +6,8 @@
 //!     [--assembly FILE]
 //!     [--harmonics 20 --samples-per-harmonic 30 --complementarity 4] [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
-//!     [--newton fail-fast|full] [--retry-depth K] [--selection first|lowest-energy] [--serial]
+//!     [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
+//!     [--selection first|lowest-energy] [--serial]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--progress] [--verify]
@@ -58,7 +59,9 @@
 //! `--retry-depth` earlier converged points (`SequentialOptions::retry_depth`, default 1; 0
 //! switches the retry off). Where the machine has more than one core, the first retry runs on
 //! a second thread beside the first attempt (`backbone_speculative_with`; the same points, bit
-//! for bit); `--serial` keeps everything on one thread.
+//! for bit); `--serial` keeps everything on one thread. A sequential run ends as stalled
+//! (exit code 1, after writing every row) after `--max-failures` consecutive failed steps
+//! (`BackboneOptions::max_consecutive_failures`, default 40).
 //!
 //! `--selection lowest-energy` (`Selection::LowestMeasure` through
 //! `BackboneOptions::selection`; period runs only) solves every step from the prediction and

@@ -80,6 +80,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             mode: a.mode,
             subharmonic: a.subharmonic,
             retry_depth: a.retry_depth,
+            max_consecutive_failures: a.max_failures,
             selection: a.selection,
             ..Default::default()
         };
@@ -147,6 +148,7 @@ fn run_parameter(
         };
         let options = SequentialOptions {
             retry_depth: a.retry_depth,
+            max_consecutive_failures: a.max_failures,
             ..Default::default()
         };
         ParameterSteps::Values(linspace(value, far, a.steps)?, options)
