@@ -50,6 +50,28 @@ pub fn two_bars_in_contact(second: Bar, gap: f64) -> Result<BarSystem, ModelErro
     b.build()
 }
 
+/// A chain of `bars` unit bars: the first clamped at its left end, each right end facing the
+/// next bar's left end across `gap`, the last held by a ground spring of stiffness
+/// `robin_stiffness` at its right end. The inner bars are held only by their contacts (they
+/// have a rigid-body mode while the contacts are open). `bars = 3` is the three-bar chain of
+/// `examples/assemblies/three_bar_chain.toml` with `robin_stiffness = 0.5`.
+///
+/// # Errors
+/// [`ModelError::NoBars`] for `bars = 0`; a gap or stiffness that is not positive and finite.
+pub fn contact_chain(bars: usize, gap: f64, robin_stiffness: f64) -> Result<BarSystem, ModelError> {
+    let mut b = AssemblyBuilder::new();
+    let ids: Vec<_> = (0..bars).map(|_| b.add_bar(Bar::unit())).collect();
+    let (Some(first), Some(last)) = (ids.first(), ids.last()) else {
+        return Err(ModelError::NoBars);
+    };
+    b.dirichlet(first.left())?;
+    for pair in ids.windows(2) {
+        b.contact(pair[0].right(), pair[1].left(), gap)?;
+    }
+    b.robin(last.right(), robin_stiffness)?;
+    b.build()
+}
+
 /// Natural frequency `i >= 1` of a clamped-free bar: `(2i - 1) pi c / (2 l)`.
 pub fn clamped_free_frequency(i: usize, length: f64, wave_speed: f64) -> f64 {
     (2.0 * i as f64 - 1.0) * PI * wave_speed / (2.0 * length)

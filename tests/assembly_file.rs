@@ -86,6 +86,9 @@ fn example_files_build_the_shorthand_systems() {
     let chain = load("three_bar_chain.toml");
     assert_eq!(chain.names(), ["1", "2", "3"]);
     assert_eq!(chain.system().contact_count(), 2);
+    let reference = nonsmooth_modes::reference::contact_chain(3, 1e-3, 0.5).unwrap();
+    assert_same_system(chain.system(), &reference);
+    assert!(nonsmooth_modes::reference::contact_chain(0, 1e-3, 0.5).is_err());
 }
 
 #[test]

@@ -1,32 +1,17 @@
 //! A backbone run keeps everything it computed: a run that stalls returns its points, each
 //! with its status, and the reason it ended.
 
-use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::EndReason;
 use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid, PointStatus};
-use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, contact_chain};
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::ContinuationError;
 
 /// Clamped bar 1, contact, bar 2, contact, bar 3 on a Robin spring: bar 2 is held only by
 /// its contacts, and the default seeds do not converge on it (yet).
 fn three_bar_chain() -> BarSystem {
-    let mut b = AssemblyBuilder::new();
-    let (one, two, three) = (
-        b.add_bar(Bar::unit()),
-        b.add_bar(Bar::unit()),
-        b.add_bar(Bar::unit()),
-    );
-    b.dirichlet(one.left())
-        .unwrap()
-        .contact(one.right(), two.left(), 1e-3)
-        .unwrap()
-        .contact(two.right(), three.left(), 1e-3)
-        .unwrap()
-        .robin(three.right(), 0.5)
-        .unwrap();
-    b.build().unwrap()
+    contact_chain(3, 1e-3, 0.5).unwrap()
 }
 
 /// A run that stalls returns every point it computed with a status that is not `Converged`,

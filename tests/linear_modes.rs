@@ -180,21 +180,7 @@ fn rigid_body_modes_with_their_multiplicity() {
     assert_eq!(count(&walls, ContactState::Open), 1);
     assert_eq!(count(&walls, ContactState::Closed), 0);
 
-    let mut b = AssemblyBuilder::new();
-    let (one, two, three) = (
-        b.add_bar(Bar::unit()),
-        b.add_bar(Bar::unit()),
-        b.add_bar(Bar::unit()),
-    );
-    b.dirichlet(one.left())
-        .unwrap()
-        .contact(one.right(), two.left(), 1e-3)
-        .unwrap()
-        .contact(two.right(), three.left(), 1e-3)
-        .unwrap()
-        .robin(three.right(), 0.5)
-        .unwrap();
-    let chain = b.build().unwrap();
+    let chain = nonsmooth_modes::reference::contact_chain(3, 1e-3, 0.5).unwrap();
     assert_eq!(count(&chain, ContactState::Open), 1);
     assert_eq!(count(&chain, ContactState::Closed), 0);
 
