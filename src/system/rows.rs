@@ -24,6 +24,13 @@ pub fn quantity_weights(quantity: Quantity, end: End, stiffness: f64) -> (f64, f
     }
 }
 
+/// Weights `(w_u, w_x)` such that `quantity = w_u u + w_x u_x` at an end (the form of
+/// [`quantity_weights`] in the strain `u_x` rather than the outward strain `p = n u_x`).
+pub fn quantity_weights_in_strain(quantity: Quantity, end: End, stiffness: f64) -> (f64, f64) {
+    let (wu, wp) = quantity_weights(quantity, end, stiffness);
+    (wu, wp * end.normal())
+}
+
 /// Adds `term` to a dense row over the `2 n_bars` Helmholtz unknowns, and its derivative in
 /// `omega` to `d_row`.
 fn add_term(

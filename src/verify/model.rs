@@ -2,8 +2,9 @@
 
 use super::VerifyError;
 use crate::bar::{Bar, BarId, End, EndRef};
-use crate::bc::{BoundaryCondition, LinearRows, Observable, Quantity, Term};
+use crate::bc::{BoundaryCondition, LinearRows, Observable, Term};
 use crate::error::ModelError;
+use crate::system::rows::quantity_weights_in_strain;
 use crate::system::BarSystem;
 
 /// An end rule the integrator advances exactly (see the [module docs](super)).
@@ -88,18 +89,6 @@ pub struct Model {
     conditions: Vec<Condition>,
 }
 
-/// `(weight of u, weight of u_x)` of a quantity at an end.
-fn weights(q: Quantity, end: End, stiffness: f64) -> (f64, f64) {
-    let n = end.normal();
-    match q {
-        Quantity::Displacement => (1.0, 0.0),
-        Quantity::OutwardDisplacement => (n, 0.0),
-        Quantity::Strain => (0.0, 1.0),
-        Quantity::OutwardStrain => (0.0, n),
-        Quantity::ContactForce => (0.0, -stiffness),
-    }
-}
-
 /// A linear form of end quantities collapsed to `(end, weight of u, weight of u_x)` per end.
 fn collapse(terms: &[Term], ends: &[EndRef], system: &BarSystem) -> Option<Vec<(f64, f64)>> {
     let mut out = vec![(0.0, 0.0); ends.len()];
@@ -108,7 +97,8 @@ fn collapse(terms: &[Term], ends: &[EndRef], system: &BarSystem) -> Option<Vec<(
             return None;
         }
         let i = ends.iter().position(|e| *e == t.end)?;
-        let (wu, wx) = weights(t.quantity, t.end.end, system.stiffness_at(t.end));
+        let (wu, wx) =
+            quantity_weights_in_strain(t.quantity, t.end.end, system.stiffness_at(t.end));
         out[i].0 += t.coefficient * wu;
         out[i].1 += t.coefficient * wx;
     }
@@ -417,6 +407,7 @@ fn force_form(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bc::Quantity;
     use crate::reference::{
         clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
     };

@@ -27,7 +27,7 @@ use crate::bar::{Bar, End, EndRef};
 use crate::bc::Quantity;
 use crate::bem::sinc;
 use crate::fourier::Basis;
-use crate::system::rows::quantity_weights;
+use crate::system::rows::quantity_weights_in_strain;
 use crate::system::{BarSystem, Layout};
 
 /// Energy `E = sum_b EA_b/2 int (u_t^2/c_b^2 + u_x^2) dx + energy stored in conditions`,
@@ -127,8 +127,8 @@ pub(crate) fn energy_of<B: Basis>(
                 End::Right => 2,
             };
         let (u, strain) = (ends[at], ends[at + 1]);
-        let (wu, wp) = quantity_weights(quantity, e.end, system.stiffness_at(e));
-        wu * u + wp * e.end.normal() * strain
+        let (wu, wx) = quantity_weights_in_strain(quantity, e.end, system.stiffness_at(e));
+        wu * u + wx * strain
     };
     total
         + system
