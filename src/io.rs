@@ -10,7 +10,7 @@ use std::io::{self, Write};
 
 /// Header of [`write_backbone_csv`].
 pub const BACKBONE_CSV_HEADER: &str =
-    "step,period,omega,energy,energy_normalized,converged,residual_norm,iterations,step_size,event";
+    "step,period,omega,energy,energy_normalized,converged,status,residual_norm,iterations,step_size,event";
 
 /// Writes a backbone as CSV: [`BACKBONE_CSV_HEADER`], then one row per point (events joined
 /// with `;`).
@@ -31,13 +31,14 @@ fn write_point_cells(p: &BackbonePoint, mut out: impl Write) -> io::Result<()> {
     let events: Vec<&str> = p.events.iter().map(Event::label).collect();
     write!(
         out,
-        "{},{:.12},{:.12},{:.12e},{:.12e},{},{:.4e},{},{:.6e},{}",
+        "{},{:.12},{:.12},{:.12e},{:.12e},{},{},{:.4e},{},{:.6e},{}",
         p.step,
         p.period,
         p.omega,
         p.energy,
         p.energy_normalized,
         p.converged,
+        p.status.label(),
         p.residual_norm,
         p.iterations,
         p.step_size,
@@ -48,7 +49,7 @@ fn write_point_cells(p: &BackbonePoint, mut out: impl Write) -> io::Result<()> {
 /// Header of [`write_branches_csv`]: `branch,harmonics`, the columns of
 /// [`BACKBONE_CSV_HEADER`], then `omega_ratio,exact_energy_normalized`.
 pub const BRANCHES_CSV_HEADER: &str = "branch,harmonics,step,period,omega,energy,\
-     energy_normalized,converged,residual_norm,iterations,step_size,event,omega_ratio,\
+     energy_normalized,converged,status,residual_norm,iterations,step_size,event,omega_ratio,\
      exact_energy_normalized";
 
 /// One branch of a table written by [`write_branches_csv`].
@@ -203,19 +204,21 @@ mod tests {
         write_backbone_csv(&points[..1], &mut single).unwrap();
         let single = String::from_utf8(single).unwrap();
         let backbone_row = single.lines().nth(1).unwrap();
+        // The backbone's columns sit after `branch,harmonics`; the ratio and exact value after.
+        let k = 2 + BACKBONE_CSV_HEADER.split(',').count();
         for line in &lines[1..] {
             let cells: Vec<&str> = line.split(',').collect();
             assert_eq!(cells.len(), header.len());
-            assert_eq!(cells[2..12].join(","), backbone_row);
+            assert_eq!(cells[2..k].join(","), backbone_row);
         }
         let cells: Vec<&str> = lines[1].split(',').collect();
         assert_eq!(cells[..2], ["NSM1; m = 20", "20"]);
-        let ratio: f64 = cells[12].parse().unwrap();
+        let ratio: f64 = cells[k].parse().unwrap();
         assert!((ratio - point().omega / 0.5).abs() < 1e-11);
-        assert_eq!(cells[13].parse::<f64>().unwrap(), 7.0);
+        assert_eq!(cells[k + 1].parse::<f64>().unwrap(), 7.0);
         let cells: Vec<&str> = lines[3].split(',').collect();
         assert_eq!(cells[..2], ["NSM2", "40"]);
-        assert_eq!(cells[13], "");
+        assert_eq!(cells[k + 1], "");
         assert!(format!("{:?}", branches[0]).contains("points: 2"));
     }
 
