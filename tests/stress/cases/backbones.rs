@@ -50,12 +50,7 @@ pub(crate) fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let collect = |p: &BackbonePoint| {
         points.push(p.clone());
         seen += 1;
-        stopped = match stop {
-            Stop::FirstPoint => true,
-            Stop::FirstRejection => !p.converged,
-            Stop::After(n) => seen >= n,
-            Stop::Never => false,
-        };
+        stopped = stops_at(stop, seen, p);
         if stopped {
             ControlFlow::Break(())
         } else {
@@ -190,12 +185,7 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let observer = |value: f64, p: &BackbonePoint| {
         seen += 1;
         points.push((value, p.clone()));
-        stopped = match stop {
-            Stop::FirstPoint => true,
-            Stop::FirstRejection => !p.converged,
-            Stop::After(n) => seen >= n,
-            Stop::Never => false,
-        };
+        stopped = stops_at(stop, seen, p);
         if stopped {
             ControlFlow::Break(())
         } else {
@@ -230,4 +220,15 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
         c.backbone_point("parameter point", &p);
     }
     Ok(())
+}
+
+/// Whether a backbone observer with policy `stop` stops at point `p`, the `seen`-th it is
+/// handed (every point counts, converged or not).
+fn stops_at(stop: Stop, seen: usize, p: &BackbonePoint) -> bool {
+    match stop {
+        Stop::FirstPoint => true,
+        Stop::FirstRejection => !p.converged,
+        Stop::After(n) => seen >= n,
+        Stop::Never => false,
+    }
 }
