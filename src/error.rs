@@ -162,6 +162,19 @@ pub enum SettingsError {
         /// Its natural frequency.
         omega: f64,
     },
+    /// No start of an energy-parametrised backbone: every solve at a fixed frequency just
+    /// above the linear mode's, from its grazing seed, failed or reached a motion that does
+    /// not touch (the state of rest).
+    #[error(
+        "no start for the nonsmooth mode of the linear mode at omega = {omega}: {attempts} \
+         solves at fixed frequencies just above it reached no motion in contact"
+    )]
+    NoStart {
+        /// The linear mode's natural frequency.
+        omega: f64,
+        /// Solves tried.
+        attempts: usize,
+    },
     /// The seed's harmonic exceeds the basis.
     #[error(
         "subharmonic {subharmonic} needs harmonic {subharmonic} but the basis stops at {harmonics}"

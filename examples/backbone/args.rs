@@ -14,8 +14,8 @@ pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--r
   [--selection first|lowest-energy] [--serial] [--out FILE]
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
-  [--parameter omega|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
-  [--progress] [--verify]";
+  [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
+  [--energy-range LO:HI] [--progress] [--verify]";
 
 /// Largest `--steps` and `--max-steps`.
 pub const MAX_POINTS: usize = 1_000_000;
@@ -38,6 +38,8 @@ const SHORTHAND_VALUES: [&str; 5] = [
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Parameter {
     Omega,
+    /// The energy level `E / E_g`, the frequency an unknown.
+    Energy,
     Gap,
     RobinStiffness,
     StiffnessRatio,
@@ -72,6 +74,8 @@ pub struct Args {
     pub omega_range: Option<(f64, f64)>,
     pub parameter: Parameter,
     pub parameter_range: Option<(f64, f64)>,
+    /// Levels `E / E_g` of `--parameter energy`.
+    pub energy_range: Option<(f64, f64)>,
     pub progress: bool,
     pub verify: bool,
 }
@@ -125,12 +129,14 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         omega_range: None,
         parameter: Parameter::Omega,
         parameter_range: None,
+        energy_range: None,
         progress: false,
         verify: false,
     };
     let mut assembly = None;
     let mut system_given = false;
     let mut values_given = Vec::new();
+    let mut parameter_given = false;
     let mut parser = lexopt::Parser::from_env();
     while let Some(arg) = parser.next()? {
         if let Long(flag) = arg {
@@ -210,8 +216,10 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             }
             Long("omega-range") => a.omega_range = Some(range(&parser.value()?.string()?)?),
             Long("parameter") => {
+                parameter_given = true;
                 a.parameter = match parser.value()?.string()?.as_str() {
-                    "omega" => Parameter::Omega,
+"omega" => Parameter::Omega,
+                    "energy" => Parameter::Energy,
                     "gap" => Parameter::Gap,
                     "robin-stiffness" => Parameter::RobinStiffness,
                     "stiffness-ratio" => Parameter::StiffnessRatio,
@@ -219,6 +227,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
                 }
             }
             Long("parameter-range") => a.parameter_range = Some(range(&parser.value()?.string()?)?),
+            Long("energy-range") => a.energy_range = Some(range(&parser.value()?.string()?)?),
             Long("progress") => a.progress = true,
             Long("verify") => a.verify = true,
             Short('h') | Long("help") => return Ok(None),
@@ -235,10 +244,18 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             )
             .into());
         }
-        if a.parameter != Parameter::Omega {
-            return Err("--parameter other than omega needs a --system shorthand".into());
+        if !matches!(a.parameter, Parameter::Omega | Parameter::Energy) {
+            return Err("--parameter other than omega or energy needs a --system shorthand".into());
+        }
+        // A file's branch is continued in the energy unless the period is asked for.
+        let period_asked = a.period_start.is_some() || a.period_end.is_some() || a.arclength;
+        if !parameter_given && !period_asked {
+            a.parameter = Parameter::Energy;
         }
         a.system = SystemKind::File(load_assembly(&path)?);
+    }
+    if a.parameter == Parameter::Energy && a.arclength {
+        return Err("--parameter energy is sequential: it takes no --method arclength".into());
     }
     Ok(Some(a))
 }

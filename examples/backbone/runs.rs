@@ -5,12 +5,14 @@ use crate::output::{Sink, HEADER};
 use crate::systems::{build_system, clamped_gap, default_periods, parameter_value};
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, backbone_speculative_with, backbone_with, parameter_branch,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
+    arclength_backbone, backbone, backbone_speculative_with, backbone_with, energy_backbone_with,
+    parameter_branch, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
+    EnergyBackboneOptions, EnergyGrid, ParameterSteps, PeriodGrid,
 };
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
 // A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
 use nonsmooth_modes::sweep::Solver;
+use nonsmooth_modes::system::BarSystem;
 use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -48,7 +50,9 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         // Arclength's stall escapes solve from far starts: the full budget.
         Solver::Newton(SemismoothNewton::default())
     };
-    if a.parameter != Parameter::Omega {
+    if a.parameter == Parameter::Energy {
+        run_energy(a, &system, solver, &mut sink)?;
+    } else if a.parameter != Parameter::Omega {
         run_parameter(a, t0, solver, &mut sink)?;
     } else if a.arclength {
         let (lo, hi) = (2.0 * PI / t0, 2.0 * PI / t1);
@@ -101,6 +105,41 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         return Err(e.into());
     }
     Ok((sink.total, sink.converged))
+}
+
+/// Continuation in the energy level `E / E_g` (the frequency an unknown).
+fn run_energy(
+    a: &Args,
+    system: &BarSystem,
+    solver: Solver,
+    sink: &mut Sink<'_>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let levels = match a.energy_range {
+        Some((start, end)) => EnergyGrid {
+            start,
+            end,
+            steps: a.steps,
+        },
+        None => EnergyGrid {
+            steps: a.steps,
+            ..EnergyGrid::for_mode(system, a.mode)?
+        },
+    };
+    let options = EnergyBackboneOptions {
+        levels,
+        mode: a.mode,
+        subharmonic: a.subharmonic,
+        retry_depth: a.retry_depth,
+        max_consecutive_failures: a.max_failures,
+        ..Default::default()
+    };
+    let see = |p: &BackbonePoint| sink.row(system, p, f64::NAN);
+    let (_, end) = energy_backbone_with(system, a.settings, &options, solver, see)?;
+    eprintln!("backbone: energy run ended: {end:?}");
+    match (&sink.error, end.error()) {
+        (None, Some(e)) => Err(e.into()),
+        _ => Ok(()),
+    }
 }
 
 /// Continuation in a system parameter at the fixed period `period`.

@@ -69,7 +69,7 @@ pub fn load_assembly(path: &str) -> Result<BarSystem, lexopt::Error> {
 pub fn build_system(a: &Args, parameter: Parameter, value: f64) -> Result<BarSystem, ModelError> {
     let mut a = a.clone();
     match parameter {
-        Parameter::Omega => {}
+        Parameter::Omega | Parameter::Energy => {}
         Parameter::Gap => a.gap = value,
         Parameter::RobinStiffness => a.robin_stiffness = value,
         Parameter::StiffnessRatio => a.stiffness_ratio = value,
@@ -87,7 +87,7 @@ pub fn build_system(a: &Args, parameter: Parameter, value: f64) -> Result<BarSys
 
 pub fn parameter_value(a: &Args, parameter: Parameter) -> f64 {
     match parameter {
-        Parameter::Omega => f64::NAN,
+        Parameter::Omega | Parameter::Energy => f64::NAN,
         Parameter::Gap => a.gap,
         Parameter::RobinStiffness => a.robin_stiffness,
         Parameter::StiffnessRatio => a.stiffness_ratio,

@@ -16,16 +16,18 @@
 //! [`ContinuationError`]: crate::ContinuationError
 
 mod arclength;
+mod bordering;
 mod driver;
 mod progress;
 mod sequential;
 mod speculative;
 
 pub use arclength::{Arclength, ArclengthOptions, ArclengthScale, TangentPredictor};
+pub(crate) use bordering::solve_bordered;
 pub(crate) use driver::{next_point, run_with};
 pub use driver::{Branch, EndReason, Observer, RejectReason, Rejection, Step};
 pub use progress::{quiet, Progress};
-pub use sequential::{linspace, Predictor, Selection, Sequential, SequentialOptions};
+pub use sequential::{geomspace, linspace, Predictor, Selection, Sequential, SequentialOptions};
 pub use speculative::{Speculation, SpeculationStats, Speculative};
 
 use crate::error::SolveError;

@@ -524,3 +524,27 @@ pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, Continua
         })
         .collect())
 }
+
+/// `steps` values from `start` to `end` (both included, exactly) in geometric progression:
+/// equispaced in `ln`, for parameters such as energies that span decades.
+///
+/// # Errors
+/// [`ContinuationError::InvalidOption`] for an end that is not positive and finite, or
+/// fewer than 2 steps.
+pub fn geomspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
+    for v in [start, end] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(ContinuationError::InvalidOption {
+                what: "range end (positive)",
+                value: v,
+            });
+        }
+    }
+    let mut values: Vec<f64> = linspace(start.ln(), end.ln(), steps)?
+        .into_iter()
+        .map(f64::exp)
+        .collect();
+    values[0] = start;
+    values[steps - 1] = end;
+    Ok(values)
+}

@@ -233,6 +233,20 @@ pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsE
         return Err(SettingsError::NoContact);
     }
     let mode = open_mode(system, 1)?;
+    Ok((grazing_energy_of(system, &mode)?, mode))
+}
+
+/// The grazing energy of the linear mode `mode` (of the open-contact system): the least
+/// energy of a motion in its eigenspace whose amplitude just closes a contact gap, as in
+/// [`grazing_energy`], which is that of the first mode. The nonsmooth mode that emanates
+/// from `mode` leaves the linear family at this energy.
+///
+/// # Errors
+/// As [`grazing_energy`].
+pub fn grazing_energy_of(system: &BarSystem, mode: &LinearMode) -> Result<f64, SettingsError> {
+    if system.contact_count() == 0 {
+        return Err(SettingsError::NoContact);
+    }
     let d = mode.shapes.len();
     let e: Vec<f64> = mode
         .shapes
@@ -276,7 +290,7 @@ pub fn grazing_energy(system: &BarSystem) -> Result<(f64, LinearMode), SettingsE
     }
     match best {
         None => Err(SettingsError::NoGrazing { omega: mode.omega }),
-        Some((energy, _, _)) if energy.is_normal() => Ok((energy, mode)),
+        Some((energy, _, _)) if energy.is_normal() => Ok(energy),
         Some((energy, law, gap)) => {
             Err(SettingsError::GrazingEnergyOutOfRange { law, gap, energy })
         }

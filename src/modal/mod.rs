@@ -5,8 +5,10 @@ mod backbone;
 mod defaults;
 pub mod diagnostics;
 pub mod energy;
+mod energy_backbone;
 mod escape;
 pub mod field;
+mod level;
 pub mod linear;
 mod parameter;
 mod point;
@@ -19,12 +21,17 @@ pub use defaults::linear_period;
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,
 };
-pub use energy::{energy, energy_at};
+pub use energy::{energy, energy_at, energy_gradient};
+pub use energy_backbone::{
+    energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, ESCAPE_AFTER,
+    ESCAPE_PERIODS, START_AMPLITUDES, START_RATIOS,
+};
 pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};
+pub use level::{split_frequency, EnergyLevel};
 pub use linear::{
-    branch_seed, grazing_energy, natural_frequencies, open_mode, rigid_body_modes, seed_from_mode,
-    ContactState, LinearMode,
+    branch_seed, grazing_energy, grazing_energy_of, natural_frequencies, open_mode,
+    rigid_body_modes, seed_from_mode, ContactState, LinearMode,
 };
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};

@@ -56,6 +56,18 @@ impl BackbonePoint {
     /// The backbone view of a continuation point at fundamental frequency `omega`, with its
     /// energy `energy` and the grazing energy `e_g` used for normalisation.
     pub fn from_point(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
+        Self::from_parts(p, (&p.x, omega), energy, e_g, PointStatus::of(p))
+    }
+
+    /// The backbone view of a continuation point whose unknowns, `x` at `omega`, are given
+    /// apart from it (a point of an energy-level problem holds `(x, Omega)`), with its status.
+    pub(crate) fn from_parts(
+        p: &Point,
+        (x, omega): (&[f64], f64),
+        energy: f64,
+        e_g: f64,
+        status: PointStatus,
+    ) -> Self {
         Self {
             step: p.step,
             period: 2.0 * PI / omega,
@@ -63,10 +75,10 @@ impl BackbonePoint {
             energy,
             energy_normalized: energy / e_g,
             converged: p.converged,
-            status: PointStatus::of(p),
+            status,
             residual_norm: p.residual_norm,
             iterations: p.iterations,
-            x: p.x.clone(),
+            x: x.to_vec(),
             step_size: p.step_size,
             events: p.events.clone(),
         }
@@ -86,25 +98,37 @@ pub enum PointStatus {
     /// floor ([`BackboneOptions::trivial_energy`](crate::modal::BackboneOptions::trivial_energy)
     /// times `E_g`): the state of rest, which is not a point of the branch.
     CollapsedToRest,
+    /// The solver converged to a motion the backbone's acceptance test refuses (an
+    /// energy-level backbone refuses a frequency that is not positive or beyond the
+    /// problem's [`max_frequency`](crate::system::Discretization::max_frequency)).
+    Rejected,
 }
 
 impl PointStatus {
     /// The status of a continuation point of a backbone, whose acceptance test is the
     /// trivial-energy floor.
     pub fn of(point: &Point) -> Self {
+        Self::refused_as(point, Self::CollapsedToRest)
+    }
+
+    /// The status of a continuation point, `refused` where the acceptance test refused a
+    /// converged solution.
+    pub(crate) fn refused_as(point: &Point, refused: Self) -> Self {
         match (&point.error, point.converged) {
             (_, true) => Self::Converged,
             (Some(e), false) => Self::SolverFailed(e.clone()),
-            (None, false) => Self::CollapsedToRest,
+            (None, false) => refused,
         }
     }
 
-    /// A short label for tables: `converged`, `solver-failed` or `collapsed-to-rest`.
+    /// A short label for tables: `converged`, `solver-failed`, `collapsed-to-rest` or
+    /// `rejected`.
     pub fn label(&self) -> &'static str {
         match self {
             Self::Converged => "converged",
             Self::SolverFailed(_) => "solver-failed",
             Self::CollapsedToRest => "collapsed-to-rest",
+            Self::Rejected => "rejected",
         }
     }
 }

@@ -1,18 +1,17 @@
 //! The bordered corrector system of the pseudo-arclength driver, its bordering solve, and the
 //! diagonal metric of the scaled norm on `y = (x, lambda)`.
 
+use crate::continuation::bordering::solve_bordered;
 use crate::continuation::ContinuationProblem;
 use crate::linalg::DenseMatrix;
-use crate::solve::{residual_scale, Problem, SingularStep, Structured, PIVOT_TOLERANCE};
+use crate::solve::{residual_scale, Problem, SingularStep, Structured};
 
 /// The bordered corrector system `[F(x, lambda); s <t, y - y_p>_W]` as a [`Problem`] in
 /// `y = (x, lambda)`, with `s` the residual scale of the problem.
 ///
-/// Its structured solve is the bordering algorithm on the problem's own structured solve:
-/// `J a = r_x` and `J b = dF/dlambda` in one call, then
-/// `dlambda = (r_lambda - c.a) / (d - c.b)`, `dx = a - dlambda b`, where `(c, d)` is the
-/// border row. Where `J` alone is singular (a fold) or has no structure, it falls back to
-/// the dense bordered Jacobian.
+/// Its structured solve is the bordering algorithm ([`solve_bordered`]) on the problem's own
+/// structured solve, with the border row `(c, d)`; where `J` alone is singular (a fold) or
+/// has no structure, it falls back to the dense bordered Jacobian.
 pub(super) struct Bordered<'a, P: ?Sized> {
     problem: &'a mut P,
     tangent: &'a [f64],
@@ -114,43 +113,11 @@ impl<P: ContinuationProblem + ?Sized> Structured for Bordered<'_, P> {
         rhs: &mut [f64],
         columns: usize,
     ) -> Option<Result<(), SingularStep>> {
-        let n = self.problem.dimension();
         let x = self.at(y);
         let mut buffer = std::mem::take(&mut self.scratch.columns);
-        buffer.clear();
-        for column in rhs.chunks_exact(n + 1).take(columns) {
-            buffer.extend_from_slice(&column[..n]);
-        }
-        buffer.resize((columns + 1) * n, 0.0);
-        self.problem
-            .parameter_derivative(x, &mut buffer[columns * n..]);
-        let solved = self
-            .problem
-            .structure()
-            .and_then(|s| s.solve_jacobian(x, &mut buffer, columns + 1));
-        let result = match solved {
-            Some(Ok(())) => {
-                let b = &buffer[columns * n..];
-                let cb: f64 = (0..n).map(|i| self.border(i) * b[i]).sum();
-                let pivot = self.border(n) - cb;
-                let size = self.border(n).abs() + cb.abs();
-                if pivot.is_finite() && pivot.abs() > PIVOT_TOLERANCE * size {
-                    for (column, a) in rhs.chunks_exact_mut(n + 1).zip(buffer.chunks_exact(n)) {
-                        let ca: f64 = (0..n).map(|i| self.border(i) * a[i]).sum();
-                        let dl = (column[n] - ca) / pivot;
-                        for i in 0..n {
-                            column[i] = a[i] - dl * b[i];
-                        }
-                        column[n] = dl;
-                    }
-                    Some(Ok(()))
-                } else {
-                    None
-                }
-            }
-            // A singular J with a regular bordered matrix (a fold): the dense path decides.
-            _ => None,
-        };
+        let (scale, tangent, metric) = (self.scale, self.tangent, self.metric);
+        let border = |i: usize| scale * tangent[i] * metric.weight(i);
+        let result = solve_bordered(self.problem, x, (rhs, columns), border, &mut buffer);
         self.scratch.columns = buffer;
         result
     }

@@ -94,11 +94,7 @@ pub(crate) fn energy_of<B: Basis>(
     let mut buffer = vec![0.0; 2 * len + 4 * nb];
     let (weights, ends) = buffer.split_at_mut(2 * len);
     let (w, v) = weights.split_at_mut(len);
-    basis.functions_at(theta, w);
-    basis.derivatives_at(theta, v);
-    for v in v.iter_mut() {
-        *v *= omega;
-    }
+    time_weights(basis, (omega, theta), w, v);
     // With the cosine basis at theta = 0 (the common call) every velocity weight vanishes:
     // skip the kinetic sums altogether.
     let moving = v.iter().any(|&v| v != 0.0);
@@ -113,13 +109,24 @@ pub(crate) fn energy_of<B: Basis>(
         };
         let c2 = bar.wave_speed() * bar.wave_speed();
         total += 0.5 * bar.stiffness() * (strain + kinetic / c2);
-        let each = || (0..len).map(|i| harmonics.get(i));
-        ends[4 * b] = each().map(|h| h.w * h.a).sum();
-        ends[4 * b + 1] = each().map(|h| h.w * h.b).sum();
-        ends[4 * b + 2] = each().map(|h| h.w * h.ul).sum();
-        ends[4 * b + 3] = each().map(|h| h.w * h.dl).sum();
+        ends[4 * b..4 * b + 4].copy_from_slice(&harmonics.end_values());
     }
-    let ends = &*ends;
+    total + stored_energy(system, ends, conditions)
+}
+
+/// The time weights `w_i = phi_i(theta)` and `v_i = omega phi_i'(theta)` of the basis
+/// functions: displacement and velocity of each coefficient at phase `theta`.
+fn time_weights<B: Basis>(basis: &B, (omega, theta): (f64, f64), w: &mut [f64], v: &mut [f64]) {
+    basis.functions_at(theta, w);
+    basis.derivatives_at(theta, v);
+    for v in v.iter_mut() {
+        *v *= omega;
+    }
+}
+
+/// The energy stored in the conditions of `system` (those of `conditions`), given the end
+/// values `ends[4 b..4 b + 4] = (u(0), u_x(0), u(l_b), u_x(l_b))` of each bar `b`.
+pub(crate) fn stored_energy(system: &BarSystem, ends: &[f64], conditions: Conditions) -> f64 {
     let value = |e: EndRef, quantity: Quantity| {
         let at = 4 * e.bar.index()
             + match e.end {
@@ -130,12 +137,11 @@ pub(crate) fn energy_of<B: Basis>(
         let (wu, wx) = quantity_weights_in_strain(quantity, e.end, system.stiffness_at(e));
         wu * u + wx * strain
     };
-    total
-        + system
-            .conditions()
-            .filter(|c| conditions == Conditions::All || c.unilateral().is_none())
-            .map(|c| c.stored_energy(&value))
-            .sum::<f64>()
+    system
+        .conditions()
+        .filter(|c| conditions == Conditions::All || c.unilateral().is_none())
+        .map(|c| c.stored_energy(&value))
+        .sum::<f64>()
 }
 
 /// Harmonics per [`Block`]: the SIMD lanes (and independent accumulators, which hide the
@@ -219,6 +225,18 @@ impl Harmonics {
             block.v[lane] = v[i];
             block.sinc_kl[lane] = sinc_kl;
         }
+    }
+
+    /// The end values `(u(0), u_x(0), u(l), u_x(l))` of the bar's field at the time weights
+    /// `w` it was filled with.
+    fn end_values(&self) -> [f64; 4] {
+        let each = || (0..self.len).map(|i| self.get(i));
+        [
+            each().map(|h| h.w * h.a).sum(),
+            each().map(|h| h.w * h.b).sum(),
+            each().map(|h| h.w * h.ul).sum(),
+            each().map(|h| h.w * h.dl).sum(),
+        ]
     }
 
     /// Harmonic `i`.
@@ -388,6 +406,10 @@ fn one_minus_sinc_over_z2(z: f64) -> f64 {
         (1.0 - sinc(z)) / (z * z)
     }
 }
+
+mod gradient;
+pub(crate) use gradient::energy_frequency_derivative;
+pub use gradient::energy_gradient;
 
 #[cfg(test)]
 mod tests;

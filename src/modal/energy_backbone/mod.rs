@@ -1,0 +1,274 @@
+//! Backbones parametrised by energy: the nonsmooth mode continued in `E / E_g` with the
+//! frequency as an unknown ([`EnergyLevel`]), from the grazing point of a linear mode.
+
+mod judge;
+
+use judge::Judge;
+pub use judge::{ESCAPE_PERIODS, START_AMPLITUDES, START_RATIOS};
+
+use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
+use crate::error::Error;
+use crate::modal::energy::energy;
+use crate::modal::level::{split_frequency, EnergyLevel};
+use crate::modal::linear::{grazing_energy, grazing_energy_of, open_mode};
+use crate::modal::point::{Backbone, BackbonePoint, PointStatus};
+use crate::solve::NonlinearSolver;
+use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
+use std::ops::ControlFlow;
+
+/// `steps` energy levels `E / E_g` from `start` to `end` (both included) in geometric
+/// progression.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct EnergyGrid {
+    /// First level (positive).
+    pub start: f64,
+    /// Last level (positive).
+    pub end: f64,
+    /// Number of levels (at least 2).
+    pub steps: usize,
+}
+
+impl Default for EnergyGrid {
+    /// The first mode's grid: `E / E_g` from 1, its grazing point, to 300, in 181 levels.
+    /// For the clamped bar this spans the paper's periods, `T = 3.90` to `3.02`.
+    fn default() -> Self {
+        Self {
+            start: 1.0,
+            end: 300.0,
+            steps: 181,
+        }
+    }
+}
+
+impl EnergyGrid {
+    /// The grid of NSM `mode` of `system`: from the grazing energy of linear mode `mode`
+    /// (where its nonsmooth mode leaves the linear family) to 300 times it, in 181 levels;
+    /// [`EnergyGrid::default`] for `mode = 1`.
+    ///
+    /// # Errors
+    /// A failed mode search or grazing energy ([`grazing_energy_of`]).
+    pub fn for_mode(system: &BarSystem, mode: usize) -> Result<Self, Error> {
+        let default = Self::default();
+        if mode == 1 {
+            return Ok(default);
+        }
+        let (e_g, _) = grazing_energy(system)?;
+        let start = grazing_energy_of(system, &open_mode(system, mode)?)? / e_g;
+        Ok(Self {
+            start,
+            end: start * default.end / default.start,
+            ..default
+        })
+    }
+}
+
+/// Options of [`energy_backbone`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyBackboneOptions {
+    /// Levels to visit (default [`EnergyGrid::default`]; [`EnergyGrid::for_mode`] for other
+    /// modes).
+    pub levels: EnergyGrid,
+    /// Linear mode the branch starts from (1-based, among the modes of nonzero frequency;
+    /// default 1).
+    pub mode: usize,
+    /// Period multiple `k` of the seed (NSM `mode` sub `k`; default 1).
+    pub subharmonic: usize,
+    /// Predictor of the sequential driver (default secant: the frequency changes smoothly
+    /// with the energy along a branch).
+    pub predictor: Predictor,
+    /// Consecutive failures before the run stops (default 40).
+    pub max_consecutive_failures: usize,
+    /// Retry a failed step from up to this many earlier converged points (default 1).
+    pub retry_depth: usize,
+}
+
+impl Default for EnergyBackboneOptions {
+    fn default() -> Self {
+        Self {
+            levels: EnergyGrid::default(),
+            mode: 1,
+            subharmonic: 1,
+            predictor: Predictor::Secant,
+            max_consecutive_failures: 40,
+            retry_depth: 1,
+        }
+    }
+}
+
+/// Computes a backbone by sequential continuation in the energy level `E / E_g`, the
+/// frequency being an unknown ([`EnergyLevel`]), and hands each point, converged or not, to
+/// `observer` (which may stop the run). Returns `E_g` and why the run ended.
+///
+/// # The run
+/// - **Start.** A nonsmooth mode at a fixed frequency just above linear mode `mode`'s,
+///   solved from its grazing seed (placed on harmonic `subharmonic`; see
+///   [`START_RATIOS`]). Its level is the branch's first; the grid's levels above it follow.
+/// - **Levels.** Each level is solved in `(x, Omega)` from the predictor. The state of
+///   rest is no solution at any level, so no point collapses to it.
+/// - **Acceptance.** A converged point joins the branch if its frequency is positive (and
+///   below the problem's
+///   [`max_frequency`](crate::system::Discretization::max_frequency)), it touches (a motion
+///   without contact is a linear one), and harmonic `subharmonic` carries more of its
+///   time-averaged energy than any other harmonic (else it sits on an internal resonance of
+///   the truncated system, see below). Refused points are reported as
+///   [`PointStatus::Rejected`].
+/// - **Internal resonances.** Where harmonic `n` of the truncated system resonates with a
+///   linear mode (`n Omega = omega_j`), the branch has a spike: in the period its energy
+///   rises without bound on both sides of `T_r = 2 pi n / omega_j`, so in the energy it
+///   climbs one flank for ever and never reaches the other side. When [`ESCAPE_AFTER`]
+///   levels in a row are refused or fail, the run jumps the spike at fixed periods just
+///   below the last accepted one ([`ESCAPE_PERIODS`]) and continues in the energy from the
+///   first acceptable point found there, of higher energy. Branches are assumed to harden
+///   (the period decreases as the energy grows), as they do with gaps that close.
+///
+/// # Errors
+/// Invalid settings or options, or no start
+/// ([`SettingsError::NoStart`](crate::SettingsError::NoStart)): nothing was
+/// computed.
+pub fn energy_backbone_with<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: &EnergyBackboneOptions,
+    solver: S,
+    mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+) -> Result<(f64, EndReason), Error> {
+    let problem = NonsmoothSystem::new(system, settings)?;
+    let grid = options.levels;
+    let levels = geomspace(grid.start, grid.end, grid.steps)?;
+    let (e_g, first) = grazing_energy(system)?;
+    let linear = if options.mode == 1 {
+        first
+    } else {
+        open_mode(system, options.mode)?
+    };
+    let mut judge = Judge::new(problem.clone(), e_g, options.subharmonic);
+    let (mut x, mut omega) = judge.start(&solver, &linear)?;
+    let seq_options = SequentialOptions {
+        predictor: options.predictor,
+        max_consecutive_failures: options.max_consecutive_failures,
+        retry_depth: options.retry_depth,
+        ..SequentialOptions::default()
+    };
+    let mut offset = 0;
+    loop {
+        let level = judge.level(&x, omega);
+        let values: Vec<f64> = std::iter::once(level)
+            .chain(levels.iter().copied().filter(|&l| l > level))
+            .collect();
+        let mut start = x.clone();
+        start.push(omega);
+        let mut accept = judge.clone();
+        let mut driver = Sequential::new(
+            EnergyLevel::new(problem.clone(), e_g)?,
+            &solver,
+            start,
+            values,
+            seq_options,
+        )?
+        .with_acceptance(move |y, _| {
+            let (x, omega) = split_frequency(y);
+            accept.accepts(x, omega)
+        });
+        let mut segment = Segment::default();
+        let branch = driver.run(&mut |step: &Step| {
+            let Some(p) = step.point() else {
+                return ControlFlow::Continue(());
+            };
+            let (x, omega) = split_frequency(&p.x);
+            let e = energy(system, problem.basis(), x, omega);
+            let status = PointStatus::refused_as(p, PointStatus::Rejected);
+            let mut point = BackbonePoint::from_parts(p, (x, omega), e, e_g, status);
+            point.step += offset;
+            segment.see(&point);
+            if observer(&point).is_break() {
+                segment.stopped = true;
+                return ControlFlow::Break(());
+            }
+            segment.flow()
+        });
+        offset += segment.points;
+        let (true, false, Some(last)) = (segment.escaping, segment.stopped, segment.last_accepted)
+        else {
+            return Ok((e_g, branch.end));
+        };
+        match judge.escape(&solver, (&last.0, last.1)) {
+            Some((x_new, omega_new)) => (x, omega) = (x_new, omega_new),
+            None => {
+                let parameter = judge.level(&last.0, last.1);
+                let failures = ESCAPE_PERIODS;
+                return Ok((
+                    e_g,
+                    EndReason::Stalled {
+                        failures,
+                        parameter,
+                    },
+                ));
+            }
+        }
+    }
+}
+
+/// Consecutive refused or failed levels after which an energy backbone jumps past an
+/// internal resonance.
+pub const ESCAPE_AFTER: usize = 2;
+
+/// What one segment of an energy backbone (a run of the driver between two escapes) saw.
+#[derive(Default)]
+struct Segment {
+    /// Points handed to the observer.
+    points: usize,
+    /// Refused or failed levels in a row.
+    misses: usize,
+    /// The last accepted point's `(x, Omega)`.
+    last_accepted: Option<(Vec<f64>, f64)>,
+    /// The segment stopped to jump a resonance.
+    escaping: bool,
+    /// The observer stopped the run.
+    stopped: bool,
+}
+
+impl Segment {
+    fn see(&mut self, point: &BackbonePoint) {
+        self.points += 1;
+        if point.converged {
+            self.misses = 0;
+            self.last_accepted = Some((point.x.clone(), point.omega));
+        } else {
+            self.misses += 1;
+        }
+    }
+
+    /// Stops the segment to escape after [`ESCAPE_AFTER`] misses in a row.
+    fn flow(&mut self) -> ControlFlow<()> {
+        if self.misses >= ESCAPE_AFTER && self.last_accepted.is_some() {
+            self.escaping = true;
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// [`energy_backbone_with`] collecting every point: a run that stalls returns what it
+/// computed, with its end reason ([`Backbone::error`]).
+///
+/// # Errors
+/// See [`energy_backbone_with`].
+pub fn energy_backbone<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: &EnergyBackboneOptions,
+    solver: S,
+) -> Result<Backbone, Error> {
+    let mut points = Vec::new();
+    let (grazing_energy, end) = energy_backbone_with(system, settings, options, solver, |p| {
+        points.push(p.clone());
+        ControlFlow::Continue(())
+    })?;
+    Ok(Backbone {
+        grazing_energy,
+        points,
+        end,
+    })
+}
