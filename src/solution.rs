@@ -33,6 +33,7 @@ use crate::modal::diagnostics::{
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
 use crate::modal::linear::grazing_energy;
+use crate::modal::signature::{contact_intervals, subharmonic_share};
 use crate::system::{BarSystem, NonsmoothSystem};
 use crate::verify::{periodicity_check, PeriodicityOptions, PeriodicityReport, VerifyError};
 
@@ -205,6 +206,23 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// See [`diagnose`].
     pub fn diagnose(&self, refinement: usize) -> Result<PointDiagnostics, SettingsError> {
         diagnose(self.problem, self.x, self.omega, refinement)
+    }
+
+    /// The share of the bars' time-averaged energy carried by the harmonics that are not
+    /// multiples of `k` (0 for a motion on the multiples of `k` alone).
+    ///
+    /// # Errors
+    /// See [`subharmonic_share`].
+    pub fn subharmonic_share(&self, k: usize) -> Result<f64, SettingsError> {
+        subharmonic_share(self.system(), self.problem.basis(), self.x, self.omega, k)
+    }
+
+    /// The number of contact intervals per period of each unilateral law.
+    ///
+    /// # Errors
+    /// See [`contact_intervals`].
+    pub fn contact_intervals(&self) -> Result<Vec<usize>, SettingsError> {
+        contact_intervals(self.problem, self.x, self.omega)
     }
 
     /// The exact time-domain march of the motion over its period and the periodicity defect.

@@ -68,21 +68,34 @@ pub(crate) fn check_motion<B: Basis>(
     x: &[f64],
     omega: f64,
 ) -> Result<(), SettingsError> {
-    if x.len() != problem.dimension() {
-        return Err(SettingsError::Length {
+    check_length(x, problem.dimension())?;
+    check_frequency_of(problem, omega)?;
+    check_unknowns_finite(x)
+}
+
+/// Checks that the unknowns `x` have length `expected` ([`SettingsError::Length`]).
+pub(crate) fn check_length(x: &[f64], expected: usize) -> Result<(), SettingsError> {
+    if x.len() == expected {
+        Ok(())
+    } else {
+        Err(SettingsError::Length {
             what: "unknowns",
             got: x.len(),
-            expected: problem.dimension(),
-        });
+            expected,
+        })
     }
-    check_frequency_of(problem, omega)?;
-    if let Some(v) = x.iter().find(|v| !v.is_finite()) {
-        return Err(SettingsError::NotPositive {
+}
+
+/// Checks that the unknowns `x` are finite ([`SettingsError::NotPositive`] naming
+/// "unknowns (finite)").
+pub(crate) fn check_unknowns_finite(x: &[f64]) -> Result<(), SettingsError> {
+    match x.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(SettingsError::NotPositive {
             what: "unknowns (finite)",
             value: *v,
-        });
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Checks that every value of `values` is finite: [`SettingsError::NonFiniteResult`]

@@ -1,5 +1,6 @@
 //! Modal post-processing: energy and its normalisation, linear modes of the open-contact
-//! system, branch seeds, backbones, and branches in a system parameter.
+//! system, branch seeds, backbones, branches in a system parameter, and the signature of a
+//! point for reports (subharmonic share, contact intervals per period).
 
 mod backbone;
 mod defaults;
@@ -12,6 +13,7 @@ mod level;
 pub mod linear;
 mod parameter;
 mod point;
+pub mod signature;
 
 pub use backbone::{
     arclength_backbone, arclength_backbone_observed, backbone, backbone_speculative_with,
@@ -35,3 +37,4 @@ pub use linear::{
 };
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
+pub use signature::{contact_intervals, harmonic_energies, subharmonic_share};

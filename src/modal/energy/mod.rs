@@ -270,7 +270,7 @@ impl Harmonics {
             if !(row_strain.is_finite() && row_kinetic.is_finite()) {
                 (row_strain, row_kinetic) = self.row_pairwise::<KINETIC>(i, &hi, &diagonal);
             }
-            let (int_uu, int_dd) = diagonal.integrals(&hi, &hi);
+            let (int_uu, int_dd) = diagonal.integrals((hi.a, hi.b), (hi.a, hi.b));
             strain += hi.w * (hi.w * int_dd + 2.0 * row_strain);
             if KINETIC {
                 kinetic += vi * (vi * int_uu + 2.0 * row_kinetic);
@@ -323,7 +323,7 @@ impl Harmonics {
         for j in 0..i {
             let hj = self.get(j);
             let (int_uu, int_dd) = if hj.k2 == hi.k2 {
-                diagonal.integrals(hi, &hj)
+                diagonal.integrals((hi.a, hi.b), (hj.a, hj.b))
             } else {
                 green(hi, &self.blocks[j / LANES], j % LANES)
             };
@@ -347,8 +347,9 @@ fn green(hi: &Harmonic, block: &Block, lane: usize) -> (f64, f64) {
 }
 
 /// The integrals of `cos^2, sin^2, sin cos` products at one wavenumber `k` over `[0, l]`,
-/// for the pairs with `k_i = k_j = k`.
-struct Diagonal {
+/// for the pairs with `k_i = k_j = k` (here, and for the energy of each harmonic alone in
+/// [`crate::modal::signature`]).
+pub(crate) struct Diagonal {
     k: f64,
     /// `int sin^2(kx) dx / k^2`.
     sin2_over_k2: f64,
@@ -359,6 +360,12 @@ struct Diagonal {
 }
 
 impl Diagonal {
+    /// The integrals at wavenumber `k` over `[0, l]`.
+    pub(crate) fn at(k: f64, l: f64) -> Self {
+        Self::new(k, l, sinc(k * l))
+    }
+
+    /// [`Diagonal::at`] given `sinc_kl = sinc(k l)`.
     fn new(k: f64, l: f64, sinc_kl: f64) -> Self {
         // int sin^2(kx) = l/2 - sin(2kl)/(4k) = k^2 l^3 g(2kl) * 2, int cos^2 = l - that,
         // int sin cos = sin^2(kl)/(2k), with g(z) = (1 - sinc z)/z^2.
@@ -371,15 +378,15 @@ impl Diagonal {
         }
     }
 
-    /// `(int u_1 u_2 dx, int u_1' u_2' dx)` of two harmonics at this wavenumber.
-    fn integrals(&self, h1: &Harmonic, h2: &Harmonic) -> (f64, f64) {
+    /// `(int u_1 u_2 dx, int u_1' u_2' dx)` of two harmonics at this wavenumber,
+    /// `u_j = a_j cos(kx) + b_j sin(kx)/k` given as `(a_j, b_j)`.
+    pub(crate) fn integrals(&self, (a1, b1): (f64, f64), (a2, b2): (f64, f64)) -> (f64, f64) {
         let Self {
             k,
             sin2_over_k2,
             cos2,
             sc_over_k,
         } = *self;
-        let (a1, b1, a2, b2) = (h1.a, h1.b, h2.a, h2.b);
         let int_uu = a1 * a2 * cos2 + b1 * b2 * sin2_over_k2 + (a1 * b2 + a2 * b1) * sc_over_k;
         // `k^2 (k^2 sin2_over_k2)`, not `k^4 sin2_over_k2`: finite up to `k ~ 1e154`, not 1e77.
         let int_dd = a1 * a2 * (k * k * (k * k * sin2_over_k2)) + b1 * b2 * cos2

@@ -1,0 +1,259 @@
+//! The signature of a computed periodic motion, for reports: how its energy is spread over the
+//! harmonics (and so how much of it lies outside the multiples of a subharmonic order `K`),
+//! and how many separate contact intervals each unilateral law has per period.
+//!
+//! Both are post-processing of one point, computed when it is written out, never inside the
+//! continuation loops: [`harmonic_energies`] costs `O(m^2)` flops, [`contact_intervals`] one
+//! law history per law.
+
+use crate::bc::LawSamples;
+use crate::error::SettingsError;
+use crate::fourier::Basis;
+use crate::modal::diagnostics::{
+    check_finite, check_frequency, check_length, check_unknowns_finite, law_history,
+};
+use crate::modal::energy::Diagonal;
+use crate::system::{BarSystem, Layout, NonsmoothSystem};
+use std::f64::consts::PI;
+
+/// The time-averaged mechanical energy of the bars carried by each harmonic `n = 0..=m` of
+/// the motion `x` at fundamental frequency `omega` (entry `n`; `m` the basis' highest
+/// harmonic).
+///
+/// # The maths
+/// The motion is `u_b(x, t) = sum_i u_(b,i)(x) phi_i(theta)`, `theta = Omega t`, with each
+/// `u_(b,i) = A cos(k x) + B sin(k x)/k` a Helmholtz solution at `k = n_i Omega / c_b`
+/// (`n_i` the harmonic of basis function `i`). Its energy is
+/// `E(t) = sum_b EA_b/2 int (u_x^2 + u_t^2 / c_b^2) dx`, a quadratic form in the
+/// `phi_i(theta)` and `Omega phi_i'(theta)`. Over a period, functions of distinct harmonics
+/// are orthogonal (`<cos(n theta) cos(n' theta)> = 0` for `n != n'`, and likewise with
+/// sines), so the time average `<E>` is a sum over harmonics of
+///
+/// ```text
+/// E_n = sum_b EA_b/2 sum_(i,j: n_i = n_j = n) ( <phi_i phi_j> int u_i' u_j' dx
+///                                           + (Omega/c_b)^2 <phi_i' phi_j'> int u_i u_j dx ),
+/// ```
+///
+/// the time-averaged energy of harmonic `n` moving alone. For the cosine basis
+/// (`phi_n = cos(n theta)`, `phi_0 = 1/2`) this is
+/// `EA/4 (int u_n'^2 dx + (n Omega/c)^2 int u_n^2 dx)` for `n >= 1` and `EA/8 int u_0'^2 dx`
+/// for the constant (`EA/2 int (u_0/2)'^2`: the constant function is `1/2`). The space
+/// integrals are the closed forms the energy uses for equal wavenumbers
+/// ([`crate::modal::energy`]); the time averages `<phi_i phi_j>` are taken from the basis
+/// itself by the mean over `2m + 2` equispaced phases, exact for the products of two
+/// harmonics up to `m`, so that any [`Basis`] whose functions are harmonics (as
+/// [`Basis::harmonic`] says) is handled with its own normalisation. Each `E_n` is the
+/// average of a non-negative energy, so it is non-negative (it is clamped at 0 against the
+/// rounding of the closed forms).
+///
+/// The energies stored in conditions (ground springs) are left out: they are quadratic in the
+/// end displacements and would split over the harmonics in the same way, but they are a small
+/// part of the energy of the paper's systems, and a share of the bars' energy is what the
+/// reports need. The sum over `n` is thus the time average of the bars' energy, which for an
+/// exact motion without springs is the constant energy [`crate::modal::energy`] returns.
+///
+/// # Errors
+/// [`SettingsError::Length`] if `x` is not `basis.len()` times the system's unknowns per
+/// harmonic; [`SettingsError::NotPositive`] or [`SettingsError::FrequencyTooSmall`] for an
+/// `omega` that is not positive and finite or below
+/// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY), and `NotPositive` for
+/// unknowns that are not finite; [`SettingsError::NonFiniteResult`] if an energy overflows.
+pub fn harmonic_energies<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+) -> Result<Vec<f64>, SettingsError> {
+    check_length(x, basis.len() * system.unknowns_per_harmonic())?;
+    check_frequency(omega)?;
+    check_unknowns_finite(x)?;
+    let (len, m) = (basis.len(), basis.harmonics());
+    // Coefficients grouped by harmonic (one each for the cosine basis).
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); m + 1];
+    for i in 0..len {
+        groups[basis.harmonic(i)].push(i);
+    }
+    let pairs = time_averages(basis, &groups);
+    let layout = Layout::of(system);
+    let mut energies = vec![0.0; m + 1];
+    for (n, (group, (p, d))) in groups.iter().zip(&pairs).enumerate() {
+        for (b, bar) in system.bars().iter().enumerate() {
+            let k = bar.wavenumber(n as f64 * omega);
+            let diagonal = Diagonal::at(k, bar.length());
+            let (mut strain, mut kinetic) = (0.0, 0.0);
+            for (r, &i) in group.iter().enumerate() {
+                for (s, &j) in group.iter().enumerate() {
+                    let (int_uu, int_dd) =
+                        diagonal.integrals(layout.pair(x, i, b), layout.pair(x, j, b));
+                    strain += p[r * group.len() + s] * int_dd;
+                    kinetic += d[r * group.len() + s] * int_uu;
+                }
+            }
+            let speed = omega / bar.wave_speed();
+            energies[n] += 0.5 * bar.stiffness() * (strain + speed * speed * kinetic);
+        }
+        energies[n] = energies[n].max(0.0);
+    }
+    check_finite("a harmonic's energy", omega, &energies)?;
+    Ok(energies)
+}
+
+/// For each group of coefficients of one harmonic, the time averages
+/// `(<phi_i phi_j>, <phi_i' phi_j'>)` of its pairs (row-major, `group.len()^2` each), by the
+/// mean over `2m + 2` equispaced phases: exact for products of harmonics up to `m`.
+fn time_averages<B: Basis>(basis: &B, groups: &[Vec<usize>]) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let phases = 2 * basis.harmonics() + 2;
+    let mut averages: Vec<(Vec<f64>, Vec<f64>)> = groups
+        .iter()
+        .map(|g| (vec![0.0; g.len() * g.len()], vec![0.0; g.len() * g.len()]))
+        .collect();
+    let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
+    for q in 0..phases {
+        let theta = 2.0 * PI * q as f64 / phases as f64;
+        basis.functions_at(theta, &mut phi);
+        basis.derivatives_at(theta, &mut dphi);
+        for (group, (p, d)) in groups.iter().zip(averages.iter_mut()) {
+            for (r, &i) in group.iter().enumerate() {
+                for (s, &j) in group.iter().enumerate() {
+                    p[r * group.len() + s] += phi[i] * phi[j] / phases as f64;
+                    d[r * group.len() + s] += dphi[i] * dphi[j] / phases as f64;
+                }
+            }
+        }
+    }
+    averages
+}
+
+/// The share, in `[0, 1]`, of the time-averaged energy of the bars carried by the harmonics
+/// that are not multiples of `k`: `sum_(n mod k != 0) E_n / sum_n E_n` with the energies
+/// `E_n` of [`harmonic_energies`] (whose doc has the maths; the energies stored in ground
+/// springs are left out).
+///
+/// A motion computed on a `k`-subharmonic branch (period `k T` of a mode of period `T`) that
+/// is still the `T`-periodic motion run `k` times has only harmonics that are multiples of
+/// `k` and a share of 0: a share away from 0 measures how much the branch has left it, i.e.
+/// the genuinely subharmonic content. Energies rather than coefficients, so that the share is
+/// independent of the normalisation of the basis and of the bars, and weighs each harmonic by
+/// what it carries of the motion (its strain and kinetic energy). `k = 1` gives 0 (every
+/// harmonic is a multiple of 1); the share is invariant under a scaling of `x`; a motion at
+/// rest (zero energy) has share 0.
+///
+/// # Errors
+/// [`SettingsError::ZeroIndex`] for `k = 0`; those of [`harmonic_energies`].
+pub fn subharmonic_share<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+    k: usize,
+) -> Result<f64, SettingsError> {
+    if k == 0 {
+        return Err(SettingsError::ZeroIndex {
+            what: "subharmonic order",
+            value: 0,
+        });
+    }
+    let energies = harmonic_energies(system, basis, x, omega)?;
+    let (mut outside, mut inside) = (0.0, 0.0);
+    for (n, e) in energies.iter().enumerate() {
+        if n % k == 0 {
+            inside += e;
+        } else {
+            outside += e;
+        }
+    }
+    // Both sums are non-negative, so `outside <= outside + inside` in floating point too.
+    let total = outside + inside;
+    Ok(if total > 0.0 { outside / total } else { 0.0 })
+}
+
+/// The number of contact intervals per period of each unilateral law of `problem` (in the
+/// order of [`BarSystem::laws`]) for the motion `x` at `omega`: the number of maximal runs of
+/// consecutive time samples in contact, the samples being the `N` instants
+/// `theta_k = 2 pi k / N` of the harmonic-balance grid over the whole period, taken
+/// periodically (a run through `theta = 0` counts once). A law in contact at every sample
+/// counts 1, a law never in contact 0. Summed over the laws, it is the number of contact
+/// intervals per period of the assembly.
+///
+/// # Contact criterion
+/// A sample is in contact when the law's gap branch is active there: a nonzero
+/// `d r / d gap` of the law sampled by [`UnilateralLaw::sample`](crate::bc::UnilateralLaw::sample)
+/// without smoothing, which for Signorini and contact laws (`r = -min(lambda, a_c g)`) means
+/// `lambda >= a_c g`. It is the criterion of the active sets the continuation drivers watch
+/// for grazing ([`Structured::active_set`](crate::solve::Structured::active_set)), which
+/// count the same samples (with the default `kink_blend = 0`; a blended Jacobian counts the
+/// samples of its blend band too).
+///
+/// # Whole period, not half
+/// The cosine basis is even in time, so the solver evaluates its laws on the folded grid
+/// `theta_0..theta_(N/2)` only (`[0, pi]`, each inner sample standing for itself and its
+/// mirror `theta_(N-k)`), and its active set counts samples with that multiplicity. Runs
+/// cannot be counted on the folded grid directly: a contact run through `theta = 0` or
+/// `theta = pi` is one interval of the period but is cut in half by the fold, while a run
+/// inside `(0, pi)` has a mirror image in `(pi, 2 pi)` and counts twice. Here the gap and
+/// force are synthesised on the full grid (through [`law_history`], for any basis), so every
+/// interval is counted once; for the cosine basis the count is even unless an interval is
+/// centred on `theta = 0` or `pi`.
+///
+/// An interval shorter than the sample spacing `T / N` may fall between samples and be
+/// missed; the harmonic-balance grid is where the law is enforced, so it is also the
+/// resolution at which the solution says anything about contact.
+///
+/// # Errors
+/// Those of [`law_history`]: a bad `x` or `omega`, or a gap or force that is not finite.
+pub fn contact_intervals<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+) -> Result<Vec<usize>, SettingsError> {
+    Ok(contact_samples(problem, x, omega)?
+        .iter()
+        .map(|contact| periodic_runs(contact))
+        .collect())
+}
+
+/// For each law, whether each of the `N` instants of the full grid is in contact (the
+/// criterion of [`contact_intervals`]).
+fn contact_samples<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+) -> Result<Vec<Vec<bool>>, SettingsError> {
+    let samples = problem.basis().samples();
+    let mut contact = Vec::with_capacity(problem.system().contact_count());
+    let (mut values, mut d_gap, mut d_force) =
+        (vec![0.0; samples], vec![0.0; samples], vec![0.0; samples]);
+    for (l, law) in problem.system().laws().enumerate() {
+        let h = law_history(problem, x, omega, l, samples)?;
+        let out = LawSamples {
+            values: &mut values,
+            d_gap: &mut d_gap,
+            d_force: &mut d_force,
+        };
+        law.sample(&h.gap, &h.force, problem.complementarity(), 0.0, out);
+        contact.push(d_gap.iter().map(|w| *w != 0.0).collect());
+    }
+    Ok(contact)
+}
+
+/// The number of maximal runs of `true` in the periodic sequence `values` (the last value
+/// precedes the first): the rises from `false` to `true`, or 1 if every value is `true`.
+fn periodic_runs(values: &[bool]) -> usize {
+    let Some(&last) = values.last() else {
+        return 0;
+    };
+    let mut previous = last;
+    let mut rises = 0;
+    for &v in values {
+        rises += usize::from(v && !previous);
+        previous = v;
+    }
+    if rises == 0 && last {
+        1
+    } else {
+        rises
+    }
+}
+
+#[cfg(test)]
+mod tests;
