@@ -4,7 +4,7 @@
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::branch_seed;
+use nonsmooth_modes::modal::{branch_seed, grazing_energy, EnergyLevel};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
@@ -153,5 +153,38 @@ fn line_search_residual_equals_the_residual_at_the_trial_point() {
                 }
             }
         }
+    }
+}
+
+/// The bordering solve of an energy-level problem (the harmonic-balance step bordered by
+/// `dF/dOmega` and the energy row) equals the dense solve of its Jacobian.
+#[test]
+fn bordered_energy_level_step_matches_the_dense_solve() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let settings = HarmonicBalanceSettings {
+        harmonics: 6,
+        ..Default::default()
+    };
+    let mut inner = NonsmoothSystem::new(&system, settings).unwrap();
+    let omega = 1.02 * PI / 2.0;
+    let seed = branch_seed(&mut inner, 1, 1, omega).unwrap();
+    let (e_g, _) = grazing_energy(&system).unwrap();
+    let mut problem = EnergyLevel::new(inner, e_g).unwrap();
+    problem.set_parameter(2.0);
+    let mut y: Vec<f64> = seed.iter().map(|s| 1.4 * s).collect();
+    y.push(omega);
+    let n = problem.dimension();
+    let mut f = vec![0.0; n];
+    problem.residual(&y, &mut f);
+    let mut jac = DenseMatrix::zeros(n, n);
+    problem.jacobian(&y, &mut jac);
+    let want = dense_solve(&jac, &f);
+    let mut got = f.clone();
+    problem.residual(&y, &mut f);
+    let solved = problem.structure().unwrap().solve_jacobian(&y, &mut got, 1);
+    assert!(matches!(solved, Some(Ok(()))), "{solved:?}");
+    let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g + w).abs() <= 1e-8 * scale, "{g} vs {}", -w);
     }
 }

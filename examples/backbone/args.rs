@@ -136,7 +136,6 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
     let mut assembly = None;
     let mut system_given = false;
     let mut values_given = Vec::new();
-    let mut parameter_given = false;
     let mut parser = lexopt::Parser::from_env();
     while let Some(arg) = parser.next()? {
         if let Long(flag) = arg {
@@ -216,9 +215,8 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             }
             Long("omega-range") => a.omega_range = Some(range(&parser.value()?.string()?)?),
             Long("parameter") => {
-                parameter_given = true;
                 a.parameter = match parser.value()?.string()?.as_str() {
-"omega" => Parameter::Omega,
+                    "omega" => Parameter::Omega,
                     "energy" => Parameter::Energy,
                     "gap" => Parameter::Gap,
                     "robin-stiffness" => Parameter::RobinStiffness,
@@ -246,11 +244,6 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         }
         if !matches!(a.parameter, Parameter::Omega | Parameter::Energy) {
             return Err("--parameter other than omega or energy needs a --system shorthand".into());
-        }
-        // A file's branch is continued in the energy unless the period is asked for.
-        let period_asked = a.period_start.is_some() || a.period_end.is_some() || a.arclength;
-        if !parameter_given && !period_asked {
-            a.parameter = Parameter::Energy;
         }
         a.system = SystemKind::File(load_assembly(&path)?);
     }

@@ -8,10 +8,11 @@ use crate::continuation::{
 use crate::error::{ContinuationError, Error};
 use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
+use crate::modal::energy_backbone::{amplified, first_solution, START_RATIOS};
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::modal::point::{Backbone, BackbonePoint};
-use crate::solve::NonlinearSolver;
+use crate::solve::{NonlinearSolver, SmoothingHomotopy};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
 use std::f64::consts::PI;
@@ -172,13 +173,14 @@ fn drive_backbone<S: NonlinearSolver>(
         2.0 * PI / grid.start,
     )?;
     let basis = problem.basis().clone();
+    let floor = options.trivial_energy * e_g;
+    let start = usable_start(&mut problem, &solver, start, 2.0 * PI / grid.start, floor);
     let seq_options = SequentialOptions {
         predictor: options.predictor,
         max_consecutive_failures: options.max_consecutive_failures,
         retry_depth: options.retry_depth,
         selection: options.selection,
     };
-    let floor = options.trivial_energy * e_g;
     // The acceptance test computes each converged point's energy; the observer reuses it.
     let last_energy = Rc::new(RefCell::new((Vec::new(), f64::NAN, f64::NAN)));
     let accepted_energy = Rc::clone(&last_energy);
@@ -224,6 +226,55 @@ fn drive_backbone<S: NonlinearSolver>(
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
     });
     Ok((e_g, branch.end))
+}
+
+/// The guess of a period backbone's first step at `omega`: the seed itself where `solver`
+/// takes it to a motion of energy above `floor` (the paper's systems: their runs are
+/// unchanged), else the first such solution from the seed at the amplitudes of
+/// [`START_AMPLITUDES`](crate::modal::START_AMPLITUDES), solved by `solver` and then by it
+/// inside a [`SmoothingHomotopy`], at `omega` and then at the higher frequencies of
+/// [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the first): a grazing seed can
+/// slide to rest, or to a floating bar's rigid-body rest against an obstacle (the free-free
+/// bar between two walls), where one that penetrates a little, a little further from the
+/// linear frequency, does not; a solution found at a higher frequency is walked back to
+/// `omega` in a few steps (as far as they converge). Else the seed (the first step then
+/// fails as it would have).
+fn usable_start<S: NonlinearSolver>(
+    problem: &mut NonsmoothSystem,
+    solver: &S,
+    seed: Vec<f64>,
+    omega: f64,
+    floor: f64,
+) -> Vec<f64> {
+    let (system, basis) = (problem.system().clone(), problem.basis().clone());
+    let mut above_rest =
+        |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, omega) > floor;
+    if first_solution(problem, &[solver], [seed.clone()], omega, &mut above_rest).is_some() {
+        return seed;
+    }
+    let homotopy = SmoothingHomotopy::new(solver);
+    let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
+    let found = START_RATIOS.iter().find_map(|r| {
+        let at = omega * r / START_RATIOS[0];
+        let above_rest =
+            |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, at) > floor;
+        first_solution(problem, &solvers, amplified(&seed), at, above_rest).map(|x| (x, at))
+    });
+    let Some((mut x, from)) = found else {
+        return seed;
+    };
+    // Walk the solution back to `omega` in a few steps, each from the last.
+    const WALK: usize = 8;
+    for k in 1..=WALK {
+        let at = from + (omega - from) * k as f64 / WALK as f64;
+        let above_rest =
+            |_: &mut NonsmoothSystem, y: &[f64]| energy(&system, &basis, y, at) > floor;
+        match first_solution(problem, &solvers, [x.clone()], at, above_rest) {
+            Some(y) => x = y,
+            None => break,
+        }
+    }
+    x
 }
 
 /// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub

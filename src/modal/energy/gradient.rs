@@ -127,7 +127,7 @@ impl Harmonics {
         for j in 0..self.len {
             let hj = self.get(j);
             let (int_uu, int_dd) = if hj.k2 == e.k2 {
-                diagonal.integrals(e, &hj)
+                diagonal.integrals((e.a, e.b), (hj.a, hj.b))
             } else {
                 green(e, &self.blocks[j / LANES], j % LANES)
             };

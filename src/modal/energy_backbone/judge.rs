@@ -5,6 +5,7 @@ use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
+use crate::modal::signature::harmonic_energies;
 use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;
@@ -50,51 +51,29 @@ impl Judge {
         energy(self.problem.system(), self.problem.basis(), x, omega) / self.grazing_energy
     }
 
-    /// Whether the converged motion `x` at `omega` is a point of the branch: a positive
-    /// frequency within the problem's range, an energy above rest, a contact at some time
-    /// sample (a motion without contact is a linear one: a resonant harmonic of the
-    /// truncated system, or a floating bar moved out of reach), and harmonic `subharmonic`
-    /// carrying more time-averaged energy than any other (else the motion sits on an
-    /// internal resonance of the truncated system).
+    /// Whether the converged motion `x` at `omega` is a point of the branch
+    /// ([`acceptable`]).
     pub(super) fn accepts(&mut self, x: &[f64], omega: f64) -> bool {
-        omega.is_finite()
-            && omega > 0.0
-            && omega <= self.problem.description().max_frequency()
-            && self.level(x, omega) > REST
-            && self.touches(x, omega)
-            && self.dominant_harmonic(x, omega) == Some(self.subharmonic)
+        acceptable(
+            &mut self.problem,
+            (self.grazing_energy, self.subharmonic),
+            x,
+            omega,
+        )
     }
 
-    fn touches(&mut self, x: &[f64], omega: f64) -> bool {
-        self.problem.set_parameter(omega);
-        self.problem
-            .active_set(x)
-            .is_some_and(|active| active.iter().any(|&a| a > 0))
-    }
-
-    /// The harmonic carrying the most time-averaged energy.
-    fn dominant_harmonic(&self, x: &[f64], omega: f64) -> Option<usize> {
-        let energies =
-            harmonic_energies(self.problem.system(), self.problem.basis(), x, omega).ok()?;
-        (0..energies.len()).max_by(|&a, &b| energies[a].total_cmp(&energies[b]))
-    }
-
-    /// Solves at fixed `omega` from `guess` with `solvers` in turn; the first accepted
-    /// solution.
+    /// The first accepted solution at fixed `omega` from one of `guesses`, each solved by
+    /// `solvers` in turn.
     fn solve_at(
         &mut self,
         solvers: &[&dyn NonlinearSolver],
-        guess: &[f64],
+        guesses: impl IntoIterator<Item = Vec<f64>>,
         omega: f64,
     ) -> Option<Vec<f64>> {
-        for solver in solvers {
-            let mut x = guess.to_vec();
-            self.problem.set_parameter(omega);
-            if solver.solve(&mut self.problem, &mut x).is_ok() && self.accepts(&x, omega) {
-                return Some(x);
-            }
-        }
-        None
+        let judge = (self.grazing_energy, self.subharmonic);
+        first_solution(&mut self.problem, solvers, guesses, omega, |p, x| {
+            acceptable(p, judge, x, omega)
+        })
     }
 
     /// The first point of the branch of `linear`: a nonsmooth mode at a fixed frequency just
@@ -121,11 +100,8 @@ impl Judge {
         for ratio in START_RATIOS {
             let omega = ratio * linear.omega / self.subharmonic as f64;
             let seed = seed_from_mode(&mut self.problem, linear, self.subharmonic, omega)?;
-            for amplitude in START_AMPLITUDES {
-                let guess: Vec<f64> = seed.iter().map(|v| amplitude * v).collect();
-                if let Some(x) = self.solve_at(&solvers, &guess, omega) {
-                    return Ok((x, omega));
-                }
+            if let Some(x) = self.solve_at(&solvers, amplified(&seed), omega) {
+                return Ok((x, omega));
             }
         }
         Err(SettingsError::NoStart {
@@ -148,21 +124,71 @@ impl Judge {
         let solvers: [&dyn NonlinearSolver; 1] = [solver];
         (1..=ESCAPE_PERIODS).find_map(|j| {
             let omega = 2.0 * PI / (period * (1.0 - j as f64 / 800.0));
-            self.solve_at(&solvers, x, omega)
+            self.solve_at(&solvers, [x.to_vec()], omega)
                 .filter(|x| self.level(x, omega) > level)
                 .map(|x| (x, omega))
         })
     }
 }
 
-// TEMPORARY until the signature module lands.
-fn harmonic_energies<B: crate::fourier::Basis>(
-    _: &crate::system::BarSystem,
-    basis: &B,
-    _: &[f64],
-    _: f64,
-) -> Result<Vec<f64>, SettingsError> {
-    let mut v = vec![0.0; basis.harmonics() + 1];
-    v[1] = 1.0;
-    Ok(v)
+/// Whether the converged motion `x` at `omega` of `problem` is a point of an energy
+/// backbone of NSM sub `subharmonic` with grazing energy `e_g`: a positive frequency within
+/// the problem's range, an energy above rest, a contact at some time sample (a motion
+/// without contact is a linear one: a resonant harmonic of the truncated system, or a
+/// floating bar moved out of reach), and harmonic `subharmonic` carrying more
+/// time-averaged energy than any other (else the motion sits on an internal resonance of
+/// the truncated system).
+fn acceptable(
+    problem: &mut NonsmoothSystem,
+    (e_g, subharmonic): (f64, usize),
+    x: &[f64],
+    omega: f64,
+) -> bool {
+    let (system, basis) = (problem.system(), problem.basis());
+    let dominant = || {
+        let energies = harmonic_energies(system, basis, x, omega).ok()?;
+        (0..energies.len()).max_by(|&a, &b| energies[a].total_cmp(&energies[b]))
+    };
+    omega.is_finite()
+        && omega > 0.0
+        && omega <= problem.description().max_frequency()
+        && energy(system, basis, x, omega) > REST * e_g
+        && dominant() == Some(subharmonic)
+        && touches(problem, x, omega)
+}
+
+/// Whether `x` at `omega` is in contact at some time sample of some law.
+fn touches(problem: &mut NonsmoothSystem, x: &[f64], omega: f64) -> bool {
+    problem.set_parameter(omega);
+    problem
+        .active_set(x)
+        .is_some_and(|active| active.iter().any(|&a| a > 0))
+}
+
+/// The guesses `a s` of a seed `s` for the amplitudes `a` of [`START_AMPLITUDES`].
+pub(crate) fn amplified(seed: &[f64]) -> impl Iterator<Item = Vec<f64>> + '_ {
+    START_AMPLITUDES
+        .into_iter()
+        .map(move |a| seed.iter().map(|v| a * v).collect())
+}
+
+/// The first of `guesses` that one of `solvers` (tried in turn on each guess) takes at
+/// `omega` to a solution that `accept` takes.
+pub(crate) fn first_solution(
+    problem: &mut NonsmoothSystem,
+    solvers: &[&dyn NonlinearSolver],
+    guesses: impl IntoIterator<Item = Vec<f64>>,
+    omega: f64,
+    mut accept: impl FnMut(&mut NonsmoothSystem, &[f64]) -> bool,
+) -> Option<Vec<f64>> {
+    for guess in guesses {
+        for solver in solvers {
+            let mut x = guess.clone();
+            problem.set_parameter(omega);
+            if solver.solve(problem, &mut x).is_ok() && accept(problem, &x) {
+                return Some(x);
+            }
+        }
+    }
+    None
 }

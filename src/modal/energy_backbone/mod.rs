@@ -1,9 +1,10 @@
 //! Backbones parametrised by energy: the nonsmooth mode continued in `E / E_g` with the
 //! frequency as an unknown ([`EnergyLevel`]), from the grazing point of a linear mode.
 
-mod judge;
+pub(crate) mod judge;
 
 use judge::Judge;
+pub(crate) use judge::{amplified, first_solution};
 pub use judge::{ESCAPE_PERIODS, START_AMPLITUDES, START_RATIOS};
 
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
