@@ -26,7 +26,7 @@ pub use diagnostics::{
 pub use energy::{energy, energy_at, energy_gradient};
 pub use energy_backbone::{
     energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, ESCAPE_AFTER,
-    ESCAPE_PERIODS, START_AMPLITUDES, START_RATIOS,
+    ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES, START_RATIOS,
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};

@@ -5,10 +5,12 @@ use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
+use crate::modal::point::{BackbonePoint, PointStatus};
 use crate::modal::signature::harmonic_energies;
 use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 
 /// Frequencies of the start, relative to the linear mode's: `80/79`, `40/39` and `20/19`
 /// (periods `79/80`, `39/40` and `19/20` of the mode's, the first of them the period
@@ -20,13 +22,20 @@ pub const START_RATIOS: [f64; 3] = [80.0 / 79.0, 40.0 / 39.0, 20.0 / 19.0];
 /// slightly penetrates cannot.
 pub const START_AMPLITUDES: [f64; 3] = [1.0, 1.01, 1.1];
 
-/// Periods tried to jump an internal resonance: `T_a (1 - j / 800)` for `j = 1..=16`
-/// below the last accepted period `T_a` (steps of the paper's period grid, over 2 % of
-/// `T_a`).
-pub const ESCAPE_PERIODS: usize = 16;
+/// Most steps of a walk across internal resonances in the period ([`Judge::walk`]):
+/// `T_a (1 - j / 800)` for `j = 1..=200` below the last accepted period `T_a` (steps of
+/// the paper's period grid, over a quarter of `T_a`).
+pub const ESCAPE_PERIODS: usize = 200;
+
+/// Steady steps in a row that end a walk across an internal resonance.
+pub const CALM_STEPS: usize = 2;
 
 /// Energies below this fraction of `E_g` are the state of rest.
 const REST: f64 = 1e-6;
+
+/// Largest share of the energy added from one accepted point to the next that a harmonic
+/// other than the branch's own may take: more is a harmonic running into resonance.
+pub const MARGINAL_SHARE: f64 = 0.5;
 
 /// The acceptance test of an energy backbone and its fixed-frequency solves, on its own
 /// copy of the harmonic-balance system.
@@ -35,6 +44,51 @@ pub(super) struct Judge {
     problem: NonsmoothSystem,
     grazing_energy: f64,
     subharmonic: usize,
+    /// The time-averaged energy per harmonic of the last accepted point.
+    reference: Option<Vec<f64>>,
+    /// The slope of the period in the energy along the branch ([`Slopes`]).
+    slopes: Slopes,
+}
+
+/// The last accepted `(T, ln E)` of an energy backbone and the slopes
+/// `|dT / d ln E|` of its last [`SLOPE_MEMORY`] steps. Along a hardening backbone the
+/// period falls steadily as the energy grows, and the slope changes slowly from step to
+/// step; on the flank of an internal resonance's spike the period stalls, the slope
+/// collapsing geometrically, step after step.
+#[derive(Debug, Clone, Default)]
+struct Slopes {
+    last: Option<(f64, f64)>,
+    recent: std::collections::VecDeque<f64>,
+}
+
+/// Steps whose slopes [`Slopes`] remembers.
+pub const SLOPE_MEMORY: usize = 5;
+
+/// A step whose slope `|dT / d ln E|` falls below this fraction of the largest of the last
+/// [`SLOPE_MEMORY`] is a period that stalls: the flank of a spike.
+pub const SLOPE_COLLAPSE: f64 = 0.5;
+
+impl Slopes {
+    /// Whether the step to `(period, level)` keeps the period falling at a rate comparable
+    /// to the last steps'; if so it is remembered.
+    fn step(&mut self, period: f64, level: f64) -> bool {
+        let here = (period, level.ln());
+        let Some((t, l)) = self.last else {
+            self.last = Some(here);
+            return true;
+        };
+        let slope = (here.0 - t) / (here.1 - l);
+        let largest = self.recent.iter().fold(0.0f64, |m, s| m.max(*s));
+        if !(slope < 0.0 && -slope >= SLOPE_COLLAPSE * largest) {
+            return false;
+        }
+        if self.recent.len() == SLOPE_MEMORY {
+            self.recent.pop_front();
+        }
+        self.recent.push_back(-slope);
+        self.last = Some(here);
+        true
+    }
 }
 
 impl Judge {
@@ -43,7 +97,21 @@ impl Judge {
             problem,
             grazing_energy,
             subharmonic,
+            reference: None,
+            slopes: Slopes::default(),
         }
+    }
+
+    /// Forgets the last accepted point: the next one is judged on its own.
+    pub(super) fn forget_reference(&mut self) {
+        self.reference = None;
+        self.slopes = Slopes::default();
+    }
+
+    /// Makes `x` at `omega` the last accepted point.
+    pub(super) fn set_reference(&mut self, x: &[f64], omega: f64) {
+        self.reference =
+            harmonic_energies(self.problem.system(), self.problem.basis(), x, omega).ok();
     }
 
     /// `E / E_g` of `x` at `omega`.
@@ -52,14 +120,23 @@ impl Judge {
     }
 
     /// Whether the converged motion `x` at `omega` is a point of the branch
-    /// ([`acceptable`]).
+    /// ([`acceptable`], and its period falls with the energy as along the last steps,
+    /// [`Slopes`]); if so it becomes the last accepted point.
     pub(super) fn accepts(&mut self, x: &[f64], omega: f64) -> bool {
-        acceptable(
+        let judge = (self.grazing_energy, self.subharmonic);
+        let verdict = acceptable(
             &mut self.problem,
-            (self.grazing_energy, self.subharmonic),
+            judge,
+            self.reference.as_deref(),
             x,
             omega,
-        )
+        );
+        let accepted =
+            verdict.is_some() && self.slopes.step(2.0 * PI / omega, self.level(x, omega));
+        if accepted {
+            self.reference = verdict;
+        }
+        accepted
     }
 
     /// The first accepted solution at fixed `omega` from one of `guesses`, each solved by
@@ -71,8 +148,9 @@ impl Judge {
         omega: f64,
     ) -> Option<Vec<f64>> {
         let judge = (self.grazing_energy, self.subharmonic);
+        let reference = self.reference.clone();
         first_solution(&mut self.problem, solvers, guesses, omega, |p, x| {
-            acceptable(p, judge, x, omega)
+            acceptable(p, judge, reference.as_deref(), x, omega).is_some()
         })
     }
 
@@ -111,50 +189,141 @@ impl Judge {
         .into())
     }
 
-    /// A point past an internal resonance: the first accepted solution of higher energy
-    /// than the last accepted point `(x, omega)`, at the periods of [`ESCAPE_PERIODS`] below
-    /// its period, each solved from `x`.
-    pub(super) fn escape<S: NonlinearSolver>(
+    /// Walks a spike of an internal resonance in the period, as a period grid does: from
+    /// the last accepted point `(x, omega)`, periods `T_a (1 - j / 800)` (the paper's grid
+    /// step), `j = 1..=`[`ESCAPE_PERIODS`], each solved from the last solution. Every step
+    /// is handed to `see` as a backbone point (converged or not: a point of the branch in
+    /// the period's parametrisation), which may stop the walk. The walk ends at the first
+    /// converged step past the spike: a motion the energy backbone accepts, of higher
+    /// energy than the start, ending [`CALM_STEPS`] steps in a row each of higher energy
+    /// than the step before and whose added energy no single other harmonic takes more than
+    /// [`MARGINAL_SHARE`] of (off the spike's flanks). Returns that point, not handed to
+    /// `see`: the energy backbone resumes from it.
+    pub(super) fn walk<S: NonlinearSolver>(
         &mut self,
         solver: &S,
         (x, omega): (&[f64], f64),
-    ) -> Option<(Vec<f64>, f64)> {
-        let level = self.level(x, omega);
+        last_level: f64,
+        mut see: impl FnMut(BackbonePoint) -> ControlFlow<()>,
+    ) -> Walk {
+        let judge = (self.grazing_energy, self.subharmonic);
+        let start = self.level(x, omega);
         let period = 2.0 * PI / omega;
-        let solvers: [&dyn NonlinearSolver; 1] = [solver];
-        (1..=ESCAPE_PERIODS).find_map(|j| {
+        let mut last = (x.to_vec(), start);
+        let mut energies = self.reference.clone();
+        let mut calm = 0;
+        for j in 1..=ESCAPE_PERIODS {
             let omega = 2.0 * PI / (period * (1.0 - j as f64 / 800.0));
-            self.solve_at(&solvers, [x.to_vec()], omega)
-                .filter(|x| self.level(x, omega) > level)
-                .map(|x| (x, omega))
-        })
+            let mut y = last.0.clone();
+            self.problem.set_parameter(omega);
+            let solved = solver.solve(&mut self.problem, &mut y);
+            let level = self.level(&y, omega);
+            let verdict = solved
+                .as_ref()
+                .ok()
+                .and_then(|_| acceptable(&mut self.problem, judge, None, &y, omega));
+            let status = match (&solved, &verdict) {
+                (Err(e), _) => PointStatus::SolverFailed(e.clone()),
+                (Ok(_), None) => PointStatus::Rejected,
+                (Ok(_), Some(_)) => PointStatus::Converged,
+            };
+            let steady = verdict.as_ref().is_some_and(|now| {
+                energies
+                    .as_deref()
+                    .is_some_and(|before| steady_growth(before, now, self.subharmonic))
+            });
+            calm = if steady && level > last.1 {
+                calm + 1
+            } else {
+                0
+            };
+            if calm >= CALM_STEPS && level > start {
+                // The energy backbone goes on from here, and reports it as its next point.
+                return Walk::Resume(y, omega);
+            }
+            let point = BackbonePoint {
+                step: 0,
+                period: 2.0 * PI / omega,
+                omega,
+                energy: level * self.grazing_energy,
+                energy_normalized: level,
+                converged: verdict.is_some(),
+                status,
+                residual_norm: solved.as_ref().map_or(f64::NAN, |i| i.residual_norm),
+                iterations: solved.as_ref().map_or(0, |i| i.iterations),
+                x: y.clone(),
+                step_size: -period / 800.0,
+                events: Vec::new(),
+            };
+            if see(point).is_break() {
+                return Walk::Stopped;
+            }
+            if let Some(now) = verdict {
+                if level > last_level {
+                    return Walk::Beyond;
+                }
+                last = (y, level);
+                energies = Some(now);
+            }
+        }
+        Walk::Lost
     }
 }
 
+/// How a walk across an internal resonance ended.
+pub(super) enum Walk {
+    /// Past the spike at this motion and frequency.
+    Resume(Vec<f64>, f64),
+    /// The observer stopped it.
+    Stopped,
+    /// It reached an accepted point beyond the last level asked for.
+    Beyond,
+    /// No acceptable step past the spike within [`ESCAPE_PERIODS`] steps.
+    Lost,
+}
+
+/// Whether the time-averaged energies per harmonic grew from `before` to `after` as along a
+/// backbone: the total grew, and no harmonic other than `own` took more than
+/// [`MARGINAL_SHARE`] of the energy added (on an internal resonance's spike one harmonic
+/// takes nearly all of it).
+fn steady_growth(before: &[f64], after: &[f64], own: usize) -> bool {
+    let added = after.iter().sum::<f64>() - before.iter().sum::<f64>();
+    added > 0.0
+        && (after.iter().zip(before).enumerate())
+            .all(|(n, (a, b))| n == own || a - b <= MARGINAL_SHARE * added)
+}
+
 /// Whether the converged motion `x` at `omega` of `problem` is a point of an energy
-/// backbone of NSM sub `subharmonic` with grazing energy `e_g`: a positive frequency within
-/// the problem's range, an energy above rest, a contact at some time sample (a motion
-/// without contact is a linear one: a resonant harmonic of the truncated system, or a
-/// floating bar moved out of reach), and harmonic `subharmonic` carrying more
-/// time-averaged energy than any other (else the motion sits on an internal resonance of
-/// the truncated system).
+/// backbone of NSM sub `subharmonic` with grazing energy `e_g`, after the accepted point
+/// whose time-averaged energies per harmonic are `reference`; if so, its own. The tests:
+///
+/// - a positive frequency within the problem's range and an energy above rest;
+/// - a contact at some time sample: a motion without contact is a linear one (a resonant
+///   harmonic of the truncated system, or a floating bar moved out of reach);
+/// - harmonic `subharmonic` carries the most time-averaged energy, and no other harmonic
+///   takes more than [`MARGINAL_SHARE`] of the energy added since `reference`: along a
+///   backbone the harmonics grow together, while a harmonic of the truncated system
+///   running into resonance with a linear mode (an internal resonance) takes nearly all
+///   the energy added, on a spike that rises without bound.
 fn acceptable(
     problem: &mut NonsmoothSystem,
     (e_g, subharmonic): (f64, usize),
+    reference: Option<&[f64]>,
     x: &[f64],
     omega: f64,
-) -> bool {
+) -> Option<Vec<f64>> {
     let (system, basis) = (problem.system(), problem.basis());
-    let dominant = || {
-        let energies = harmonic_energies(system, basis, x, omega).ok()?;
-        (0..energies.len()).max_by(|&a, &b| energies[a].total_cmp(&energies[b]))
-    };
-    omega.is_finite()
+    if !(omega.is_finite()
         && omega > 0.0
         && omega <= problem.description().max_frequency()
-        && energy(system, basis, x, omega) > REST * e_g
-        && dominant() == Some(subharmonic)
-        && touches(problem, x, omega)
+        && energy(system, basis, x, omega) > REST * e_g)
+    {
+        return None;
+    }
+    let energies = harmonic_energies(system, basis, x, omega).ok()?;
+    let dominant = (0..energies.len()).max_by(|&a, &b| energies[a].total_cmp(&energies[b]));
+    let steady = reference.is_none_or(|r| steady_growth(r, &energies, subharmonic));
+    (dominant == Some(subharmonic) && steady && touches(problem, x, omega)).then_some(energies)
 }
 
 /// Whether `x` at `omega` is in contact at some time sample of some law.

@@ -3,9 +3,11 @@
 
 pub(crate) mod judge;
 
-use judge::Judge;
 pub(crate) use judge::{amplified, first_solution};
-pub use judge::{ESCAPE_PERIODS, START_AMPLITUDES, START_RATIOS};
+use judge::{Judge, Walk};
+pub use judge::{
+    ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES, START_RATIOS,
+};
 
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
 use crate::error::Error;
@@ -159,6 +161,8 @@ pub fn energy_backbone_with<S: NonlinearSolver>(
             .collect();
         let mut start = x.clone();
         start.push(omega);
+        // The segment's first point is its start, a solution already judged.
+        judge.forget_reference();
         let mut accept = judge.clone();
         let mut driver = Sequential::new(
             EnergyLevel::new(problem.clone(), e_g)?,
@@ -193,9 +197,17 @@ pub fn energy_backbone_with<S: NonlinearSolver>(
         else {
             return Ok((e_g, branch.end));
         };
-        match judge.escape(&solver, (&last.0, last.1)) {
-            Some((x_new, omega_new)) => (x, omega) = (x_new, omega_new),
-            None => {
+        judge.set_reference(&last.0, last.1);
+        let walked = judge.walk(&solver, (&last.0, last.1), grid.end, |mut point| {
+            point.step += offset;
+            offset += 1;
+            observer(&point)
+        });
+        match walked {
+            Walk::Resume(x_new, omega_new) => (x, omega) = (x_new, omega_new),
+            Walk::Stopped => return Ok((e_g, EndReason::StoppedByObserver)),
+            Walk::Beyond => return Ok((e_g, EndReason::Completed)),
+            Walk::Lost => {
                 let parameter = judge.level(&last.0, last.1);
                 let failures = ESCAPE_PERIODS;
                 return Ok((
