@@ -38,7 +38,7 @@ use crate::system::{BarSystem, Layout, NonsmoothSystem};
 /// `EA/4 (int u_n'^2 dx + (n Omega/c)^2 int u_n^2 dx)` for `n >= 1` and `EA/8 int u_0'^2 dx`
 /// for the constant (`EA/2 int (u_0/2)'^2`: the constant function is `1/2`). The space
 /// integrals are the closed forms the energy uses for equal wavenumbers
-/// ([`crate::modal::energy`]). The time averages come from the basis itself, so that any
+/// ([`mod@crate::modal::energy`]). The time averages come from the basis itself, so that any
 /// [`Basis`] is handled with its own normalisation: a function of harmonic `n`
 /// ([`Basis::harmonic`]) is `phi_i = c_i cos(n theta) + s_i sin(n theta)` with
 /// `c_i = phi_i(0)` and `s_i = phi_i'(0) / n`, whence
@@ -52,7 +52,7 @@ use crate::system::{BarSystem, Layout, NonsmoothSystem};
 /// end displacements and would split over the harmonics in the same way, but they are a small
 /// part of the energy of the paper's systems, and a share of the bars' energy is what the
 /// reports need. The sum over `n` is thus the time average of the bars' energy, which for an
-/// exact motion without springs is the constant energy [`crate::modal::energy`] returns.
+/// exact motion without springs is the constant energy [`crate::modal::energy()`] returns.
 ///
 /// # Errors
 /// [`SettingsError::Length`] if `x` is not `basis.len()` times the system's unknowns per
