@@ -15,6 +15,11 @@ pub const BACKBONE_CSV_HEADER: &str =
 /// Writes a backbone as CSV: [`BACKBONE_CSV_HEADER`], then one row per point (events joined
 /// with `;`).
 ///
+/// The `backbone` example's columns `contacts_per_period` and `subharmonic_share` are not
+/// here: a [`BackbonePoint`] does not carry the system and basis they are computed with
+/// ([`crate::modal::contact_intervals`], [`crate::modal::subharmonic_share`]); compute them
+/// per point and write them with [`write_columns_csv`].
+///
 /// # Errors
 /// Any I/O error of `out`.
 pub fn write_backbone_csv(points: &[BackbonePoint], mut out: impl Write) -> io::Result<()> {

@@ -219,10 +219,13 @@ impl<'a, B: Basis> Solution<'a, B> {
 
     /// The number of contact intervals per period of each unilateral law.
     ///
+    /// It samples the laws with a copy of the problem (the solution only borrows it); in a
+    /// loop over many points, call [`contact_intervals`] with a problem of your own.
+    ///
     /// # Errors
     /// See [`contact_intervals`].
     pub fn contact_intervals(&self) -> Result<Vec<usize>, SettingsError> {
-        contact_intervals(self.problem, self.x, self.omega)
+        contact_intervals(&mut self.problem.clone(), self.x, self.omega)
     }
 
     /// The exact time-domain march of the motion over its period and the periodicity defect.

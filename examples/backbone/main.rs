@@ -45,6 +45,16 @@
 //! exact integrator (`verify::periodicity_check`, `dt = 1/400`) and adds the columns
 //! `periodicity_defect,displacement_defect,max_penetration`.
 //!
+//! Last in every row, so that the columns before them keep their places:
+//! `contacts_per_period`, the number of contact intervals per period summed over the
+//! contacts (`modal::contact_intervals` on the harmonic-balance time grid: 1 for the clamped
+//! bar's first mode, `K` for that mode run `K` times on a `K`-subharmonic branch, 0 for a
+//! point collapsed to rest), and, with `--subharmonic K` for `K > 1`, `subharmonic_share`, the
+//! share of the bars' time-averaged energy in the harmonics that are not multiples of `K`
+//! (`modal::subharmonic_share`: 0 while the branch is the `T`-periodic mode repeated, away
+//! from 0 where it is genuinely subharmonic). A cell is left empty, with a message on stderr,
+//! where the point's unknowns do not allow the computation (not finite).
+//!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
 //! escape from internal-resonance stalls. `--parameter gap|robin-stiffness|stiffness-ratio`

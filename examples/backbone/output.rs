@@ -1,16 +1,32 @@
-//! The CSV output: its header, one row per point and the `--verify` columns.
+//! The CSV output: its header, one row per point, the `--verify` columns and the signature
+//! columns (contact intervals, subharmonic share), last so that every other column keeps its
+//! place.
 
 use crate::args::MAX_VERIFY_STEPS;
 use nonsmooth_modes::continuation::Event;
-use nonsmooth_modes::modal::BackbonePoint;
+use nonsmooth_modes::modal::{contact_intervals, subharmonic_share, BackbonePoint};
 use nonsmooth_modes::reference::ClampedFirstMode;
-use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
+use nonsmooth_modes::system::NonsmoothSystem;
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
 
 pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,status,residual_norm,iterations,step_size,event,parameter";
+
+/// The whole header: [`HEADER`], the `--verify` columns if `verify`, then
+/// `contacts_per_period`, and `subharmonic_share` for a subharmonic order `K > 1`.
+pub fn header(verify: bool, subharmonic: usize) -> String {
+    let mut header = HEADER.to_string();
+    if verify {
+        header.push_str(",periodicity_defect,displacement_defect,max_penetration");
+    }
+    header.push_str(",contacts_per_period");
+    if subharmonic > 1 {
+        header.push_str(",subharmonic_share");
+    }
+    header
+}
 
 fn events(events: &[Event]) -> String {
     events
@@ -23,20 +39,49 @@ fn events(events: &[Event]) -> String {
 /// Writes rows and counts them; remembers the first I/O error and stops the run on it.
 pub struct Sink<'a> {
     pub out: &'a mut dyn Write,
-    pub verify: Option<HarmonicBalanceSettings>,
+    /// `--verify`: march every point in time and write the verification columns.
+    pub verify: bool,
     pub exact: Option<f64>,
     pub total: usize,
     pub converged: usize,
     pub error: Option<std::io::Error>,
     pub progress: bool,
+    /// The subharmonic order `K` of the run: `subharmonic_share` is written for `K > 1`.
+    pub subharmonic: usize,
 }
 
 impl Sink<'_> {
-    /// `periodicity_defect,displacement_defect,max_penetration` of a point, or empty cells.
-    fn verification(&self, system: &BarSystem, p: &BackbonePoint) -> String {
-        let Some(settings) = self.verify else {
-            return String::new();
+    /// `,contacts_per_period` and, for `K > 1`, `,subharmonic_share` of a point (empty cells
+    /// where they cannot be computed, e.g. the unknowns of a failed step are not finite).
+    fn signature(&self, problem: &mut NonsmoothSystem, p: &BackbonePoint) -> String {
+        let cell = |value: Result<String, nonsmooth_modes::SettingsError>, what: &str| {
+            value.unwrap_or_else(|e| {
+                eprintln!("backbone: {what} of step {} not computed: {e}", p.step);
+                String::new()
+            })
         };
+        let contacts = contact_intervals(problem, &p.x, p.omega).map(|c| c.iter().sum::<usize>());
+        let mut cells = format!(
+            ",{}",
+            cell(contacts.map(|c| c.to_string()), "contacts_per_period")
+        );
+        if self.subharmonic > 1 {
+            let (system, basis) = (problem.system(), problem.basis());
+            let share = subharmonic_share(system, basis, &p.x, p.omega, self.subharmonic);
+            cells.push(',');
+            cells.push_str(&cell(
+                share.map(|s| format!("{s:.6e}")),
+                "subharmonic_share",
+            ));
+        }
+        cells
+    }
+
+    /// `periodicity_defect,displacement_defect,max_penetration` of a point, or empty cells.
+    fn verification(&self, problem: &NonsmoothSystem, p: &BackbonePoint) -> String {
+        if !self.verify {
+            return String::new();
+        }
         let options = PeriodicityOptions {
             adjust_grid: true,
             ..Default::default()
@@ -50,13 +95,8 @@ impl Sink<'_> {
             );
             return ",,,".to_string();
         }
-        let report = settings
-            .cosine_basis()
-            .map_err(|e| e.to_string())
-            .and_then(|basis| {
-                periodicity_check(system, &basis, &p.x, p.omega, &options)
-                    .map_err(|e| e.to_string())
-            });
+        let (system, basis) = (problem.system(), problem.basis());
+        let report = periodicity_check(system, basis, &p.x, p.omega, &options);
         match report {
             Ok(r) => format!(
                 ",{:.6e},{:.6e},{:.6e}",
@@ -69,9 +109,11 @@ impl Sink<'_> {
         }
     }
 
+    /// Writes the row of `p`, a point of `problem` (whose system is the one at the point's
+    /// parameter value `parameter`, NaN for period runs).
     pub fn row(
         &mut self,
-        system: &BarSystem,
+        problem: &mut NonsmoothSystem,
         p: &BackbonePoint,
         parameter: f64,
     ) -> ControlFlow<()> {
@@ -86,9 +128,10 @@ impl Sink<'_> {
                 p.step, p.period, p.energy_normalized, p.step_size
             );
         }
-        let verification = self.verification(system, p);
+        let verification = self.verification(problem, p);
+        let signature = self.signature(problem, p);
         let line = format!(
-            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}",
+            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}{}",
             p.step,
             p.period,
             p.omega,
@@ -107,6 +150,7 @@ impl Sink<'_> {
                 format!("{parameter:.10e}")
             },
             verification,
+            signature,
         );
         match writeln!(self.out, "{line}") {
             Ok(()) => ControlFlow::Continue(()),

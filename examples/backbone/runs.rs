@@ -1,7 +1,7 @@
 //! The runs: sequential or arclength in the period, and continuation in a system parameter.
 
 use crate::args::{Args, Parameter};
-use crate::output::{Sink, HEADER};
+use crate::output::{header, Sink};
 use crate::systems::{build_system, clamped_gap, default_periods, parameter_value};
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::modal::{
@@ -10,6 +10,7 @@ use nonsmooth_modes::modal::{
     EnergyBackboneOptions, EnergyGrid, ParameterSteps, PeriodGrid,
 };
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
+use nonsmooth_modes::system::NonsmoothSystem;
 // A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
 use nonsmooth_modes::sweep::Solver;
 use nonsmooth_modes::system::BarSystem;
@@ -24,15 +25,10 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         _ => default_periods(a)?,
     };
     let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
-    let extra = if a.verify {
-        ",periodicity_defect,displacement_defect,max_penetration"
-    } else {
-        ""
-    };
-    writeln!(out, "{HEADER}{extra}")?;
+    writeln!(out, "{}", header(a.verify, a.subharmonic))?;
     let mut sink = Sink {
         out,
-        verify: a.verify.then_some(a.settings),
+        verify: a.verify,
         exact: (a.mode == 1 && a.subharmonic == 1 && a.parameter != Parameter::Gap)
             .then(|| clamped_gap(&system))
             .flatten(),
@@ -40,6 +36,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         converged: 0,
         error: None,
         progress: a.progress,
+        subharmonic: a.subharmonic,
     };
     let solver = if a.dogleg {
         Solver::Dogleg(Dogleg::default())
@@ -67,8 +64,9 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             },
             ..Default::default()
         };
+        let mut problem = NonsmoothSystem::new(&system, a.settings)?;
         let (_, branch) = arclength_backbone(&system, a.settings, &options, solver, |p| {
-            sink.row(&system, p, f64::NAN)
+            sink.row(&mut problem, p, f64::NAN)
         })?;
         eprintln!(
             "backbone: arclength ended: {:?}; {} rejected steps",
@@ -88,7 +86,9 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             selection: a.selection,
             ..Default::default()
         };
-        let see = |p: &BackbonePoint| sink.row(&system, p, f64::NAN);
+        // The problem the rows are evaluated with (the runs keep their own).
+        let mut problem = NonsmoothSystem::new(&system, a.settings)?;
+        let see = |p: &BackbonePoint| sink.row(&mut problem, p, f64::NAN);
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let (_, end) = if a.serial || cores < 2 {
             backbone_with(&system, a.settings, &options, solver, see)?
@@ -133,7 +133,8 @@ fn run_energy(
         max_consecutive_failures: a.max_failures,
         ..Default::default()
     };
-    let see = |p: &BackbonePoint| sink.row(system, p, f64::NAN);
+    let mut problem = NonsmoothSystem::new(system, a.settings)?;
+    let see = |p: &BackbonePoint| sink.row(&mut problem, p, f64::NAN);
     let (_, end) = energy_backbone_with(system, a.settings, &options, solver, see)?;
     eprintln!("backbone: energy run ended: {end:?}");
     match (&sink.error, end.error()) {
@@ -200,7 +201,11 @@ fn run_parameter(
         steps,
         solver,
         |v, point| match build_system(a, parameter, v) {
-            Ok(system) => sink.row(&system, point, v),
+            // The system changes with the parameter: a problem per row.
+            Ok(system) => match NonsmoothSystem::new(&system, a.settings) {
+                Ok(mut problem) => sink.row(&mut problem, point, v),
+                Err(_) => ControlFlow::Continue(()),
+            },
             Err(_) => ControlFlow::Continue(()),
         },
     )?;

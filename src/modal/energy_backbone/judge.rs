@@ -58,6 +58,7 @@ pub(super) struct Judge {
 #[derive(Debug, Clone, Default)]
 struct Slopes {
     last: Option<(f64, f64)>,
+    chord_taken: bool,
     recent: std::collections::VecDeque<f64>,
 }
 
@@ -82,10 +83,15 @@ impl Slopes {
         if !(slope < 0.0 && -slope >= SLOPE_COLLAPSE * largest) {
             return false;
         }
-        if self.recent.len() == SLOPE_MEMORY {
-            self.recent.pop_front();
+        // The step from a segment's start (the branch's start, or the end of a walk) spans
+        // more than a grid step: its slope is a chord, checked for its sign only.
+        if self.chord_taken {
+            if self.recent.len() == SLOPE_MEMORY {
+                self.recent.pop_front();
+            }
+            self.recent.push_back(-slope);
         }
-        self.recent.push_back(-slope);
+        self.chord_taken = true;
         self.last = Some(here);
         true
     }

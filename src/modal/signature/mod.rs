@@ -3,18 +3,17 @@
 //! and how many separate contact intervals each unilateral law has per period.
 //!
 //! Both are post-processing of one point, computed when it is written out, never inside the
-//! continuation loops: [`harmonic_energies`] costs `O(m^2)` flops, [`contact_intervals`] one
+//! continuation loops: [`harmonic_energies`] costs `O(m)` flops, [`contact_intervals`] one
 //! law history per law.
 
 use crate::bc::LawSamples;
 use crate::error::SettingsError;
 use crate::fourier::Basis;
 use crate::modal::diagnostics::{
-    check_finite, check_frequency, check_length, check_unknowns_finite, law_history,
+    check_finite, check_frequency, check_length, check_motion, check_unknowns_finite,
 };
 use crate::modal::energy::Diagonal;
 use crate::system::{BarSystem, Layout, NonsmoothSystem};
-use std::f64::consts::PI;
 
 /// The time-averaged mechanical energy of the bars carried by each harmonic `n = 0..=m` of
 /// the motion `x` at fundamental frequency `omega` (entry `n`; `m` the basis' highest
@@ -39,10 +38,13 @@ use std::f64::consts::PI;
 /// `EA/4 (int u_n'^2 dx + (n Omega/c)^2 int u_n^2 dx)` for `n >= 1` and `EA/8 int u_0'^2 dx`
 /// for the constant (`EA/2 int (u_0/2)'^2`: the constant function is `1/2`). The space
 /// integrals are the closed forms the energy uses for equal wavenumbers
-/// ([`crate::modal::energy`]); the time averages `<phi_i phi_j>` are taken from the basis
-/// itself by the mean over `2m + 2` equispaced phases, exact for the products of two
-/// harmonics up to `m`, so that any [`Basis`] whose functions are harmonics (as
-/// [`Basis::harmonic`] says) is handled with its own normalisation. Each `E_n` is the
+/// ([`mod@crate::modal::energy`]). The time averages come from the basis itself, so that any
+/// [`Basis`] is handled with its own normalisation: a function of harmonic `n`
+/// ([`Basis::harmonic`]) is `phi_i = c_i cos(n theta) + s_i sin(n theta)` with
+/// `c_i = phi_i(0)` and `s_i = phi_i'(0) / n`, whence
+/// `<phi_i phi_j> = (c_i c_j + s_i s_j) / 2` and `<phi_i' phi_j'> = n^2 <phi_i phi_j>`
+/// (`c_i c_j` and 0 for `n = 0`): one evaluation of the basis, `O(m)` flops in all (more
+/// only for a basis with several functions per harmonic). Each `E_n` is the
 /// average of a non-negative energy, so it is non-negative (it is clamped at 0 against the
 /// rounding of the closed forms).
 ///
@@ -50,7 +52,7 @@ use std::f64::consts::PI;
 /// end displacements and would split over the harmonics in the same way, but they are a small
 /// part of the energy of the paper's systems, and a share of the bars' energy is what the
 /// reports need. The sum over `n` is thus the time average of the bars' energy, which for an
-/// exact motion without springs is the constant energy [`crate::modal::energy`] returns.
+/// exact motion without springs is the constant energy [`crate::modal::energy()`] returns.
 ///
 /// # Errors
 /// [`SettingsError::Length`] if `x` is not `basis.len()` times the system's unknowns per
@@ -68,60 +70,42 @@ pub fn harmonic_energies<B: Basis>(
     check_frequency(omega)?;
     check_unknowns_finite(x)?;
     let (len, m) = (basis.len(), basis.harmonics());
+    // Each basis function is `phi_i = c_i cos(n theta) + s_i sin(n theta)`, `n = n_i`:
+    // `c_i = phi_i(0)`, `s_i = phi_i'(0) / n`.
+    let (mut c, mut s) = (vec![0.0; len], vec![0.0; len]);
+    basis.functions_at(0.0, &mut c);
+    basis.derivatives_at(0.0, &mut s);
     // Coefficients grouped by harmonic (one each for the cosine basis).
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); m + 1];
-    for i in 0..len {
-        groups[basis.harmonic(i)].push(i);
+    for (i, s) in s.iter_mut().enumerate() {
+        let n = basis.harmonic(i);
+        *s = if n == 0 { 0.0 } else { *s / n as f64 };
+        groups[n].push(i);
     }
-    let pairs = time_averages(basis, &groups);
     let layout = Layout::of(system);
     let mut energies = vec![0.0; m + 1];
-    for (n, (group, (p, d))) in groups.iter().zip(&pairs).enumerate() {
+    for (n, group) in groups.iter().enumerate() {
+        // `<phi_i phi_j> = (c_i c_j + s_i s_j) / 2` for `n >= 1`, `c_i c_j` for `n = 0`;
+        // `<phi_i' phi_j'> = n^2 <phi_i phi_j>`.
+        let half = if n == 0 { 1.0 } else { 0.5 };
         for (b, bar) in system.bars().iter().enumerate() {
             let k = bar.wavenumber(n as f64 * omega);
             let diagonal = Diagonal::at(k, bar.length());
-            let (mut strain, mut kinetic) = (0.0, 0.0);
-            for (r, &i) in group.iter().enumerate() {
-                for (s, &j) in group.iter().enumerate() {
+            let mut sum = 0.0;
+            for &i in group {
+                for &j in group {
+                    let average = half * (c[i] * c[j] + s[i] * s[j]);
                     let (int_uu, int_dd) =
                         diagonal.integrals(layout.pair(x, i, b), layout.pair(x, j, b));
-                    strain += p[r * group.len() + s] * int_dd;
-                    kinetic += d[r * group.len() + s] * int_uu;
+                    sum += average * (int_dd + k * k * int_uu);
                 }
             }
-            let speed = omega / bar.wave_speed();
-            energies[n] += 0.5 * bar.stiffness() * (strain + speed * speed * kinetic);
+            energies[n] += 0.5 * bar.stiffness() * sum;
         }
         energies[n] = energies[n].max(0.0);
     }
     check_finite("a harmonic's energy", omega, &energies)?;
     Ok(energies)
-}
-
-/// For each group of coefficients of one harmonic, the time averages
-/// `(<phi_i phi_j>, <phi_i' phi_j'>)` of its pairs (row-major, `group.len()^2` each), by the
-/// mean over `2m + 2` equispaced phases: exact for products of harmonics up to `m`.
-fn time_averages<B: Basis>(basis: &B, groups: &[Vec<usize>]) -> Vec<(Vec<f64>, Vec<f64>)> {
-    let phases = 2 * basis.harmonics() + 2;
-    let mut averages: Vec<(Vec<f64>, Vec<f64>)> = groups
-        .iter()
-        .map(|g| (vec![0.0; g.len() * g.len()], vec![0.0; g.len() * g.len()]))
-        .collect();
-    let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
-    for q in 0..phases {
-        let theta = 2.0 * PI * q as f64 / phases as f64;
-        basis.functions_at(theta, &mut phi);
-        basis.derivatives_at(theta, &mut dphi);
-        for (group, (p, d)) in groups.iter().zip(averages.iter_mut()) {
-            for (r, &i) in group.iter().enumerate() {
-                for (s, &j) in group.iter().enumerate() {
-                    p[r * group.len() + s] += phi[i] * phi[j] / phases as f64;
-                    d[r * group.len() + s] += dphi[i] * dphi[j] / phases as f64;
-                }
-            }
-        }
-    }
-    averages
 }
 
 /// The share, in `[0, 1]`, of the time-averaged energy of the bars carried by the harmonics
@@ -191,18 +175,27 @@ pub fn subharmonic_share<B: Basis>(
 /// cannot be counted on the folded grid directly: a contact run through `theta = 0` or
 /// `theta = pi` is one interval of the period but is cut in half by the fold, while a run
 /// inside `(0, pi)` has a mirror image in `(pi, 2 pi)` and counts twice. Here the gap and
-/// force are synthesised on the full grid (through [`law_history`], for any basis), so every
-/// interval is counted once; for the cosine basis the count is even unless an interval is
-/// centred on `theta = 0` or `pi`.
+/// force are synthesised on the full grid
+/// ([`NonsmoothSystem::gap_history`], [`NonsmoothSystem::force_history`], for any basis), so
+/// every interval is counted once; for the cosine basis the count is even unless an interval
+/// is centred on `theta = 0` or `pi`.
 ///
 /// An interval shorter than the sample spacing `T / N` may fall between samples and be
 /// missed; the harmonic-balance grid is where the law is enforced, so it is also the
 /// resolution at which the solution says anything about contact.
 ///
+/// The problem moves to `omega` (as with [`NonsmoothSystem::gap_history`]); the histories
+/// are synthesised by the basis' transform, `O(N log N)` per law, cheap enough to run for
+/// every point a continuation writes out.
+///
 /// # Errors
-/// Those of [`law_history`]: a bad `x` or `omega`, or a gap or force that is not finite.
+/// [`SettingsError::Length`] if `x` does not have the problem's dimension;
+/// [`SettingsError::NotPositive`], [`SettingsError::FrequencyTooSmall`] or
+/// [`SettingsError::FrequencyTooLarge`] for an `omega` that is not positive and finite or
+/// outside the problem's range, and `NotPositive` for unknowns that are not finite;
+/// [`SettingsError::NonFiniteResult`] if a gap or force sample overflows.
 pub fn contact_intervals<B: Basis>(
-    problem: &NonsmoothSystem<B>,
+    problem: &mut NonsmoothSystem<B>,
     x: &[f64],
     omega: f64,
 ) -> Result<Vec<usize>, SettingsError> {
@@ -215,25 +208,38 @@ pub fn contact_intervals<B: Basis>(
 /// For each law, whether each of the `N` instants of the full grid is in contact (the
 /// criterion of [`contact_intervals`]).
 fn contact_samples<B: Basis>(
-    problem: &NonsmoothSystem<B>,
+    problem: &mut NonsmoothSystem<B>,
     x: &[f64],
     omega: f64,
 ) -> Result<Vec<Vec<bool>>, SettingsError> {
+    check_motion(problem, x, omega)?;
+    // The histories first: they move the problem to `omega`, the laws then borrow it.
+    let histories: Vec<(Vec<f64>, Vec<f64>)> = (0..problem.system().contact_count())
+        .map(|l| {
+            (
+                problem.gap_history(x, omega, l),
+                problem.force_history(x, omega, l),
+            )
+        })
+        .collect();
+    let values = histories.iter().flat_map(|(g, f)| g.iter().chain(f));
+    check_finite("a gap or contact force sample", omega, values)?;
     let samples = problem.basis().samples();
-    let mut contact = Vec::with_capacity(problem.system().contact_count());
     let (mut values, mut d_gap, mut d_force) =
         (vec![0.0; samples], vec![0.0; samples], vec![0.0; samples]);
-    for (l, law) in problem.system().laws().enumerate() {
-        let h = law_history(problem, x, omega, l, samples)?;
-        let out = LawSamples {
-            values: &mut values,
-            d_gap: &mut d_gap,
-            d_force: &mut d_force,
-        };
-        law.sample(&h.gap, &h.force, problem.complementarity(), 0.0, out);
-        contact.push(d_gap.iter().map(|w| *w != 0.0).collect());
-    }
-    Ok(contact)
+    let a_c = problem.complementarity();
+    let laws = problem.system().laws().zip(&histories);
+    Ok(laws
+        .map(|(law, (gap, force))| {
+            let out = LawSamples {
+                values: &mut values,
+                d_gap: &mut d_gap,
+                d_force: &mut d_force,
+            };
+            law.sample(gap, force, a_c, 0.0, out);
+            d_gap.iter().map(|w| *w != 0.0).collect()
+        })
+        .collect())
 }
 
 /// The number of maximal runs of `true` in the periodic sequence `values` (the last value
