@@ -209,3 +209,41 @@ fn free_free_bar_between_walls_has_a_period_backbone() {
     );
     assert!(converged.iter().all(|p| p.energy_normalized > 0.5));
 }
+
+/// Over the whole default range (`E/E_g` from 1 to 300), the energy backbone of the clamped
+/// bar follows the exact family as well as the period grid does: the fraction of its
+/// converged points within 5 % of the exact energy is at least the period grid's less 5
+/// points (`m = 20`), and no converged point sits at rest.
+#[test]
+fn energy_backbone_of_the_clamped_bar_is_as_faithful_as_the_period_grid() {
+    let system = clamped_bar_with_obstacle(GAP).unwrap();
+    let within = |points: Vec<(f64, f64)>| {
+        let good = points
+            .iter()
+            .filter(|(t, e)| *t > 3.0 && (e / clamped_exact(*t) - 1.0).abs() < 0.05)
+            .count();
+        good as f64 / points.len() as f64
+    };
+    let solver = SemismoothNewton::default;
+    let by_energy = energy_backbone(
+        &system,
+        settings(20),
+        &EnergyBackboneOptions::default(),
+        solver(),
+    )
+    .unwrap();
+    let by_period = backbone(&system, settings(20), &BackboneOptions::default(), solver()).unwrap();
+    let points = |run: &nonsmooth_modes::modal::Backbone| {
+        run.converged()
+            .map(|p| (p.period, p.energy_normalized))
+            .collect::<Vec<_>>()
+    };
+    let (e, p) = (points(&by_energy), points(&by_period));
+    assert!(e.len() >= 150, "{} converged points", e.len());
+    assert!(e.iter().all(|(_, level)| *level > 0.5));
+    let (fe, fp) = (within(e), within(p));
+    assert!(
+        fe >= fp - 0.05,
+        "within 5 %: energy {fe:.3}, period {fp:.3}"
+    );
+}

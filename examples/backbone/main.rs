@@ -9,8 +9,8 @@
 //!     [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
 //!     [--selection first|lowest-energy] [--serial]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
-//!     [--omega-range LO:HI] [--parameter omega|gap|robin-stiffness|stiffness-ratio]
-//!     [--parameter-range LO:HI] [--progress] [--verify]
+//!     [--omega-range LO:HI] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
+//!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify]
 //! ```
 //!
 //! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
@@ -21,7 +21,8 @@
 //! shorthands as files and a three-bar chain). It needs the `serde` feature
 //! (`cargo run --release --features serde --example backbone -- --assembly FILE`; without it
 //! the flag is refused with that command), excludes `--system` and the shorthands' value
-//! flags (the values are in the file) and continues in the period only (`--parameter omega`).
+//! flags (the values are in the file) and continues in the period (`--parameter omega`) or in
+//! the energy (`--parameter energy`).
 //! A file that cannot be read or built is a usage error, explained on stderr.
 //!
 //! Default periods: the shorthands keep the grids they have always had (`ds` and `two-bar`
@@ -57,7 +58,11 @@
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
-//! escape from internal-resonance stalls. `--parameter gap|robin-stiffness|stiffness-ratio`
+//! escape from internal-resonance stalls. `--parameter energy` continues the branch in the
+//! energy level `E/E_g` with the frequency an unknown (`modal::energy_backbone`; levels from
+//! `--energy-range LO:HI`, default from mode `i`'s grazing energy to 300 times it, in `--steps`
+//! geometric levels; sequential only); the points where it walks an internal resonance in the
+//! period are rows too (`docs/assemblies.md`). `--parameter gap|robin-stiffness|stiffness-ratio`
 //! continues in that parameter at the fixed period `--period-start` inside
 //! `--parameter-range` (default: a decade either side), starting from the branch point at that
 //! period (reached by a short sequential run from the system's default start).

@@ -25,8 +25,9 @@ pub use diagnostics::{
 };
 pub use energy::{energy, energy_at, energy_gradient};
 pub use energy_backbone::{
-    energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, ESCAPE_AFTER,
-    ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES, START_RATIOS,
+    energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, CALM_STEPS,
+    ESCAPE_AFTER, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES,
+    START_RATIOS,
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};

@@ -22,7 +22,8 @@ pub const START_RATIOS: [f64; 3] = [80.0 / 79.0, 40.0 / 39.0, 20.0 / 19.0];
 /// slightly penetrates cannot.
 pub const START_AMPLITUDES: [f64; 3] = [1.0, 1.01, 1.1];
 
-/// Most steps of a walk across internal resonances in the period ([`Judge::walk`]):
+/// Most steps of a walk across internal resonances in the period
+/// ([`energy_backbone_with`](super::energy_backbone_with)):
 /// `T_a (1 - j / 800)` for `j = 1..=200` below the last accepted period `T_a` (steps of
 /// the paper's period grid, over a quarter of `T_a`).
 pub const ESCAPE_PERIODS: usize = 200;
@@ -62,7 +63,7 @@ struct Slopes {
     recent: std::collections::VecDeque<f64>,
 }
 
-/// Steps whose slopes [`Slopes`] remembers.
+/// Steps whose slopes `|dT / d ln E|` an energy backbone compares a new step with.
 pub const SLOPE_MEMORY: usize = 5;
 
 /// A step whose slope `|dT / d ln E|` falls below this fraction of the largest of the last

@@ -6,7 +6,8 @@ pub(crate) mod judge;
 pub(crate) use judge::{amplified, first_solution};
 use judge::{Judge, Walk};
 pub use judge::{
-    ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES, START_RATIOS,
+    CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES,
+    START_RATIOS,
 };
 
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
@@ -112,18 +113,23 @@ impl Default for EnergyBackboneOptions {
 /// - **Acceptance.** A converged point joins the branch if its frequency is positive (and
 ///   below the problem's
 ///   [`max_frequency`](crate::system::Discretization::max_frequency)), it touches (a motion
-///   without contact is a linear one), and harmonic `subharmonic` carries more of its
-///   time-averaged energy than any other harmonic (else it sits on an internal resonance of
-///   the truncated system, see below). Refused points are reported as
-///   [`PointStatus::Rejected`].
+///   without contact is a linear one), harmonic `subharmonic` carries the most of its
+///   time-averaged energy, no other harmonic takes more than [`MARGINAL_SHARE`] of the energy
+///   added since the last accepted point, and its period keeps falling at a rate comparable
+///   to the last steps' ([`SLOPE_COLLAPSE`], [`SLOPE_MEMORY`]). Refused points are reported
+///   as [`PointStatus::Rejected`].
 /// - **Internal resonances.** Where harmonic `n` of the truncated system resonates with a
 ///   linear mode (`n Omega = omega_j`), the branch has a spike: in the period its energy
 ///   rises without bound on both sides of `T_r = 2 pi n / omega_j`, so in the energy it
-///   climbs one flank for ever and never reaches the other side. When [`ESCAPE_AFTER`]
-///   levels in a row are refused or fail, the run jumps the spike at fixed periods just
-///   below the last accepted one ([`ESCAPE_PERIODS`]) and continues in the energy from the
-///   first acceptable point found there, of higher energy. Branches are assumed to harden
-///   (the period decreases as the energy grows), as they do with gaps that close.
+///   climbs one flank for ever and never reaches the other side; the last two tests refuse
+///   the flank. When [`ESCAPE_AFTER`] levels in a row are refused or fail, the run walks
+///   the spike in the period, as a period grid does, from the last accepted point (at most
+///   [`ESCAPE_PERIODS`] steps of `1/800` of its period, each a reported point), until
+///   [`CALM_STEPS`] steps in a row grow steadily, and continues in the energy from there.
+///   Branches are assumed to harden (the period falls as the energy grows), as they do with
+///   gaps that close.
+///
+/// `docs/assemblies.md` compares it with the period grid on systems with exact solutions.
 ///
 /// # Errors
 /// Invalid settings or options, or no start
