@@ -9,7 +9,7 @@ use nonsmooth_modes::system::HarmonicBalanceSettings;
 pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] | [--assembly FILE.toml|FILE.json]
   [--harmonics M] [--samples-per-harmonic NH]
-  [--complementarity AC] [--mode I] [--subharmonic K] [--period-start T0] [--period-end T1] [--steps S]
+  [--complementarity AC] [--mode I] [--subharmonic K] [--repeated] [--period-start T0] [--period-end T1] [--steps S]
   [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
   [--selection first|lowest-energy] [--serial] [--out FILE]
   [--method sequential|arclength]
@@ -56,6 +56,8 @@ pub struct Args {
     pub settings: HarmonicBalanceSettings,
     pub mode: usize,
     pub subharmonic: usize,
+    /// With `--subharmonic K > 1`: keep the `K`-fold repeated branch, do not switch off it.
+    pub repeated: bool,
     pub period_start: Option<f64>,
     pub period_end: Option<f64>,
     pub steps: usize,
@@ -114,6 +116,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         settings: HarmonicBalanceSettings::default(),
         mode: 1,
         subharmonic: 1,
+        repeated: false,
         period_start: None,
         period_end: None,
         steps: 181,
@@ -172,6 +175,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("complementarity") => a.settings.complementarity = parser.value()?.parse()?,
             Long("mode") => a.mode = parser.value()?.parse()?,
             Long("subharmonic") => a.subharmonic = parser.value()?.parse()?,
+            Long("repeated") => a.repeated = true,
             Long("period-start") => a.period_start = Some(parser.value()?.parse()?),
             Long("period-end") => a.period_end = Some(parser.value()?.parse()?),
             Long("steps") => a.steps = at_most("steps", parser.value()?, MAX_POINTS)?,

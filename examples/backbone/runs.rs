@@ -6,8 +6,8 @@ use crate::systems::{build_system, clamped_gap, default_periods, parameter_value
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::modal::{
     arclength_backbone, backbone, backbone_speculative_with, backbone_with, energy_backbone_with,
-    parameter_branch, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
-    EnergyBackboneOptions, EnergyGrid, ParameterSteps, PeriodGrid,
+    genuine_subharmonic_backbone_with, parameter_branch, ArclengthBackboneOptions, BackboneOptions,
+    BackbonePoint, EnergyBackboneOptions, EnergyGrid, ParameterSteps, PeriodGrid,
 };
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::NonsmoothSystem;
@@ -90,7 +90,9 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         let mut problem = NonsmoothSystem::new(&system, a.settings)?;
         let see = |p: &BackbonePoint| sink.row(&mut problem, p, f64::NAN);
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let (_, end) = if a.serial || cores < 2 {
+        let (_, end) = if a.subharmonic > 1 && !a.repeated {
+            genuine_subharmonic_backbone_with(&system, a.settings, &options, solver, see)?
+        } else if a.serial || cores < 2 {
             backbone_with(&system, a.settings, &options, solver, see)?
         } else {
             let speculation = Speculation::default();

@@ -20,9 +20,14 @@ pub enum SystemKind {
 }
 
 /// Default period range: just below the linear period of the chosen mode down to a strongly
-/// nonlinear period; the shorthands' fixed grids, or for a file the rule of the header
-/// (`K T_i 79/80 -> K T_i 61/80`, `T_i` rounded to 6 significant digits).
+/// nonlinear period; the shorthands' fixed grids for their first mode, else the rule of the
+/// header (`K T_i 79/80 -> K T_i 61/80`, `T_i` rounded to 6 significant digits).
 pub fn default_periods(a: &Args) -> Result<(f64, f64), Box<dyn std::error::Error>> {
+    if a.mode != 1 || a.subharmonic != 1 {
+        let system = build_system(a, Parameter::Omega, f64::NAN)?;
+        let grid = PeriodGrid::for_mode(&system, a.mode, a.subharmonic)?;
+        return Ok((grid.start, grid.end));
+    }
     Ok(match &a.system {
         SystemKind::Clamped => (3.95, 3.05),
         // Robin k = 0.5: omega_1 = 0.653271, T_1 = 9.618

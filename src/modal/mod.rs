@@ -14,6 +14,7 @@ pub mod linear;
 mod parameter;
 mod point;
 pub mod signature;
+mod subharmonic;
 
 pub use backbone::{
     arclength_backbone, arclength_backbone_observed, backbone, backbone_speculative_with,
@@ -39,3 +40,7 @@ pub use linear::{
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
 pub use signature::{contact_intervals, harmonic_energies, subharmonic_share};
+pub use subharmonic::{
+    genuine_subharmonic_backbone_with, leave_subspace, symmetry_breaking_direction, GENUINE_SHARE,
+    NUDGES,
+};

@@ -1,0 +1,133 @@
+//! Genuine subharmonics: the subspace of the multiples of `K` is invariant (the Jacobian at a
+//! point of it is block diagonal), and a point of the `K`-fold repeated branch can be left
+//! along the complement block's most singular direction.
+
+use nonsmooth_modes::continuation::ContinuationProblem;
+use nonsmooth_modes::fourier::Basis;
+use nonsmooth_modes::linalg::DenseMatrix;
+use nonsmooth_modes::modal::{
+    branch_seed, genuine_subharmonic_backbone_with, linear_period, subharmonic_share,
+    symmetry_breaking_direction, BackboneOptions, PeriodGrid, PointStatus, GENUINE_SHARE,
+};
+use nonsmooth_modes::reference::robin_bar_with_obstacle;
+use nonsmooth_modes::solve::{Problem, SemismoothNewton};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
+use std::f64::consts::PI;
+use std::ops::ControlFlow;
+
+const K: usize = 3;
+
+fn settings(harmonics: usize) -> HarmonicBalanceSettings {
+    HarmonicBalanceSettings {
+        harmonics,
+        ..Default::default()
+    }
+}
+
+/// At a point of the subspace of the multiples of `K` (a penetrating seed of NSM 2 sub 3 of
+/// the Robin bar, so that the law is active at some samples), the Jacobian has no entry
+/// between the multiples of `K` and the other harmonics, in either direction.
+#[test]
+fn the_multiples_of_k_are_an_invariant_subspace() {
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let mut problem = NonsmoothSystem::new(&system, settings(12)).unwrap();
+    let omega = 2.0 * PI / (0.98 * linear_period(&system, 2, K).unwrap());
+    let seed: Vec<f64> = branch_seed(&mut problem, 2, K, omega)
+        .unwrap()
+        .iter()
+        .map(|v| 1.3 * v)
+        .collect();
+    problem.set_parameter(omega);
+    let n = problem.dimension();
+    let mut f = vec![0.0; n];
+    problem.residual(&seed, &mut f);
+    let mut jac = DenseMatrix::zeros(n, n);
+    problem.jacobian(&seed, &mut jac);
+    let per = system.unknowns_per_harmonic();
+    let laws = system.contact_count();
+    let linear = per - laws;
+    let len = problem.basis().len();
+    let harmonic_of_row = |r: usize| {
+        if r < len * linear {
+            r / linear
+        } else {
+            (r - len * linear) % len
+        }
+    };
+    let (mut coupling, mut size) = (0.0f64, 0.0f64);
+    for r in 0..n {
+        for c in 0..n {
+            let (hr, hc) = (harmonic_of_row(r) % K == 0, (c / per) % K == 0);
+            size = size.max(jac[(r, c)].abs());
+            if hr != hc {
+                coupling = coupling.max(jac[(r, c)].abs());
+            }
+        }
+    }
+    assert!(size > 0.0);
+    assert!(
+        coupling <= 1e-12 * size,
+        "coupling {coupling:e} of {size:e}"
+    );
+    // The direction leaves the subspace: zero on its multiples of K, nonzero off them.
+    let (direction, measure) = symmetry_breaking_direction(&mut problem, &seed, omega, K).unwrap();
+    assert!(measure.is_finite() && measure >= 0.0);
+    for (j, d) in direction.iter().enumerate() {
+        if (j / per) % K == 0 {
+            assert_eq!(*d, 0.0);
+        }
+    }
+    assert!(direction.iter().any(|d| d.abs() == 1.0));
+    assert!(symmetry_breaking_direction(&mut problem, &seed, omega, 1).is_none());
+}
+
+/// NSM 2 sub 3 of the Robin bar at `m = 30`: the run leaves the repeated branch, and every
+/// converged point after the switch has at least `GENUINE_SHARE` of its energy off the
+/// multiples of 3, recomputed here from its unknowns.
+#[test]
+fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            steps: 30,
+            ..PeriodGrid::for_mode(&system, 2, K).unwrap()
+        },
+        mode: 2,
+        subharmonic: K,
+        ..Default::default()
+    };
+    let problem = NonsmoothSystem::new(&system, settings(30)).unwrap();
+    let mut points = Vec::new();
+    genuine_subharmonic_backbone_with(
+        &system,
+        settings(30),
+        &options,
+        SemismoothNewton::default(),
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    let share = |p: &nonsmooth_modes::modal::BackbonePoint| {
+        subharmonic_share(&system, problem.basis(), &p.x, p.omega, K).unwrap()
+    };
+    let genuine: Vec<_> = points
+        .iter()
+        .filter(|p| p.status == PointStatus::Converged && share(p) >= GENUINE_SHARE)
+        .collect();
+    assert!(genuine.len() >= 5, "{} genuine points", genuine.len());
+    let first = points
+        .iter()
+        .position(|p| share(p) >= GENUINE_SHARE)
+        .unwrap();
+    for p in &points[first..] {
+        if p.converged {
+            assert!(share(p) >= GENUINE_SHARE, "step {}: {}", p.step, share(p));
+        }
+    }
+    // Before the switch, the branch is the repeated one.
+    for p in points[..first].iter().filter(|p| p.converged) {
+        assert!(share(p) < 1e-10, "step {}: {}", p.step, share(p));
+    }
+}
