@@ -247,3 +247,26 @@ fn energy_backbone_of_the_clamped_bar_is_as_faithful_as_the_period_grid() {
         "within 5 %: energy {fe:.3}, period {fp:.3}"
     );
 }
+
+/// The three-bar chain (bar 2 held only by its contacts): its start adds the floating bar's
+/// rigid-body motion to the seed of the last bar's mode. The energy backbone starts, and its
+/// converged points are motions in which the floating bar touches both neighbours.
+#[test]
+fn the_chain_with_a_floating_bar_starts_and_its_points_touch_both_contacts() {
+    let system = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
+    let run = energy_backbone(
+        &system,
+        settings(20),
+        &EnergyBackboneOptions::default(),
+        SemismoothNewton::default(),
+    )
+    .unwrap();
+    let converged: Vec<_> = run.converged().collect();
+    assert!(converged.len() >= 50, "{} converged", converged.len());
+    let mut problem = NonsmoothSystem::new(&system, settings(20)).unwrap();
+    for p in &converged {
+        let intervals =
+            nonsmooth_modes::modal::contact_intervals(&mut problem, &p.x, p.omega).unwrap();
+        assert!(intervals.iter().all(|&n| n >= 1), "step {}: {intervals:?}", p.step);
+    }
+}

@@ -8,7 +8,7 @@ use crate::continuation::{
 use crate::error::{ContinuationError, Error};
 use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
-use crate::modal::energy_backbone::{amplified, first_solution, START_RATIOS};
+use crate::modal::energy_backbone::{first_solution, StartGuesses, START_RATIOS};
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::modal::point::{Backbone, BackbonePoint};
@@ -174,7 +174,13 @@ fn drive_backbone<S: NonlinearSolver>(
     )?;
     let basis = problem.basis().clone();
     let floor = options.trivial_energy * e_g;
-    let start = usable_start(&mut problem, &solver, start, 2.0 * PI / grid.start, floor);
+    let start = usable_start(
+        &mut problem,
+        &solver,
+        (start, options.subharmonic),
+        2.0 * PI / grid.start,
+        floor,
+    );
     let seq_options = SequentialOptions {
         predictor: options.predictor,
         max_consecutive_failures: options.max_consecutive_failures,
@@ -230,9 +236,10 @@ fn drive_backbone<S: NonlinearSolver>(
 
 /// The guess of a period backbone's first step at `omega`: the seed itself where `solver`
 /// takes it to a motion of energy above `floor` (the paper's systems: their runs are
-/// unchanged), else the first such solution from the seed at the amplitudes of
-/// [`START_AMPLITUDES`](crate::modal::START_AMPLITUDES), solved by `solver` and then by it
-/// inside a [`SmoothingHomotopy`], at `omega` and then at the higher frequencies of
+/// unchanged), else the first such solution from the guesses of the energy backbone's start
+/// around the seed (amplitudes [`START_AMPLITUDES`](crate::modal::START_AMPLITUDES); with
+/// floating bars their rigid-body motions added), solved by `solver` and then by it inside a
+/// [`SmoothingHomotopy`], at `omega` and then at the higher frequencies of
 /// [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the first): a grazing seed can
 /// slide to rest, or to a floating bar's rigid-body rest against an obstacle (the free-free
 /// bar between two walls), where one that penetrates a little, a little further from the
@@ -242,7 +249,7 @@ fn drive_backbone<S: NonlinearSolver>(
 fn usable_start<S: NonlinearSolver>(
     problem: &mut NonsmoothSystem,
     solver: &S,
-    seed: Vec<f64>,
+    (seed, subharmonic): (Vec<f64>, usize),
     omega: f64,
     floor: f64,
 ) -> Vec<f64> {
@@ -254,11 +261,13 @@ fn usable_start<S: NonlinearSolver>(
     }
     let homotopy = SmoothingHomotopy::new(solver);
     let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
-    let found = START_RATIOS.iter().find_map(|r| {
+    let guesses = StartGuesses::new(&system);
+    let found = guesses.ratios().into_iter().find_map(|r| {
         let at = omega * r / START_RATIOS[0];
         let above_rest =
             |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, at) > floor;
-        first_solution(problem, &solvers, amplified(&seed), at, above_rest).map(|x| (x, at))
+        let tries = guesses.around(problem, &seed, subharmonic);
+        first_solution(problem, &solvers, tries, at, above_rest).map(|x| (x, at))
     });
     let Some((mut x, from)) = found else {
         return seed;

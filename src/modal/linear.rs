@@ -396,15 +396,31 @@ fn seed_checked<B: Basis>(
         }
         .into());
     }
-    let basis = problem.basis().clone();
+    let mut x = vec![0.0; problem.dimension()];
+    add_on_harmonic(problem, shape, subharmonic, scale, &mut x);
+    Ok(x)
+}
+
+/// Adds `scale shape` (Helmholtz unknowns of one harmonic) to `x` on harmonic `harmonic`,
+/// as the motion `scale shape` at `t = 0`.
+///
+/// # Panics
+/// If the basis has no function of `harmonic` that is nonzero at `t = 0` or `shape` is
+/// longer than the unknowns of one harmonic (callers check both).
+pub(crate) fn add_on_harmonic<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    shape: &[f64],
+    harmonic: usize,
+    scale: f64,
+    x: &mut [f64],
+) {
+    let basis = problem.basis();
     let mut phi = vec![0.0; basis.len()];
     basis.functions_at(0.0, &mut phi);
     let i = (0..basis.len())
-        .find(|&i| basis.harmonic(i) == subharmonic && phi[i] != 0.0)
+        .find(|&i| basis.harmonic(i) == harmonic && phi[i] != 0.0)
         .expect("a basis has a function of each harmonic that is nonzero at t = 0");
-    let mut x = vec![0.0; problem.dimension()];
     for (c, s) in shape.iter().enumerate() {
-        x[problem.index(i, 0, 0) + c] = scale * s / phi[i];
+        x[problem.index(i, 0, 0) + c] += scale * s / phi[i];
     }
-    Ok(x)
 }

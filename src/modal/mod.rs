@@ -27,8 +27,8 @@ pub use diagnostics::{
 pub use energy::{energy, energy_at, energy_gradient};
 pub use energy_backbone::{
     energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, CALM_STEPS,
-    ESCAPE_AFTER, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES,
-    START_RATIOS,
+    ESCAPE_AFTER, ESCAPE_PERIODS, FLOATING_AMPLITUDES, FLOATING_RATIOS, MARGINAL_SHARE,
+    RIGID_AMPLITUDES, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES, START_RATIOS,
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};

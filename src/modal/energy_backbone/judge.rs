@@ -1,6 +1,7 @@
 //! What makes a motion a point of an energy backbone, and the solves at fixed frequency
 //! that start a branch and jump its internal resonances.
 
+use super::start::{first_solution, StartGuesses};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::modal::energy::energy;
@@ -11,16 +12,6 @@ use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
-
-/// Frequencies of the start, relative to the linear mode's: `80/79`, `40/39` and `20/19`
-/// (periods `79/80`, `39/40` and `19/20` of the mode's, the first of them the period
-/// grid's first, [`crate::modal::PeriodGrid::for_mode`]).
-pub const START_RATIOS: [f64; 3] = [80.0 / 79.0, 40.0 / 39.0, 20.0 / 19.0];
-
-/// Amplitudes of the start, relative to the grazing seed's: a seed that only grazes can
-/// slide to a rigid-body motion resting against an obstacle (a floating bar), one that
-/// slightly penetrates cannot.
-pub const START_AMPLITUDES: [f64; 3] = [1.0, 1.01, 1.1];
 
 /// Most steps of a walk across internal resonances in the period
 /// ([`energy_backbone_with`](super::energy_backbone_with)):
@@ -169,9 +160,8 @@ impl Judge {
     /// for a spectrum of commensurate frequencies such as the clamped bar's, a family of
     /// linear motions of the same period meets the branch), and Newton's method in
     /// `(x, Omega)` slides along that family. At a fixed frequency off the linear one the
-    /// only linear motion is rest. The frequencies of [`START_RATIOS`] and amplitudes of
-    /// [`START_AMPLITUDES`] are tried in turn, each with `solver` and then with it inside a
-    /// [`SmoothingHomotopy`].
+    /// only linear motion is rest. The guesses of [`StartGuesses`] are tried in turn, each
+    /// with `solver` and then with it inside a [`SmoothingHomotopy`].
     ///
     /// # Errors
     /// A failed seed, or [`SettingsError::NoStart`] if no attempt is accepted.
@@ -182,16 +172,18 @@ impl Judge {
     ) -> Result<(Vec<f64>, f64), Error> {
         let homotopy = SmoothingHomotopy::new(solver);
         let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
-        for ratio in START_RATIOS {
+        let guesses = StartGuesses::new(self.problem.system());
+        for ratio in guesses.ratios() {
             let omega = ratio * linear.omega / self.subharmonic as f64;
             let seed = seed_from_mode(&mut self.problem, linear, self.subharmonic, omega)?;
-            if let Some(x) = self.solve_at(&solvers, amplified(&seed), omega) {
+            let tries = guesses.around(&self.problem, &seed, self.subharmonic);
+            if let Some(x) = self.solve_at(&solvers, tries, omega) {
                 return Ok((x, omega));
             }
         }
         Err(SettingsError::NoStart {
             omega: linear.omega,
-            attempts: START_RATIOS.len() * START_AMPLITUDES.len() * solvers.len(),
+            attempts: guesses.count() * solvers.len(),
         }
         .into())
     }
@@ -339,32 +331,4 @@ fn touches(problem: &mut NonsmoothSystem, x: &[f64], omega: f64) -> bool {
     problem
         .active_set(x)
         .is_some_and(|active| active.iter().any(|&a| a > 0))
-}
-
-/// The guesses `a s` of a seed `s` for the amplitudes `a` of [`START_AMPLITUDES`].
-pub(crate) fn amplified(seed: &[f64]) -> impl Iterator<Item = Vec<f64>> + '_ {
-    START_AMPLITUDES
-        .into_iter()
-        .map(move |a| seed.iter().map(|v| a * v).collect())
-}
-
-/// The first of `guesses` that one of `solvers` (tried in turn on each guess) takes at
-/// `omega` to a solution that `accept` takes.
-pub(crate) fn first_solution(
-    problem: &mut NonsmoothSystem,
-    solvers: &[&dyn NonlinearSolver],
-    guesses: impl IntoIterator<Item = Vec<f64>>,
-    omega: f64,
-    mut accept: impl FnMut(&mut NonsmoothSystem, &[f64]) -> bool,
-) -> Option<Vec<f64>> {
-    for guess in guesses {
-        for solver in solvers {
-            let mut x = guess.clone();
-            problem.set_parameter(omega);
-            if solver.solve(problem, &mut x).is_ok() && accept(problem, &x) {
-                return Some(x);
-            }
-        }
-    }
-    None
 }

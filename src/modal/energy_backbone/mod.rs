@@ -2,12 +2,13 @@
 //! frequency as an unknown ([`EnergyLevel`]), from the grazing point of a linear mode.
 
 pub(crate) mod judge;
+mod start;
 
-pub(crate) use judge::{amplified, first_solution};
 use judge::{Judge, Walk};
-pub use judge::{
-    CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES,
-    START_RATIOS,
+pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY};
+pub(crate) use start::{first_solution, StartGuesses};
+pub use start::{
+    FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
 };
 
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
