@@ -24,6 +24,7 @@
 //!   samples were made (its docs state when a Jacobian-type evaluation reuses them);
 //! - `step.rs`: the structured (condensed) Newton step.
 
+mod band;
 mod discretization;
 mod state;
 mod step;
@@ -37,6 +38,7 @@ use crate::linalg::DenseMatrix;
 use crate::solve::{point_on_ray, Problem, SingularStep, Structured};
 use crate::system::rows::HarmonicRows;
 use crate::system::{BarSystem, Layout};
+use band::Banded;
 use state::{Frequency, Samples};
 use step::Reduced;
 
@@ -121,6 +123,7 @@ struct Workspace {
     frequency: Frequency,
     samples: Samples,
     reduced: Reduced,
+    banded: Banded,
 }
 
 impl NonsmoothSystem<CosineBasis> {
@@ -151,6 +154,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             frequency: Frequency::new(),
             samples: Samples::new(&description),
             reduced: Reduced::default(),
+            banded: Banded::default(),
         };
         Ok(Self { description, ws })
     }
@@ -356,8 +360,12 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
             frequency,
             samples,
             reduced,
+            banded,
         } = &mut self.ws;
-        reduced.solve((&self.description, frequency), samples, rhs, columns)
+        let d = &self.description;
+        banded
+            .solve((d, frequency), samples, rhs, columns)
+            .or_else(|| reduced.solve((d, frequency), samples, rhs, columns))
     }
 
     /// Along a line search the observables are affine in `t`: the samples of `x` (kept from
