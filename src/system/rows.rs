@@ -294,20 +294,40 @@ const HADAMARD_SCREEN: f64 = 1e-12;
 /// dependent ones (Hadamard's inequality), by a Cholesky factorisation of the small Gram
 /// matrix. Returns 0 for a zero row or a failed factorisation.
 fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
-    // Up to eight rows (four bars) the Gram matrix and the norms live on the stack: the screen
-    // runs for every harmonic at every new frequency.
-    let mut stack = [0.0; 72];
-    let mut heap = Vec::new();
-    let buffer: &mut [f64] = if r * r + r <= stack.len() {
-        &mut stack[..r * r + r]
-    } else {
-        heap.resize(r * r + r, 0.0);
-        &mut heap
-    };
+    // Up to eight rows (four bars) the Gram matrix, the norms and the supports live on the
+    // stack: the screen runs for every harmonic at every new frequency.
+    let (mut stack, mut heap) = ([0.0; 72], Vec::new());
+    let buffer = scratch(&mut stack, &mut heap, r * r + r, 0.0);
     let (g, norms) = buffer.split_at_mut(r * r);
+    let (mut stack, mut heap) = ([(0, 0); 8], Vec::new());
+    let supports = scratch(&mut stack, &mut heap, r, (0, 0));
     let row = |i: usize| &rows[i * n..(i + 1) * n];
+    // Row `i` is zero outside `supports[i]`. A row involves the bars at its ends only, so in an
+    // assembly of many bars most pairs of rows do not overlap: their product is zero without
+    // a sum of `n` terms (the terms left out are exact zeros: the sums are the same).
+    for (i, s) in supports.iter_mut().enumerate() {
+        let first = row(i).iter().position(|&v| v != 0.0).unwrap_or(n);
+        *s = (
+            first,
+            row(i)
+                .iter()
+                .rposition(|&v| v != 0.0)
+                .map_or(first, |k| k + 1),
+        );
+    }
+    let product = |i: usize, j: usize| {
+        let (from, to) = (
+            supports[i].0.max(supports[j].0),
+            supports[i].1.min(supports[j].1),
+        );
+        if from < to {
+            dot(&row(i)[from..to], &row(j)[from..to])
+        } else {
+            0.0
+        }
+    };
     for (i, v) in norms.iter_mut().enumerate() {
-        *v = dot(row(i), row(i));
+        *v = product(i, i);
     }
     // `v > 0` fails for zero and NaN alike.
     if !norms.iter().all(|&v| v > 0.0) {
@@ -316,7 +336,7 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
     // Gram matrix of the normalised rows, factorised in place (lower triangle).
     for i in 0..r {
         for j in 0..=i {
-            g[i * r + j] = dot(row(i), row(j)) / (norms[i] * norms[j]).sqrt();
+            g[i * r + j] = product(i, j) / (norms[i] * norms[j]).sqrt();
         }
     }
     let mut det = 1.0;
@@ -340,6 +360,25 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
         }
     }
     det
+}
+
+/// `len` values: the first ones of `stack` when it holds them (no allocation), else `heap`,
+/// resized, each set to `value`.
+fn scratch<'a, T: Copy, const N: usize>(
+    stack: &'a mut [T; N],
+    heap: &'a mut Vec<T>,
+    len: usize,
+    value: T,
+) -> &'a mut [T] {
+    if len <= N {
+        let out = &mut stack[..len];
+        out.fill(value);
+        out
+    } else {
+        heap.clear();
+        heap.resize(len, value);
+        heap
+    }
 }
 
 #[inline]
