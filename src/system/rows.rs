@@ -290,30 +290,32 @@ impl HarmonicRows {
 /// relative singular value `s` gives a ratio of order `s^2`, far below it.
 const HADAMARD_SCREEN: f64 = 1e-12;
 
+/// Rows (four bars) up to which [`hadamard_ratio`] keeps its storage on the stack.
+const SMALL_ROWS: usize = 8;
+
 /// `det(L L^T) / prod |r_i|^2` of the `r x n` row-major rows `L`: 1 for orthogonal rows, 0 for
 /// dependent ones (Hadamard's inequality), by a Cholesky factorisation of the small Gram
 /// matrix. Returns 0 for a zero row or a failed factorisation.
 fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
-    // Up to eight rows (four bars) the Gram matrix, the norms and the supports live on the
-    // stack: the screen runs for every harmonic at every new frequency.
-    let (mut stack, mut heap) = ([0.0; 72], Vec::new());
-    let buffer = scratch(&mut stack, &mut heap, r * r + r, 0.0);
+    // Up to `SMALL_ROWS` rows the Gram matrix, the norms and the supports live on the stack:
+    // the screen runs for every harmonic at every new frequency.
+    let (mut stack, mut heap) = ([0.0; SMALL_ROWS * SMALL_ROWS + SMALL_ROWS], Vec::new());
+    let buffer = scratch(&mut stack, &mut heap, r * r + r);
     let (g, norms) = buffer.split_at_mut(r * r);
-    let (mut stack, mut heap) = ([(0, 0); 8], Vec::new());
-    let supports = scratch(&mut stack, &mut heap, r, (0, 0));
+    let (mut stack, mut heap) = ([(0, n); SMALL_ROWS], Vec::new());
+    let supports = scratch(&mut stack, &mut heap, r);
     let row = |i: usize| &rows[i * n..(i + 1) * n];
     // Row `i` is zero outside `supports[i]`. A row involves the bars at its ends only, so in an
     // assembly of many bars most pairs of rows do not overlap: their product is zero without
-    // a sum of `n` terms (the terms left out are exact zeros: the sums are the same).
-    for (i, s) in supports.iter_mut().enumerate() {
-        let first = row(i).iter().position(|&v| v != 0.0).unwrap_or(n);
-        *s = (
-            first,
-            row(i)
-                .iter()
-                .rposition(|&v| v != 0.0)
-                .map_or(first, |k| k + 1),
-        );
+    // a sum of `n` terms (the terms left out are exact zeros: the sums are the same). Up to
+    // `SMALL_ROWS` rows the whole rows are cheaper than finding the supports.
+    if r > SMALL_ROWS {
+        for (i, s) in supports.iter_mut().enumerate() {
+            let nonzero = |v: &f64| *v != 0.0;
+            let first = row(i).iter().position(nonzero).unwrap_or(n);
+            let last = row(i).iter().rposition(nonzero).map_or(first, |k| k + 1);
+            *s = (first, last);
+        }
     }
     let product = |i: usize, j: usize| {
         let (from, to) = (
@@ -362,21 +364,17 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
     det
 }
 
-/// `len` values: the first ones of `stack` when it holds them (no allocation), else `heap`,
-/// resized, each set to `value`.
-fn scratch<'a, T: Copy, const N: usize>(
+/// The first `len` values of `stack` when it holds them (no allocation), else `heap` resized
+/// to `len` default values: working storage whose small sizes stay off the heap.
+fn scratch<'a, T: Copy + Default, const N: usize>(
     stack: &'a mut [T; N],
     heap: &'a mut Vec<T>,
     len: usize,
-    value: T,
 ) -> &'a mut [T] {
     if len <= N {
-        let out = &mut stack[..len];
-        out.fill(value);
-        out
+        &mut stack[..len]
     } else {
-        heap.clear();
-        heap.resize(len, value);
+        heap.resize(len, T::default());
         heap
     }
 }
