@@ -15,8 +15,8 @@
 //! It is the LU of the same Jacobian as the dense fallback's (`Problem::jacobian`), with the
 //! same pivot tolerance, so the steps agree with it to rounding; unlike the condensed step it
 //! needs neither a null basis nor its regularity. It is used for two contacts or more where
-//! its multiply-adds, weighted by [`STAIRCASE_WEIGHT`], are fewer than the condensed LU's;
-//! systems with one contact keep the condensed step.
+//! its multiply-adds are fewer than the condensed LU's ([`worth_it`]); systems with one contact
+//! keep the condensed step.
 
 use super::discretization::Discretization;
 use super::state::{Frequency, Samples};
@@ -24,12 +24,6 @@ use crate::fourier::Basis;
 use crate::linalg::{Staircase, StaircaseLu};
 use crate::solve::{SingularStep, PIVOT_TOLERANCE};
 use crate::system::rows::HarmonicRows;
-
-/// Weight of the staircase's multiply-adds against the condensed LU's when choosing. Its
-/// windows are smaller matrices than the condensed one, on which faer's kernels run slower,
-/// but it needs no condensation at each new frequency: on chains at `m = 20` the two steps
-/// cost the same at about 7 bars, where their multiply-adds are equal (`benches/chain.rs`).
-const STAIRCASE_WEIGHT: f64 = 1.0;
 
 /// The blocks (bars) whose unknowns `row` involves at some harmonic, `(first, last)`, given
 /// the row of each harmonic: `None` if it involves none.
@@ -80,10 +74,14 @@ pub(super) fn staircase_of<B: Basis>(
     Staircase::new(2 * len, d.unknowns / 2, &spans)
 }
 
-/// Whether the staircase LU of shape `shape` costs less than the condensed LU of `d`.
+/// Whether the staircase LU of shape `shape` takes fewer multiply-adds than the condensed LU
+/// of `d`, `(len n_contacts)^3 / 3`. The staircase's windows are smaller matrices, on which
+/// faer's kernels run slower, but it needs no condensation at a new frequency: on chains at
+/// `m = 20` the measured times cross where the counts do, between 7 and 8 bars
+/// (`benches/chain.rs`, `docs/performance.md`).
 fn worth_it<B: Basis>(d: &Discretization<B>, shape: &Staircase) -> bool {
     let condensed = (d.basis().len() * d.laws) as f64;
-    STAIRCASE_WEIGHT * shape.flops() < condensed.powi(3) / 3.0
+    shape.flops() < condensed.powi(3) / 3.0
 }
 
 /// Storage of the staircase step: the factors and one solution in bar-by-bar order.

@@ -22,7 +22,9 @@
 //! - `discretization.rs`: [`Discretization`] and its evaluations into given buffers;
 //! - `state.rs`: the rows at one frequency and the law samples, with the record of how the
 //!   samples were made (its docs state when a Jacobian-type evaluation reuses them);
-//! - `step.rs`: the structured (condensed) Newton step.
+//! - `step.rs`: the structured (condensed) Newton step;
+//! - `band.rs`: the staircase Newton step of assemblies with several contacts, at a cost linear
+//!   in the number of bars of a chain.
 
 mod band;
 mod discretization;
@@ -348,7 +350,9 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     }
 
     /// The Newton step with the linear rows condensed (formulation §5): only a dense LU of
-    /// size `len * n_contacts` is factorised, once for all right-hand sides.
+    /// size `len * n_contacts` is factorised, once for all right-hand sides. With two contacts
+    /// or more, where it is cheaper, the whole Jacobian is factorised bar by bar instead (a
+    /// staircase LU: linear in the number of bars of a chain, `band.rs`).
     fn solve_jacobian(
         &mut self,
         x: &[f64],
