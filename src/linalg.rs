@@ -8,6 +8,9 @@ use faer::{Mat, MatMut, MatRef, Par};
 use std::cell::RefCell;
 use std::ops::{Index, IndexMut};
 
+mod staircase;
+pub(crate) use staircase::{Staircase, StaircaseLu};
+
 /// A dense, column-major `f64` matrix.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct DenseMatrix {

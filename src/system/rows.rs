@@ -290,24 +290,46 @@ impl HarmonicRows {
 /// relative singular value `s` gives a ratio of order `s^2`, far below it.
 const HADAMARD_SCREEN: f64 = 1e-12;
 
+/// Rows (four bars) up to which [`hadamard_ratio`] keeps its storage on the stack.
+const SMALL_ROWS: usize = 8;
+
 /// `det(L L^T) / prod |r_i|^2` of the `r x n` row-major rows `L`: 1 for orthogonal rows, 0 for
 /// dependent ones (Hadamard's inequality), by a Cholesky factorisation of the small Gram
 /// matrix. Returns 0 for a zero row or a failed factorisation.
 fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
-    // Up to eight rows (four bars) the Gram matrix and the norms live on the stack: the screen
-    // runs for every harmonic at every new frequency.
-    let mut stack = [0.0; 72];
-    let mut heap = Vec::new();
-    let buffer: &mut [f64] = if r * r + r <= stack.len() {
-        &mut stack[..r * r + r]
-    } else {
-        heap.resize(r * r + r, 0.0);
-        &mut heap
-    };
+    // Up to `SMALL_ROWS` rows the Gram matrix, the norms and the supports live on the stack:
+    // the screen runs for every harmonic at every new frequency.
+    let (mut stack, mut heap) = ([0.0; SMALL_ROWS * SMALL_ROWS + SMALL_ROWS], Vec::new());
+    let buffer = scratch(&mut stack, &mut heap, r * r + r);
     let (g, norms) = buffer.split_at_mut(r * r);
+    let (mut stack, mut heap) = ([(0, n); SMALL_ROWS], Vec::new());
+    let supports = scratch(&mut stack, &mut heap, r);
     let row = |i: usize| &rows[i * n..(i + 1) * n];
+    // Row `i` is zero outside `supports[i]`. A row involves the bars at its ends only, so in an
+    // assembly of many bars most pairs of rows do not overlap: their product is zero without
+    // a sum of `n` terms (the terms left out are exact zeros: the sums are the same). Up to
+    // `SMALL_ROWS` rows the whole rows are cheaper than finding the supports.
+    if r > SMALL_ROWS {
+        for (i, s) in supports.iter_mut().enumerate() {
+            let nonzero = |v: &f64| *v != 0.0;
+            let first = row(i).iter().position(nonzero).unwrap_or(n);
+            let last = row(i).iter().rposition(nonzero).map_or(first, |k| k + 1);
+            *s = (first, last);
+        }
+    }
+    let product = |i: usize, j: usize| {
+        let (from, to) = (
+            supports[i].0.max(supports[j].0),
+            supports[i].1.min(supports[j].1),
+        );
+        if from < to {
+            dot(&row(i)[from..to], &row(j)[from..to])
+        } else {
+            0.0
+        }
+    };
     for (i, v) in norms.iter_mut().enumerate() {
-        *v = dot(row(i), row(i));
+        *v = product(i, i);
     }
     // `v > 0` fails for zero and NaN alike.
     if !norms.iter().all(|&v| v > 0.0) {
@@ -316,7 +338,7 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
     // Gram matrix of the normalised rows, factorised in place (lower triangle).
     for i in 0..r {
         for j in 0..=i {
-            g[i * r + j] = dot(row(i), row(j)) / (norms[i] * norms[j]).sqrt();
+            g[i * r + j] = product(i, j) / (norms[i] * norms[j]).sqrt();
         }
     }
     let mut det = 1.0;
@@ -340,6 +362,21 @@ fn hadamard_ratio(rows: &[f64], r: usize, n: usize) -> f64 {
         }
     }
     det
+}
+
+/// The first `len` values of `stack` when it holds them (no allocation), else `heap` resized
+/// to `len` default values: working storage whose small sizes stay off the heap.
+fn scratch<'a, T: Copy + Default, const N: usize>(
+    stack: &'a mut [T; N],
+    heap: &'a mut Vec<T>,
+    len: usize,
+) -> &'a mut [T] {
+    if len <= N {
+        &mut stack[..len]
+    } else {
+        heap.resize(len, T::default());
+        heap
+    }
 }
 
 #[inline]

@@ -22,8 +22,11 @@
 //! - `discretization.rs`: [`Discretization`] and its evaluations into given buffers;
 //! - `state.rs`: the rows at one frequency and the law samples, with the record of how the
 //!   samples were made (its docs state when a Jacobian-type evaluation reuses them);
-//! - `step.rs`: the structured (condensed) Newton step.
+//! - `step.rs`: the structured (condensed) Newton step;
+//! - `band.rs`: the staircase Newton step of assemblies with several contacts, at a cost linear
+//!   in the number of bars of a chain.
 
+mod band;
 mod discretization;
 mod state;
 mod step;
@@ -37,6 +40,7 @@ use crate::linalg::DenseMatrix;
 use crate::solve::{point_on_ray, Problem, SingularStep, Structured};
 use crate::system::rows::HarmonicRows;
 use crate::system::{BarSystem, Layout};
+use band::Banded;
 use state::{Frequency, Samples};
 use step::Reduced;
 
@@ -121,6 +125,7 @@ struct Workspace {
     frequency: Frequency,
     samples: Samples,
     reduced: Reduced,
+    banded: Banded,
 }
 
 impl NonsmoothSystem<CosineBasis> {
@@ -151,6 +156,7 @@ impl<B: Basis> NonsmoothSystem<B> {
             frequency: Frequency::new(),
             samples: Samples::new(&description),
             reduced: Reduced::default(),
+            banded: Banded::default(),
         };
         Ok(Self { description, ws })
     }
@@ -344,7 +350,9 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     }
 
     /// The Newton step with the linear rows condensed (formulation §5): only a dense LU of
-    /// size `len * n_contacts` is factorised, once for all right-hand sides.
+    /// size `len * n_contacts` is factorised, once for all right-hand sides. With two contacts
+    /// or more, where it is cheaper, the whole Jacobian is factorised bar by bar instead (a
+    /// staircase LU: linear in the number of bars of a chain, `band.rs`).
     fn solve_jacobian(
         &mut self,
         x: &[f64],
@@ -356,8 +364,12 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
             frequency,
             samples,
             reduced,
+            banded,
         } = &mut self.ws;
-        reduced.solve((&self.description, frequency), samples, rhs, columns)
+        let d = &self.description;
+        banded
+            .solve((d, frequency), samples, rhs, columns)
+            .or_else(|| reduced.solve((d, frequency), samples, rhs, columns))
     }
 
     /// Along a line search the observables are affine in `t`: the samples of `x` (kept from

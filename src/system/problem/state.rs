@@ -29,9 +29,11 @@
 //! Newton iteration (about 8 % of the instructions of a backbone at 20 harmonics) and would
 //! move converged points near internal resonances, where the solution is barely isolated.
 
+use super::band::staircase_of;
 use super::discretization::Discretization;
 use crate::bc::LawSamples;
 use crate::fourier::Basis;
+use crate::linalg::Staircase;
 use crate::system::condense::{condense_into, CondenseScratch, Condensed};
 use crate::system::rows::{HarmonicRows, RowsScratch};
 
@@ -53,6 +55,9 @@ pub(super) struct Frequency {
     /// rank.
     condensed_state: Option<bool>,
     condense_scratch: CondenseScratch,
+    /// The staircase shape of the Jacobian (`None`: stale; `Some(None)`: the structured step
+    /// condenses instead), see `band.rs`.
+    staircase: Option<Option<Staircase>>,
 }
 
 impl Frequency {
@@ -65,6 +70,7 @@ impl Frequency {
             condensed: Vec::new(),
             condensed_state: None,
             condense_scratch: CondenseScratch::default(),
+            staircase: None,
         }
     }
 
@@ -76,6 +82,7 @@ impl Frequency {
         }
         self.omega = omega;
         self.condensed_state = None;
+        self.staircase = None;
         let (system, scratch) = (d.system(), &mut self.rows_scratch);
         let harmonics = d.basis().harmonics() + 1;
         self.rows.truncate(harmonics);
@@ -108,6 +115,22 @@ impl Frequency {
             self.condensed_state = Some(all);
         }
         self.condensed_state == Some(true)
+    }
+}
+
+impl Frequency {
+    /// Brings the staircase shape of the Jacobian up to date ([`staircase_of`]); whether the
+    /// structured step takes it (then [`Frequency::staircase`] is `Some`).
+    pub(super) fn prepare_staircase<B: Basis>(&mut self, d: &Discretization<B>) -> bool {
+        let rows = &self.rows;
+        (self.staircase)
+            .get_or_insert_with(|| staircase_of(d, rows))
+            .is_some()
+    }
+
+    /// The staircase shape of the Jacobian, once [`Frequency::prepare_staircase`] found one.
+    pub(super) fn staircase(&self) -> Option<&Staircase> {
+        self.staircase.as_ref().and_then(Option::as_ref)
     }
 }
 
