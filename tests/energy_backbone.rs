@@ -267,6 +267,10 @@ fn the_chain_with_a_floating_bar_starts_and_its_points_touch_both_contacts() {
     for p in &converged {
         let intervals =
             nonsmooth_modes::modal::contact_intervals(&mut problem, &p.x, p.omega).unwrap();
-        assert!(intervals.iter().all(|&n| n >= 1), "step {}: {intervals:?}", p.step);
+        assert!(
+            intervals.iter().all(|&n| n >= 1),
+            "step {}: {intervals:?}",
+            p.step
+        );
     }
 }
