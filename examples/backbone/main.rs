@@ -53,8 +53,15 @@
 //! point collapsed to rest), and, with `--subharmonic K` for `K > 1`, `subharmonic_share`, the
 //! share of the bars' time-averaged energy in the harmonics that are not multiples of `K`
 //! (`modal::subharmonic_share`: 0 while the branch is the `T`-periodic mode repeated, away
-//! from 0 where it is genuinely subharmonic). A cell is left empty, with a message on stderr,
-//! where the point's unknowns do not allow the computation (not finite).
+//! from 0 where it is genuinely subharmonic; empty for a point collapsed to rest). A cell is
+//! left empty, with a message on stderr, where the point's unknowns do not allow the
+//! computation (not finite).
+//!
+//! `--subharmonic K > 1` (sequential runs in the period): the seed on harmonic `K` gives the
+//! mode of period `T/K` traced `K` times, a subspace Newton's method never leaves; the run
+//! follows it until a point can be left along the most singular direction off the multiples
+//! of `K`, then continues on that genuinely `T`-periodic branch
+//! (`modal::genuine_subharmonic_backbone_with`). `--repeated` keeps the repeated branch.
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic

@@ -4,7 +4,7 @@
 
 use crate::args::MAX_VERIFY_STEPS;
 use nonsmooth_modes::continuation::Event;
-use nonsmooth_modes::modal::{contact_intervals, subharmonic_share, BackbonePoint};
+use nonsmooth_modes::modal::{contact_intervals, subharmonic_share, BackbonePoint, PointStatus};
 use nonsmooth_modes::reference::ClampedFirstMode;
 use nonsmooth_modes::system::NonsmoothSystem;
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
@@ -52,7 +52,8 @@ pub struct Sink<'a> {
 
 impl Sink<'_> {
     /// `,contacts_per_period` and, for `K > 1`, `,subharmonic_share` of a point (empty cells
-    /// where they cannot be computed, e.g. the unknowns of a failed step are not finite).
+    /// where they cannot be computed, e.g. the unknowns of a failed step are not finite, and
+    /// an empty share for a point collapsed to rest).
     fn signature(&self, problem: &mut NonsmoothSystem, p: &BackbonePoint) -> String {
         let cell = |value: Result<String, nonsmooth_modes::SettingsError>, what: &str| {
             value.unwrap_or_else(|e| {
@@ -65,7 +66,10 @@ impl Sink<'_> {
             ",{}",
             cell(contacts.map(|c| c.to_string()), "contacts_per_period")
         );
-        if self.subharmonic > 1 {
+        if self.subharmonic > 1 && p.status == PointStatus::CollapsedToRest {
+            // The share of a motion at rest is that of rounding noise: no number to report.
+            cells.push(',');
+        } else if self.subharmonic > 1 {
             let (system, basis) = (problem.system(), problem.basis());
             let share = subharmonic_share(system, basis, &p.x, p.omega, self.subharmonic);
             cells.push(',');
