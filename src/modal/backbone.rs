@@ -234,18 +234,16 @@ fn drive_backbone<S: NonlinearSolver>(
     Ok((e_g, branch.end))
 }
 
-/// The guess of a period backbone's first step at `omega`: the seed itself where `solver`
-/// takes it to a motion of energy above `floor` (the paper's systems: their runs are
-/// unchanged), else the first such solution from the guesses of the energy backbone's start
-/// around the seed (amplitudes [`START_AMPLITUDES`](crate::modal::START_AMPLITUDES); with
-/// floating bars their rigid-body motions added), solved by `solver` and then by it inside a
-/// [`SmoothingHomotopy`], at `omega` and then at the higher frequencies of
-/// [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the first): a grazing seed can
-/// slide to rest, or to a floating bar's rigid-body rest against an obstacle (the free-free
-/// bar between two walls), where one that penetrates a little, a little further from the
-/// linear frequency, does not; a solution found at a higher frequency is walked back to
-/// `omega` in a few steps (as far as they converge). Else the seed (the first step then
-/// fails as it would have).
+/// The guess of a period backbone's first step at `omega`. For a system with a bar held only
+/// by contacts (a rigid-body mode of the open-contact system), the grazing seed can slide to
+/// the bar at rest against an obstacle (the free-free bar between two walls): there the seed
+/// is kept where `solver` takes it to a motion of energy above `floor`, else the first such
+/// solution from the guesses of the energy backbone's start around the seed
+/// ([`START_AMPLITUDES`](crate::modal::START_AMPLITUDES); the rigid-body motions added),
+/// solved by `solver` and then by it inside a [`SmoothingHomotopy`], at `omega` and then at
+/// the higher frequencies of [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the
+/// first), walked back to `omega` in a few steps (as far as they converge); else the seed.
+/// Other systems (the paper's three) keep the seed, without a solve.
 fn usable_start<S: NonlinearSolver>(
     problem: &mut NonsmoothSystem,
     solver: &S,
@@ -253,6 +251,10 @@ fn usable_start<S: NonlinearSolver>(
     omega: f64,
     floor: f64,
 ) -> Vec<f64> {
+    let guesses = StartGuesses::new(problem.system());
+    if !guesses.floating() {
+        return seed;
+    }
     let (system, basis) = (problem.system().clone(), problem.basis().clone());
     let mut above_rest =
         |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, omega) > floor;
@@ -261,7 +263,6 @@ fn usable_start<S: NonlinearSolver>(
     }
     let homotopy = SmoothingHomotopy::new(solver);
     let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
-    let guesses = StartGuesses::new(&system);
     let found = guesses.ratios().into_iter().find_map(|r| {
         let at = omega * r / START_RATIOS[0];
         let above_rest =

@@ -51,7 +51,8 @@ impl StartGuesses {
         Self { rigid, gap }
     }
 
-    fn floating(&self) -> bool {
+    /// Whether the system has a bar held only by contacts (a rigid-body mode) and a gap.
+    pub(crate) fn floating(&self) -> bool {
         !self.rigid.is_empty() && self.gap.is_finite()
     }
 
