@@ -2,6 +2,7 @@
 //! `J`'s own structured solve.
 
 use crate::continuation::ContinuationProblem;
+use crate::linalg::DenseMatrix;
 use crate::solve::{SingularStep, PIVOT_TOLERANCE};
 
 /// Solves `[J, b; c^T, d] (z, zeta) = (r, rho)` in place for `columns` right-hand sides of
@@ -50,4 +51,28 @@ pub(crate) fn solve_bordered<P: ContinuationProblem + ?Sized>(
         column[n] = zeta;
     }
     Some(Ok(()))
+}
+
+/// The dense bordered matrix `[J, b; c^T, d]` into `jac` (resized to `n + 1`), from `J`
+/// (`inner`, `n x n`), the column `b` and the row `border(i)` (`c_i` for `i < n`, `d` for
+/// `i = n`): the fallback of [`solve_bordered`] and the Jacobian of a bordered problem.
+pub(crate) fn fill_bordered(
+    jac: &mut DenseMatrix,
+    inner: &DenseMatrix,
+    column: &[f64],
+    border: impl Fn(usize) -> f64,
+) {
+    let n = column.len();
+    jac.reset(n + 1, n + 1);
+    for j in 0..n {
+        for i in 0..n {
+            jac[(i, j)] = inner[(i, j)];
+        }
+    }
+    for (i, b) in column.iter().enumerate() {
+        jac[(i, n)] = *b;
+    }
+    for i in 0..=n {
+        jac[(n, i)] = border(i);
+    }
 }

@@ -23,7 +23,7 @@ mod sequential;
 mod speculative;
 
 pub use arclength::{Arclength, ArclengthOptions, ArclengthScale, TangentPredictor};
-pub(crate) use bordering::solve_bordered;
+pub(crate) use bordering::{fill_bordered, solve_bordered};
 pub(crate) use driver::{next_point, run_with};
 pub use driver::{Branch, EndReason, Observer, RejectReason, Rejection, Step};
 pub use progress::{quiet, Progress};

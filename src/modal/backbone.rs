@@ -315,16 +315,7 @@ pub fn backbone<S: NonlinearSolver>(
     options: &BackboneOptions,
     solver: S,
 ) -> Result<Backbone, Error> {
-    let mut points = Vec::new();
-    let (grazing_energy, end) = backbone_with(system, settings, options, solver, |p| {
-        points.push(p.clone());
-        ControlFlow::Continue(())
-    })?;
-    Ok(Backbone {
-        grazing_energy,
-        points,
-        end,
-    })
+    Backbone::collect(|see| backbone_with(system, settings, options, solver, see))
 }
 
 /// Options of [`arclength_backbone`].

@@ -10,15 +10,14 @@
 //!
 //! with `s` the residual scale of `F`. The state of rest has `E = 0` and is no solution
 //! at any level `lambda > 0`: a branch continued in `lambda` cannot collapse to it, which a
-//! branch continued in the period can. Along a backbone, `E` grows monotonically where the
-//! period does not (the clamped bar's family is vertical at `T = 4` in the period's
-//! parametrisation), so the energy is also the better-conditioned parameter.
+//! branch continued in the period can. The price is the truncated system's internal
+//! resonances, spikes that have no other side in the energy (`docs/assemblies.md`).
 //!
 //! The Jacobian is `F`'s bordered by the column `dF/dOmega` and the row
 //! `s (dE/dx, dE/dOmega) / (lambda E_g)`; its structured solve is the bordering algorithm on
 //! `F`'s condensed solve.
 
-use crate::continuation::{solve_bordered, ContinuationProblem};
+use crate::continuation::{fill_bordered, solve_bordered, ContinuationProblem};
 use crate::error::{ContinuationError, Error};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::DenseMatrix;
@@ -154,18 +153,7 @@ impl<B: Basis> Problem for EnergyLevel<B> {
         df.resize(n, 0.0);
         self.inner.jacobian(x, jacobian);
         self.inner.parameter_derivative(x, df);
-        jac.reset(n + 1, n + 1);
-        for j in 0..n {
-            for i in 0..n {
-                jac[(i, j)] = jacobian[(i, j)];
-            }
-        }
-        for i in 0..n {
-            jac[(i, n)] = df[i];
-        }
-        for (j, g) in gradient.iter().enumerate() {
-            jac[(n, j)] = *g;
-        }
+        fill_bordered(jac, jacobian, df, |i| gradient[i]);
     }
 
     fn structure(&mut self) -> Option<&mut dyn Structured> {

@@ -7,6 +7,7 @@ use crate::fourier::Basis;
 use crate::solution::Solution;
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 
 /// One point of a backbone.
 #[derive(Debug, Clone, PartialEq)]
@@ -147,6 +148,25 @@ pub struct Backbone {
 }
 
 impl Backbone {
+    /// Collects every point a backbone driver hands to its observer: `run` is called with
+    /// an observer that keeps them all and returns the driver's `(E_g, end reason)`.
+    pub(crate) fn collect<E>(
+        run: impl FnOnce(
+            &mut dyn FnMut(&BackbonePoint) -> ControlFlow<()>,
+        ) -> Result<(f64, EndReason), E>,
+    ) -> Result<Self, E> {
+        let mut points = Vec::new();
+        let (grazing_energy, end) = run(&mut |p: &BackbonePoint| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        })?;
+        Ok(Self {
+            grazing_energy,
+            points,
+            end,
+        })
+    }
+
     /// The converged points.
     pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
         self.points.iter().filter(|p| p.converged)

@@ -1,7 +1,7 @@
 //! The bordered corrector system of the pseudo-arclength driver, its bordering solve, and the
 //! diagonal metric of the scaled norm on `y = (x, lambda)`.
 
-use crate::continuation::bordering::solve_bordered;
+use crate::continuation::bordering::{fill_bordered, solve_bordered};
 use crate::continuation::ContinuationProblem;
 use crate::linalg::DenseMatrix;
 use crate::solve::{residual_scale, Problem, SingularStep, Structured};
@@ -59,11 +59,6 @@ impl<'a, P: ContinuationProblem + ?Sized> Bordered<'a, P> {
         self.scale = residual_scale(self.problem);
         &y[..n]
     }
-
-    /// The border row `(c, d)`: `c_i = s t_i w_i`, `d = s t_lambda w_lambda`.
-    fn border(&self, i: usize) -> f64 {
-        self.scale * self.tangent[i] * self.metric.weight(i)
-    }
 }
 
 impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
@@ -84,18 +79,12 @@ impl<P: ContinuationProblem + ?Sized> Problem for Bordered<'_, P> {
         df.resize(n, 0.0);
         self.problem.jacobian(x, inner);
         self.problem.parameter_derivative(x, df);
-        jac.reset(n + 1, n + 1);
-        for j in 0..n {
-            for i in 0..n {
-                jac[(i, j)] = inner[(i, j)];
-            }
-        }
-        for i in 0..n {
-            jac[(i, n)] = df[i];
-        }
-        for i in 0..=n {
-            jac[(n, i)] = self.border(i);
-        }
+        fill_bordered(
+            jac,
+            inner,
+            df,
+            border_row(self.scale, self.tangent, self.metric),
+        );
     }
     fn structure(&mut self) -> Option<&mut dyn Structured> {
         Some(self)
@@ -115,8 +104,7 @@ impl<P: ContinuationProblem + ?Sized> Structured for Bordered<'_, P> {
     ) -> Option<Result<(), SingularStep>> {
         let x = self.at(y);
         let mut buffer = std::mem::take(&mut self.scratch.columns);
-        let (scale, tangent, metric) = (self.scale, self.tangent, self.metric);
-        let border = |i: usize| scale * tangent[i] * metric.weight(i);
+        let border = border_row(self.scale, self.tangent, self.metric);
         let result = solve_bordered(self.problem, x, (rhs, columns), border, &mut buffer);
         self.scratch.columns = buffer;
         result
@@ -127,6 +115,16 @@ impl<P: ContinuationProblem + ?Sized> Structured for Bordered<'_, P> {
             .structure()
             .is_some_and(|s| s.set_smoothing(smoothing))
     }
+}
+
+/// The border row `(c, d)`: `c_i = s t_i w_i`, `d = s t_lambda w_lambda`, for the residual
+/// scale `s`, the tangent `t` and the metric `w`.
+fn border_row<'b>(
+    scale: f64,
+    tangent: &'b [f64],
+    metric: &'b Metric,
+) -> impl Fn(usize) -> f64 + 'b {
+    move |i| scale * tangent[i] * metric.weight(i)
 }
 
 /// Diagonal metric `W` of the scaled norm on `y = (x, lambda)`: `x[i]` weighs `x_w[i]`,

@@ -163,21 +163,8 @@ mod tests {
     use super::*;
     use crate::bar::Bar;
     use crate::fourier::CosineBasis;
+    use crate::modal::energy::tests::coefficients;
     use crate::reference::{contact_chain, robin_bar_with_obstacle, two_bars_in_contact};
-
-    /// A deterministic spread of coefficients in `[-1, 1] * scale`.
-    fn coefficients(n: usize, seed: u64, scale: f64) -> Vec<f64> {
-        let mut state = seed;
-        (0..n)
-            .map(|i| {
-                state = state
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                let r = (state >> 11) as f64 / (1u64 << 53) as f64;
-                scale * (2.0 * r - 1.0) / (1.0 + 0.2 * i as f64)
-            })
-            .collect()
-    }
 
     fn systems() -> Vec<BarSystem> {
         vec![

@@ -125,7 +125,7 @@ fn pair_integrals(hi: &OracleHarmonic, hj: &OracleHarmonic, l: f64) -> (f64, f64
 }
 
 /// A deterministic spread of coefficients in `[-1, 1] * scale`, decaying with the index.
-fn coefficients(n: usize, seed: u64, scale: f64) -> Vec<f64> {
+pub(super) fn coefficients(n: usize, seed: u64, scale: f64) -> Vec<f64> {
     let mut state = seed;
     (0..n)
         .map(|i| {

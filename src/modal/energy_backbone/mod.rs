@@ -281,14 +281,5 @@ pub fn energy_backbone<S: NonlinearSolver>(
     options: &EnergyBackboneOptions,
     solver: S,
 ) -> Result<Backbone, Error> {
-    let mut points = Vec::new();
-    let (grazing_energy, end) = energy_backbone_with(system, settings, options, solver, |p| {
-        points.push(p.clone());
-        ControlFlow::Continue(())
-    })?;
-    Ok(Backbone {
-        grazing_energy,
-        points,
-        end,
-    })
+    Backbone::collect(|see| energy_backbone_with(system, settings, options, solver, see))
 }
