@@ -8,10 +8,10 @@ use crate::continuation::{
 use crate::error::{ContinuationError, Error};
 use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
-use crate::modal::energy_backbone::{first_solution, StartGuesses, START_RATIOS};
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::modal::point::{Backbone, BackbonePoint};
+use crate::modal::start::{first_solution, StartGuesses, START_RATIOS};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
@@ -76,6 +76,18 @@ pub struct BackboneOptions {
     /// Converged points with `E < trivial_energy * E_g` count as collapsed to rest and are
     /// not accepted (default `1e-6`).
     pub trivial_energy: f64,
+}
+
+impl BackboneOptions {
+    /// The options of the sequential driver these options ask for.
+    pub fn sequential(&self) -> SequentialOptions {
+        SequentialOptions {
+            predictor: self.predictor,
+            max_consecutive_failures: self.max_consecutive_failures,
+            retry_depth: self.retry_depth,
+            selection: self.selection,
+        }
+    }
 }
 
 impl Default for BackboneOptions {
@@ -181,12 +193,7 @@ fn drive_backbone<S: NonlinearSolver>(
         2.0 * PI / grid.start,
         floor,
     );
-    let seq_options = SequentialOptions {
-        predictor: options.predictor,
-        max_consecutive_failures: options.max_consecutive_failures,
-        retry_depth: options.retry_depth,
-        selection: options.selection,
-    };
+    let seq_options = options.sequential();
     // The acceptance test computes each converged point's energy; the observer reuses it.
     let last_energy = Rc::new(RefCell::new((Vec::new(), f64::NAN, f64::NAN)));
     let accepted_energy = Rc::clone(&last_energy);

@@ -14,6 +14,7 @@ pub mod linear;
 mod parameter;
 mod point;
 pub mod signature;
+mod start;
 mod subharmonic;
 
 pub use backbone::{
@@ -27,8 +28,7 @@ pub use diagnostics::{
 pub use energy::{energy, energy_at, energy_gradient};
 pub use energy_backbone::{
     energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, CALM_STEPS,
-    ESCAPE_AFTER, ESCAPE_PERIODS, FLOATING_AMPLITUDES, FLOATING_RATIOS, MARGINAL_SHARE,
-    RIGID_AMPLITUDES, SLOPE_COLLAPSE, SLOPE_MEMORY, START_AMPLITUDES, START_RATIOS,
+    ESCAPE_AFTER, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY,
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use field::{FieldEvaluator, FieldValue};
@@ -40,6 +40,9 @@ pub use linear::{
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
 pub use signature::{contact_intervals, harmonic_energies, subharmonic_share};
+pub use start::{
+    FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
+};
 pub use subharmonic::{
     genuine_subharmonic_backbone_with, leave_subspace, symmetry_breaking_direction, GENUINE_SHARE,
     NUDGES,

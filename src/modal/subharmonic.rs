@@ -16,8 +16,7 @@
 //! off the multiples of `K` ([`subharmonic_share`]) is at least [`GENUINE_SHARE`].
 
 use crate::continuation::{
-    linspace, ContinuationProblem, EndReason, PeriodParametrised, Sequential, SequentialOptions,
-    Step,
+    linspace, ContinuationProblem, EndReason, PeriodParametrised, Sequential, Step,
 };
 use crate::error::{ContinuationError, Error};
 use crate::fourier::Basis;
@@ -212,18 +211,12 @@ pub fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
     let basis = problem.basis().clone();
     let accept_system = system.clone();
     let accept_basis = basis.clone();
-    let seq_options = SequentialOptions {
-        predictor: options.predictor,
-        max_consecutive_failures: options.max_consecutive_failures,
-        retry_depth: options.retry_depth,
-        ..SequentialOptions::default()
-    };
     let mut driver = Sequential::new(
         PeriodParametrised::new(problem),
         &solver,
         start,
         values,
-        seq_options,
+        options.sequential(),
     )?
     .with_acceptance(move |x, period| {
         let omega = 2.0 * PI / period;

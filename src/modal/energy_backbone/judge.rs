@@ -1,13 +1,13 @@
 //! What makes a motion a point of an energy backbone, and the solves at fixed frequency
 //! that start a branch and jump its internal resonances.
 
-use super::start::{first_solution, StartGuesses};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
 use crate::modal::point::{BackbonePoint, PointStatus};
 use crate::modal::signature::harmonic_energies;
+use crate::modal::start::{first_solution, StartGuesses};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;
@@ -129,10 +129,12 @@ impl Judge {
             x,
             omega,
         );
-        let accepted =
-            verdict.is_some() && self.slopes.step(2.0 * PI / omega, self.level(x, omega));
+        let Some((energies, level)) = verdict else {
+            return false;
+        };
+        let accepted = self.slopes.step(2.0 * PI / omega, level);
         if accepted {
-            self.reference = verdict;
+            self.reference = Some(energies);
         }
         accepted
     }
@@ -226,7 +228,7 @@ impl Judge {
                 (Ok(_), None) => PointStatus::Rejected,
                 (Ok(_), Some(_)) => PointStatus::Converged,
             };
-            let steady = verdict.as_ref().is_some_and(|now| {
+            let steady = verdict.as_ref().is_some_and(|(now, _)| {
                 energies
                     .as_deref()
                     .is_some_and(|before| steady_growth(before, now, self.subharmonic))
@@ -257,7 +259,7 @@ impl Judge {
             if see(point).is_break() {
                 return Walk::Stopped;
             }
-            if let Some(now) = verdict {
+            if let Some((now, _)) = verdict {
                 if level > last_level {
                     return Walk::Beyond;
                 }
@@ -294,7 +296,8 @@ fn steady_growth(before: &[f64], after: &[f64], own: usize) -> bool {
 
 /// Whether the converged motion `x` at `omega` of `problem` is a point of an energy
 /// backbone of NSM sub `subharmonic` with grazing energy `e_g`, after the accepted point
-/// whose time-averaged energies per harmonic are `reference`; if so, its own. The tests:
+/// whose time-averaged energies per harmonic are `reference`; if so, its own and its level
+/// `E / E_g`. The tests:
 ///
 /// - a positive frequency within the problem's range and an energy above rest;
 /// - a contact at some time sample: a motion without contact is a linear one (a resonant
@@ -310,19 +313,21 @@ fn acceptable(
     reference: Option<&[f64]>,
     x: &[f64],
     omega: f64,
-) -> Option<Vec<f64>> {
+) -> Option<(Vec<f64>, f64)> {
     let (system, basis) = (problem.system(), problem.basis());
+    let level = energy(system, basis, x, omega) / e_g;
     if !(omega.is_finite()
         && omega > 0.0
         && omega <= problem.description().max_frequency()
-        && energy(system, basis, x, omega) > REST * e_g)
+        && level > REST)
     {
         return None;
     }
     let energies = harmonic_energies(system, basis, x, omega).ok()?;
     let dominant = (0..energies.len()).max_by(|&a, &b| energies[a].total_cmp(&energies[b]));
     let steady = reference.is_none_or(|r| steady_growth(r, &energies, subharmonic));
-    (dominant == Some(subharmonic) && steady && touches(problem, x, omega)).then_some(energies)
+    (dominant == Some(subharmonic) && steady && touches(problem, x, omega))
+        .then_some((energies, level))
 }
 
 /// Whether `x` at `omega` is in contact at some time sample of some law.

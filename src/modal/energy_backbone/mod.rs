@@ -2,14 +2,9 @@
 //! frequency as an unknown ([`EnergyLevel`]), from the grazing point of a linear mode.
 
 pub(crate) mod judge;
-mod start;
 
 use judge::{Judge, Walk};
 pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY};
-pub(crate) use start::{first_solution, StartGuesses};
-pub use start::{
-    FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
-};
 
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
 use crate::error::Error;
@@ -108,7 +103,7 @@ impl Default for EnergyBackboneOptions {
 /// # The run
 /// - **Start.** A nonsmooth mode at a fixed frequency just above linear mode `mode`'s,
 ///   solved from its grazing seed (placed on harmonic `subharmonic`; see
-///   [`START_RATIOS`]). Its level is the branch's first; the grid's levels above it follow.
+///   [`START_RATIOS`](crate::modal::START_RATIOS)). Its level is the branch's first; the grid's levels above it follow.
 /// - **Levels.** Each level is solved in `(x, Omega)` from the predictor. The state of
 ///   rest is no solution at any level, so no point collapses to it.
 /// - **Acceptance.** A converged point joins the branch if its frequency is positive (and

@@ -1,4 +1,4 @@
-//! The guesses that start a branch: the grazing seed of a linear mode at a few frequencies
+//! The guesses that start a branch, for the energy and the period backbones alike: the grazing seed of a linear mode at a few frequencies
 //! and amplitudes, with the motions of floating bars added where the system has any.
 
 use crate::continuation::ContinuationProblem;
