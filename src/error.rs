@@ -414,6 +414,21 @@ pub enum ContinuationError {
         /// Parameter value.
         lambda: f64,
     },
+    /// [`Arclength::switch_branch`](crate::continuation::Arclength::switch_branch) was asked
+    /// to switch where the last accepted step reported no branch point.
+    #[error("no branch point between the last two accepted points (parameter {parameter})")]
+    NoBranchPoint {
+        /// Parameter of the current point.
+        parameter: f64,
+    },
+    /// The corrector failed on the branch that crosses at a branch point.
+    #[error("switching branches at parameter {parameter}: {error}")]
+    BranchSwitch {
+        /// Parameter of the branch point's estimate.
+        parameter: f64,
+        /// The corrector's error.
+        error: SolveError,
+    },
     /// The starting vector does not match the problem dimension.
     #[error("starting vector has length {got}, the problem has dimension {expected}")]
     Dimension {

@@ -243,6 +243,36 @@ impl Lu {
         Ok(())
     }
 
+    /// The sign of `det A` (`+1` or `-1`) of the factorised matrix: the signs of `U`'s pivots
+    /// times the parity of the row permutation (`P A = L U`, `det P = +-1`). Continuation
+    /// drivers watch it along a branch: it changes at a simple branch point.
+    pub(crate) fn determinant_sign(&self) -> f64 {
+        let n = self.n;
+        let mut sign = 1.0;
+        for i in 0..n {
+            if self.factors[i * n + i] < 0.0 {
+                sign = -sign;
+            }
+        }
+        // A permutation is odd when `n` minus its number of cycles is odd.
+        let mut seen = vec![false; n];
+        let mut cycles = 0;
+        for start in 0..n {
+            if !seen[start] {
+                cycles += 1;
+                let mut i = start;
+                while !seen[i] {
+                    seen[i] = true;
+                    i = self.perm[i];
+                }
+            }
+        }
+        if (n - cycles) % 2 == 1 {
+            sign = -sign;
+        }
+        sign
+    }
+
     /// Solves `A x = b` in place (no allocation once a right-hand side of this size has been
     /// solved).
     ///
@@ -411,6 +441,56 @@ mod tests {
         assert!((b[0] - 1.0).abs() < 1e-14 && (b[1] - 1.0).abs() < 1e-14);
         a[(1, 1)] = 0.5;
         assert!(Lu::factor(&a, 1e-14).is_err());
+    }
+
+    /// `det` by cofactor expansion along the first column (small `n` only).
+    fn cofactor_determinant(a: &DenseMatrix) -> f64 {
+        let n = a.nrows();
+        if n == 1 {
+            return a[(0, 0)];
+        }
+        (0..n)
+            .map(|i| {
+                let mut minor = DenseMatrix::zeros(n - 1, n - 1);
+                for (r, row) in (0..n).filter(|&r| r != i).enumerate() {
+                    for c in 1..n {
+                        minor[(r, c - 1)] = a[(row, c)];
+                    }
+                }
+                let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+                sign * a[(i, 0)] * cofactor_determinant(&minor)
+            })
+            .sum()
+    }
+
+    #[test]
+    fn determinant_sign_matches_the_cofactor_expansion() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut negative, mut pivoted) = (0, 0);
+        for trial in 0..200 {
+            let n = 1 + trial % 6;
+            let mut a = DenseMatrix::zeros(n, n);
+            for j in 0..n {
+                for i in 0..n {
+                    a[(i, j)] = next();
+                }
+            }
+            let det = cofactor_determinant(&a);
+            let lu = Lu::factor(&a, 0.0).unwrap();
+            assert_eq!(lu.determinant_sign(), det.signum(), "n = {n}, det = {det}");
+            negative += usize::from(det < 0.0);
+            pivoted += usize::from(lu.perm.iter().enumerate().any(|(i, &p)| i != p));
+        }
+        assert!(
+            negative > 50 && pivoted > 100,
+            "{negative} negative, {pivoted} pivoted"
+        );
     }
 
     #[test]

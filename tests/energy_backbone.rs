@@ -6,8 +6,9 @@ use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{geomspace, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{
-    backbone, branch_seed, energy, energy_backbone, grazing_energy, split_frequency,
-    BackboneOptions, EnergyBackboneOptions, EnergyGrid, EnergyLevel, PeriodGrid, PointStatus,
+    arclength_backbone, backbone, branch_seed, energy, energy_backbone, grazing_energy,
+    split_frequency, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
+    EnergyBackboneOptions, EnergyGrid, EnergyLevel, PeriodGrid, PointStatus,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
 use nonsmooth_modes::solve::{Problem, SemismoothNewton};
@@ -16,6 +17,7 @@ use nonsmooth_modes::system::{
 };
 use nonsmooth_modes::{ContinuationError, Error};
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 
 const GAP: f64 = 1e-3;
 
@@ -261,10 +263,22 @@ fn the_chain_with_a_floating_bar_starts_and_its_points_touch_both_contacts() {
         SemismoothNewton::default(),
     )
     .unwrap();
-    let converged: Vec<_> = run.converged().collect();
+    let converged: Vec<_> = run.converged().cloned().collect();
     assert!(converged.len() >= 50, "{} converged", converged.len());
-    let mut problem = NonsmoothSystem::new(&system, settings(20)).unwrap();
-    for p in &converged {
+    assert_every_contact_touches(&system, &converged);
+}
+
+/// Every point of `points` (`m = 20`) has at least one contact interval per period at every
+/// law and lies above the grazing energy.
+fn assert_every_contact_touches(system: &BarSystem, points: &[BackbonePoint]) {
+    let mut problem = NonsmoothSystem::new(system, settings(20)).unwrap();
+    for p in points {
+        assert!(
+            p.energy_normalized > 1.0,
+            "step {}: {}",
+            p.step,
+            p.energy_normalized
+        );
         let intervals =
             nonsmooth_modes::modal::contact_intervals(&mut problem, &p.x, p.omega).unwrap();
         assert!(
@@ -273,4 +287,33 @@ fn the_chain_with_a_floating_bar_starts_and_its_points_touch_both_contacts() {
             p.step
         );
     }
+}
+
+/// The chain's pseudo-arclength backbone starts from the same robust guesses as the period
+/// backbone, at the frequency where they converge (the grazing seed meets a singular Jacobian:
+/// with every contact open the floating bar's mean position is free); every accepted point
+/// touches both contacts and none sits at rest.
+#[test]
+fn the_chains_arclength_backbone_starts_where_its_guesses_converge() {
+    let system = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
+    let options = ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap();
+    let mut points = Vec::new();
+    let (_, branch) = arclength_backbone(
+        &system,
+        settings(20),
+        &options,
+        SemismoothNewton::default(),
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    assert!(
+        points.len() >= 50,
+        "{} points, end {:?}",
+        points.len(),
+        branch.end
+    );
+    assert_every_contact_touches(&system, &points);
 }

@@ -131,3 +131,81 @@ fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
         assert!(share(p) < 1e-10, "step {}: {}", p.step, share(p));
     }
 }
+
+/// The arclength backbone of NSM 2 sub 3 reports branch points on the repeated branch, and
+/// switching at the first one leaves the subspace of the multiples of `K`: the points before
+/// the switch are the repeated branch (share below 1e-9), some after it are genuinely
+/// subharmonic (share above `GENUINE_SHARE`), and none sits at rest. A branch point the run
+/// never reaches leaves the run as it is without a switch; a bad request is refused.
+#[test]
+fn switching_at_a_branch_point_of_the_repeated_branch_leaves_the_subspace() {
+    use nonsmooth_modes::continuation::{EndReason, Event};
+    use nonsmooth_modes::modal::{arclength_backbone, ArclengthBackboneOptions, SwitchAt};
+    use nonsmooth_modes::{ContinuationError, Error};
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let run = |switch| {
+        let options = ArclengthBackboneOptions {
+            switch,
+            ..ArclengthBackboneOptions::for_mode(&system, 2, K).unwrap()
+        };
+        let mut points = Vec::new();
+        let result = arclength_backbone(
+            &system,
+            settings(40),
+            &options,
+            SemismoothNewton::default(),
+            |p| {
+                points.push(p.clone());
+                ControlFlow::Continue(())
+            },
+        );
+        result.map(|(_, branch)| (points, branch))
+    };
+    let problem = NonsmoothSystem::new(&system, settings(40)).unwrap();
+    let basis = problem.basis().clone();
+    let share = |p: &nonsmooth_modes::modal::BackbonePoint| {
+        subharmonic_share(&system, &basis, &p.x, p.omega, K).unwrap()
+    };
+    let (points, branch) = run(Some(SwitchAt {
+        branch_point: 1,
+        side: 1.0,
+    }))
+    .unwrap();
+    assert_eq!(points.len(), branch.points.len());
+    let at = points
+        .iter()
+        .position(|p| {
+            p.events
+                .iter()
+                .any(|e| matches!(e, Event::BranchPoint { .. }))
+        })
+        .expect("a branch point");
+    assert!(points[..=at].iter().all(|p| share(p) < 1e-9));
+    let genuine = points[at + 1..]
+        .iter()
+        .filter(|p| share(p) > GENUINE_SHARE)
+        .count();
+    assert!(genuine >= 10, "{genuine} genuinely subharmonic points");
+    assert_eq!(points[at + 1].step, points[at].step + 1);
+    assert!(points.iter().all(|p| p.energy_normalized > 1.0));
+
+    let (plain, _) = run(None).unwrap();
+    let (unreached, unreached_branch) = run(Some(SwitchAt {
+        branch_point: 1000,
+        side: -1.0,
+    }))
+    .unwrap();
+    assert!(!matches!(
+        unreached_branch.end,
+        EndReason::SwitchFailed { .. }
+    ));
+    assert_eq!(plain.len(), unreached.len());
+    assert!(plain.iter().zip(&unreached).all(|(a, b)| a.x == b.x));
+    assert!(matches!(
+        run(Some(SwitchAt {
+            branch_point: 0,
+            side: 1.0
+        })),
+        Err(Error::Continuation(ContinuationError::InvalidOption { .. }))
+    ));
+}

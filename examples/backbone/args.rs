@@ -3,7 +3,7 @@
 
 use crate::systems::{load_assembly, SystemKind};
 use nonsmooth_modes::continuation::{ArclengthOptions, Selection};
-use nonsmooth_modes::modal::BackboneOptions;
+use nonsmooth_modes::modal::{BackboneOptions, SwitchAt};
 use nonsmooth_modes::system::HarmonicBalanceSettings;
 
 pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
@@ -13,7 +13,7 @@ pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--r
   [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
   [--selection first|lowest-energy] [--serial] [--out FILE]
   [--method sequential|arclength]
-  [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI]
+  [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI] [--switch-at N[:SIDE]]
   [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
   [--energy-range LO:HI] [--progress] [--verify]";
 
@@ -74,6 +74,8 @@ pub struct Args {
     pub arclength: bool,
     pub driver: ArclengthOptions,
     pub omega_range: Option<(f64, f64)>,
+    /// `--switch-at N[:SIDE]` of arclength runs.
+    pub switch: Option<SwitchAt>,
     pub parameter: Parameter,
     pub parameter_range: Option<(f64, f64)>,
     /// Levels `E / E_g` of `--parameter energy`.
@@ -91,6 +93,18 @@ fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
             .map_err(|e| lexopt::Error::from(format!("`{v}`: {e}")))
     };
     Ok((parse(a)?, parse(b)?))
+}
+
+/// `N` or `N:SIDE` of `--switch-at`: the `N`-th branch point (from 1), side `+1` (default) or
+/// `-1`.
+fn switch_at(text: &str) -> Result<SwitchAt, lexopt::Error> {
+    let (n, side) = text.split_once(':').unwrap_or((text, "1"));
+    let branch_point: usize = n.parse().map_err(|e| format!("`{n}`: {e}"))?;
+    let side: f64 = side.parse().map_err(|e| format!("`{side}`: {e}"))?;
+    if branch_point == 0 || !(side == 1.0 || side == -1.0) {
+        return Err(format!("expected N:SIDE with N >= 1 and SIDE 1 or -1, got `{text}`").into());
+    }
+    Ok(SwitchAt { branch_point, side })
 }
 
 /// The count `value` of `--flag`, at most `max`.
@@ -130,6 +144,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         arclength: false,
         driver: ArclengthOptions::default(),
         omega_range: None,
+        switch: None,
         parameter: Parameter::Omega,
         parameter_range: None,
         energy_range: None,
@@ -218,6 +233,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
                 a.driver.max_steps = at_most("max-steps", parser.value()?, MAX_POINTS)?
             }
             Long("omega-range") => a.omega_range = Some(range(&parser.value()?.string()?)?),
+            Long("switch-at") => a.switch = Some(switch_at(&parser.value()?.string()?)?),
             Long("parameter") => {
                 a.parameter = match parser.value()?.string()?.as_str() {
                     "omega" => Parameter::Omega,
@@ -250,6 +266,9 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             return Err("--parameter other than omega or energy needs a --system shorthand".into());
         }
         a.system = SystemKind::File(load_assembly(&path)?);
+    }
+    if a.switch.is_some() && !a.arclength {
+        return Err("--switch-at needs --method arclength".into());
     }
     if a.parameter == Parameter::Energy && a.arclength {
         return Err("--parameter energy is sequential: it takes no --method arclength".into());

@@ -9,7 +9,7 @@
 //!     [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
 //!     [--selection first|lowest-energy] [--serial]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
-//!     [--omega-range LO:HI] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
+//!     [--omega-range LO:HI] [--switch-at N[:SIDE]] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify]
 //! ```
 //!
@@ -65,7 +65,11 @@
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
-//! escape from internal-resonance stalls. `--parameter energy` continues the branch in the
+//! escape from internal-resonance stalls; its `event` column marks folds, jumps, grazing and
+//! branch points (`branch-point`: the sign of the bordered Jacobian's determinant changed),
+//! and `--switch-at N[:SIDE]` leaves the branch at its `N`-th branch point for the branch
+//! crossing there, on side `SIDE` (`1`, the default, or `-1`) of its direction
+//! (`ArclengthBackboneOptions::switch`). `--parameter energy` continues the branch in the
 //! energy level `E/E_g` with the frequency an unknown (`modal::energy_backbone`; levels from
 //! `--energy-range LO:HI`, default from mode `i`'s grazing energy to 300 times it, in `--steps`
 //! geometric levels; sequential only); the points where it walks an internal resonance in the

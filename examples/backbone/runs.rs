@@ -58,6 +58,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             omega_range: a.omega_range.unwrap_or((lo.min(hi) * 0.999, lo.max(hi))),
             mode: a.mode,
             subharmonic: a.subharmonic,
+            switch: a.switch,
             arclength: ArclengthOptions {
                 direction: if t1 < t0 { 1.0 } else { -1.0 },
                 ..a.driver

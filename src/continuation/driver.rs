@@ -115,6 +115,13 @@ pub enum EndReason {
         /// Parameter value where the run stalled.
         parameter: f64,
     },
+    /// A run asked to switch branches at a branch point could not
+    /// ([`Arclength::switch_branch`](crate::continuation::Arclength::switch_branch)).
+    SwitchFailed {
+        /// Why.
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))]
+        error: Box<ContinuationError>,
+    },
 }
 
 impl EndReason {
@@ -139,6 +146,7 @@ impl EndReason {
                     parameter: last.parameter,
                 })
             }
+            Self::SwitchFailed { error } => Some((**error).clone()),
             _ => None,
         }
     }

@@ -162,6 +162,7 @@ pub struct Point {
 
 /// Something that happened along a branch, reported on the point where it was detected.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Event {
     /// Turning point: the parameter component of the tangent changed sign.
@@ -176,6 +177,17 @@ pub enum Event {
         /// Distance to the prediction (or to the point jumped from) over the step size.
         ratio: f64,
     },
+    /// A simple branch point lies between this point and the one before: the sign of
+    /// `det [J, F_lambda; t^T W]` (with the tangent `t` oriented along the branch) changed
+    /// while every law's active set kept its size. A fold leaves that sign unchanged; a
+    /// change of active set can flip it without a branch point (the generalised Jacobian
+    /// jumps), so such a change is reported as grazing alone.
+    /// [`Arclength::switch_branch`](crate::continuation::Arclength::switch_branch) follows
+    /// the other branch.
+    BranchPoint {
+        /// Parameter at the point after the branch point.
+        parameter: f64,
+    },
     /// The active set of a unilateral law appeared (`contact == true`) or vanished.
     Grazing {
         /// Law index.
@@ -186,11 +198,12 @@ pub enum Event {
 }
 
 impl Event {
-    /// A short label for tables: `fold`, `jump`, `grazing+`, `grazing-`.
+    /// A short label for tables: `fold`, `jump`, `branch-point`, `grazing+`, `grazing-`.
     pub fn label(&self) -> &'static str {
         match self {
             Event::Fold { .. } => "fold",
             Event::Jump { .. } => "jump",
+            Event::BranchPoint { .. } => "branch-point",
             Event::Grazing { contact: true, .. } => "grazing+",
             Event::Grazing { contact: false, .. } => "grazing-",
         }

@@ -12,6 +12,7 @@ use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::modal::point::{Backbone, BackbonePoint};
 use crate::modal::start::{first_solution, StartGuesses, START_RATIOS};
+use crate::modal::switch::{Runner, SwitchAt};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
@@ -186,7 +187,7 @@ fn drive_backbone<S: NonlinearSolver>(
     )?;
     let basis = problem.basis().clone();
     let floor = options.trivial_energy * e_g;
-    let start = usable_start(
+    let (start, _) = usable_start(
         &mut problem,
         &solver,
         (start, options.subharmonic),
@@ -250,23 +251,24 @@ fn drive_backbone<S: NonlinearSolver>(
 /// solved by `solver` and then by it inside a [`SmoothingHomotopy`], at `omega` and then at
 /// the higher frequencies of [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the
 /// first), walked back to `omega` in a few steps (as far as they converge); else the seed.
-/// Other systems (the paper's three) keep the seed, without a solve.
+/// Other systems (the paper's three) keep the seed, without a solve. Returns the guess and
+/// the frequency it was last solved at (`omega` for the seed).
 fn usable_start<S: NonlinearSolver>(
     problem: &mut NonsmoothSystem,
     solver: &S,
     (seed, subharmonic): (Vec<f64>, usize),
     omega: f64,
     floor: f64,
-) -> Vec<f64> {
+) -> (Vec<f64>, f64) {
     let guesses = StartGuesses::new(problem.system());
     if !guesses.floating() {
-        return seed;
+        return (seed, omega);
     }
     let (system, basis) = (problem.system().clone(), problem.basis().clone());
     let mut above_rest =
         |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, omega) > floor;
     if first_solution(problem, &[solver], [seed.clone()], omega, &mut above_rest).is_some() {
-        return seed;
+        return (seed, omega);
     }
     let homotopy = SmoothingHomotopy::new(solver);
     let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
@@ -278,20 +280,21 @@ fn usable_start<S: NonlinearSolver>(
         first_solution(problem, &solvers, tries, at, above_rest).map(|x| (x, at))
     });
     let Some((mut x, from)) = found else {
-        return seed;
+        return (seed, omega);
     };
     // Walk the solution back to `omega` in a few steps, each from the last.
     const WALK: usize = 8;
+    let mut reached = from;
     for k in 1..=WALK {
         let at = from + (omega - from) * k as f64 / WALK as f64;
         let above_rest =
             |_: &mut NonsmoothSystem, y: &[f64]| energy(&system, &basis, y, at) > floor;
         match first_solution(problem, &solvers, [x.clone()], at, above_rest) {
-            Some(y) => x = y,
+            Some(y) => (x, reached) = (y, at),
             None => break,
         }
     }
-    x
+    (x, reached)
 }
 
 /// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
@@ -346,6 +349,10 @@ pub struct ArclengthBackboneOptions {
     pub escape: Option<StallEscape>,
     /// As [`BackboneOptions::trivial_energy`] (default `1e-6`).
     pub trivial_energy: f64,
+    /// Leave the branch at one of its branch points for the branch crossing there (default
+    /// `None`: follow the branch seeded). The run's points are those of both branches; the
+    /// switched point is numbered as the next step.
+    pub switch: Option<SwitchAt>,
 }
 
 impl Default for ArclengthBackboneOptions {
@@ -358,6 +365,7 @@ impl Default for ArclengthBackboneOptions {
             arclength: ArclengthOptions::default(),
             escape: Some(StallEscape::default()),
             trivial_energy: 1e-6,
+            switch: None,
         }
     }
 }
@@ -440,8 +448,16 @@ pub fn arclength_backbone_observed<S: NonlinearSolver>(
         escape.validate()?;
     }
     let floor = options.trivial_energy * e_g;
+    // A floating bar's branch may start only at a higher frequency than asked.
+    let (start, omega0) = usable_start(
+        &mut problem,
+        &solver,
+        (start, options.subharmonic),
+        omega0,
+        floor,
+    );
     let (accept_system, accept_basis) = (system.clone(), basis.clone());
-    let mut driver = Arclength::new(problem, solver, start, omega0, arclength)?
+    let driver = Arclength::new(problem, solver, start, omega0, arclength)?
         .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
     let mut see = |step: &Step| match step {
         Step::Accepted(p) => observer.point(&BackbonePoint::from_point(
@@ -453,9 +469,10 @@ pub fn arclength_backbone_observed<S: NonlinearSolver>(
         Step::Rejected(r) => observer.rejected(r),
         Step::Finished(_) => ControlFlow::Continue(()),
     };
-    let branch = match options.escape {
-        Some(escape) => EscapingArclength::new(driver, escape)?.run(&mut see),
-        None => driver.run(&mut see),
+    let mut runner = match options.escape {
+        Some(escape) => Runner::Escaping(EscapingArclength::new(driver, escape)?),
+        None => Runner::Plain(driver),
     };
+    let branch = runner.run_switching(options.switch, &mut see)?;
     Ok((e_g, branch))
 }

@@ -127,6 +127,22 @@ impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
         self.driver
     }
 
+    /// Switches the driver onto the branch crossing at the branch point reported on the last
+    /// accepted point ([`Arclength::switch_branch`]); the stall window starts anew from the
+    /// switched point, and a run that had ended runs again.
+    ///
+    /// # Errors
+    /// Those of [`Arclength::switch_branch`]; the run is then unchanged.
+    pub fn switch_branch(&mut self, side: f64) -> Result<Point, ContinuationError> {
+        let point = self.driver.switch_branch(side)?;
+        self.history.clear();
+        self.frontier = None;
+        self.record(&point);
+        self.finished = None;
+        self.done = false;
+        Ok(point)
+    }
+
     /// One step of the driver, or a jump past a stall.
     pub fn step(&mut self) -> Step {
         if let Some(end) = &self.finished {

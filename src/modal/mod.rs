@@ -16,6 +16,7 @@ mod point;
 pub mod signature;
 mod start;
 mod subharmonic;
+mod switch;
 
 pub use backbone::{
     arclength_backbone, arclength_backbone_observed, backbone, backbone_speculative_with,
@@ -47,3 +48,4 @@ pub use subharmonic::{
     genuine_subharmonic_backbone_with, leave_subspace, symmetry_breaking_direction, GENUINE_SHARE,
     NUDGES,
 };
+pub use switch::SwitchAt;

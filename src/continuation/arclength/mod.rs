@@ -29,6 +29,7 @@
 //! SIAM Classics in Applied Mathematics 45 (2003), chapter 2.
 
 mod bordered;
+mod branching;
 mod options;
 
 pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
@@ -41,6 +42,7 @@ use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::{NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
 use bordered::{BorderScratch, Bordered, Metric};
+use branching::Bracket;
 
 /// Pseudo-arclength continuation driver, generic over the problem and the corrector.
 pub struct Arclength<P, S> {
@@ -63,6 +65,11 @@ pub struct Arclength<P, S> {
     rejections: usize,
     accept: Option<Acceptance>,
     border: BorderScratch,
+    /// The sign of `det [J, F_lambda; t^T W]` at the current point (`None` when not watched
+    /// or exactly singular).
+    orientation: Option<f64>,
+    /// The last accepted step, when it crossed a branch point.
+    bracket: Option<Bracket>,
 }
 
 impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
@@ -132,10 +139,14 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             rejections: 0,
             accept: None,
             border: BorderScratch::default(),
+            orientation: None,
+            bracket: None,
         };
+        let y = driver.y.clone();
         driver.tangent = driver
-            .tangent_at(&driver.y.clone(), &seed)
+            .tangent_at(&y, &seed)
             .ok_or(ContinuationError::SingularTangent { lambda: lambda0 })?;
+        driver.orientation = driver.orientation_at(&y, &driver.tangent.clone());
         driver.active = driver.active_set();
         driver.start = Some(driver.point(0, &info, Vec::new()));
         Ok(driver)
@@ -245,6 +256,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         let tangent = self
             .tangent_at(&y, &seed)
             .ok_or(ContinuationError::SingularTangent { lambda })?;
+        self.orientation = self.orientation_at(&y, &tangent);
+        self.bracket = None;
         self.previous = None;
         self.y = y;
         self.tangent = tangent;
@@ -275,6 +288,28 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         self.problem.set_parameter(self.y[n]);
         let x = &self.y[..n];
         self.problem.structure().and_then(|s| s.active_set(x))
+    }
+
+    /// The prediction `y_p = from + h direction` and the corrector's solution of `F = 0` on
+    /// the hyperplane `<direction, y - y_p>_W = 0` through it (its last iterate on failure).
+    fn predict_and_correct(
+        &mut self,
+        from: &[f64],
+        direction: &[f64],
+        h: f64,
+    ) -> (Vec<f64>, Vec<f64>, Result<SolveInfo, SolveError>) {
+        let predicted: Vec<f64> = (from.iter().zip(direction))
+            .map(|(y, t)| y + h * t)
+            .collect();
+        let mut y = predicted.clone();
+        let mut bordered = Bordered::new(
+            &mut self.problem,
+            (direction, &predicted),
+            &self.metric,
+            &mut self.border,
+        );
+        let result = self.solver.solve(&mut bordered, &mut y);
+        (predicted, y, result)
     }
 
     /// Unit tangent at `y` oriented along `reference` (`<t, reference>_W > 0`).
@@ -376,22 +411,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
             _ => None,
         };
         let direction = secant.unwrap_or_else(|| self.tangent.clone());
-        let predicted: Vec<f64> = self
-            .y
-            .iter()
-            .zip(&direction)
-            .map(|(y, t)| y + self.ds * t)
-            .collect();
-        let mut y = predicted.clone();
-        let result = {
-            let mut bordered = Bordered::new(
-                &mut self.problem,
-                (&direction, &predicted),
-                &self.metric,
-                &mut self.border,
-            );
-            self.solver.solve(&mut bordered, &mut y)
-        };
+        let (predicted, y, result) = self.predict_and_correct(&self.y.clone(), &direction, self.ds);
         let info = match result {
             Ok(info) => info,
             Err(e) => return self.reject(predicted[n], RejectReason::Solver(e)),
@@ -431,8 +451,19 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         if tangent[n] * self.tangent[n] < 0.0 {
             events.push(Event::Fold { parameter: y[n] });
         }
+        let orientation = self.orientation_at(&y, &tangent);
         self.problem.set_parameter(y[n]);
         let active = self.problem.structure().and_then(|s| s.active_set(&y[..n]));
+        let same_active = match (&self.active, &active) {
+            (Some(old), Some(new)) => old == new,
+            _ => true,
+        };
+        let crossed = matches!((self.orientation, orientation), (Some(a), Some(b)) if a != b);
+        self.bracket = (crossed && same_active).then(|| Bracket::new(&self.y, &y, &tangent));
+        if self.bracket.is_some() {
+            events.push(Event::BranchPoint { parameter: y[n] });
+        }
+        self.orientation = orientation;
         if let (Some(old), Some(new)) = (&self.active, &active) {
             for (law, (a, b)) in old.iter().zip(new).enumerate() {
                 if (*a == 0) != (*b == 0) {

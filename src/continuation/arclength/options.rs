@@ -66,6 +66,12 @@ pub struct ArclengthOptions {
     /// from `ds_max`), but a `shrink` close to 1 takes millions of them, each a corrector
     /// solve, to get there; this bounds the whole run's.
     pub max_rejections: usize,
+    /// Watch the sign of `det [J, F_lambda; t^T W]` along the branch and report a
+    /// [`Event::BranchPoint`](crate::continuation::Event::BranchPoint) where it changes
+    /// (default `true`). It costs one dense factorisation of the bordered Jacobian per
+    /// accepted point, `O(n^3)` in the problem's dimension `n`; turn it off for large
+    /// problems whose branch points do not matter.
+    pub branch_points: bool,
 }
 
 impl Default for ArclengthOptions {
@@ -85,6 +91,7 @@ impl Default for ArclengthOptions {
             jump_ratio: 2.0,
             max_turn: std::f64::consts::FRAC_PI_4,
             max_rejections: 10_000,
+            branch_points: true,
         }
     }
 }

@@ -68,6 +68,13 @@ fn passes_the_fold_of_a_circle_and_comes_back() {
         .with_event(|e| matches!(e, Event::Fold { .. }))
         .collect();
     assert_eq!(folds.len(), 1);
+    assert_eq!(
+        branch
+            .with_event(|e| matches!(e, Event::BranchPoint { .. }))
+            .count(),
+        0,
+        "a fold is not a branch point"
+    );
     assert!(folds[0].parameter > 0.95);
     assert!(
         branch.points.iter().any(|p| p.x[0] < -0.5),
@@ -246,4 +253,125 @@ fn restart_from_continues_the_branch_elsewhere_with_the_same_scale() {
     let next = &rest.points[0];
     let (problem, _) = driver.into_parts();
     assert_eq!(problem.parameter(), next.parameter);
+}
+
+/// `F(x, lambda) = (x_0 (lambda - x_0^2), x_1 - lambda)`: the branch `x_0 = 0` is crossed at
+/// `lambda = 0` by the pitchfork `x_0^2 = lambda`, `x_1 = lambda`.
+struct Pitchfork {
+    lambda: f64,
+}
+
+impl Problem for Pitchfork {
+    fn dimension(&self) -> usize {
+        2
+    }
+    fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        f[0] = x[0] * (self.lambda - x[0] * x[0]);
+        f[1] = x[1] - self.lambda;
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        jac.reset(2, 2);
+        jac[(0, 0)] = self.lambda - 3.0 * x[0] * x[0];
+        jac[(1, 1)] = 1.0;
+    }
+}
+
+impl ContinuationProblem for Pitchfork {
+    fn parameter(&self) -> f64 {
+        self.lambda
+    }
+    fn set_parameter(&mut self, lambda: f64) {
+        self.lambda = lambda;
+    }
+    fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
+        df[0] = x[0];
+        df[1] = -1.0;
+    }
+}
+
+/// A driver on the trivial branch of [`Pitchfork`] from `lambda = -1`.
+fn on_the_trivial_branch(branch_points: bool) -> Arclength<Pitchfork, SemismoothNewton> {
+    let options = ArclengthOptions {
+        ds: 0.05,
+        ds_max: 0.1,
+        parameter_range: (-1.5, 1.0),
+        scale: ArclengthScale::Fixed(1.0, 1.0),
+        branch_points,
+        ..Default::default()
+    };
+    Arclength::new(
+        Pitchfork { lambda: -1.0 },
+        SemismoothNewton::default(),
+        vec![0.0, -1.0],
+        -1.0,
+        options,
+    )
+    .unwrap()
+}
+
+/// [`on_the_trivial_branch`] stepped until the accepted point that reports the branch point
+/// (returned with it).
+fn at_the_pitchfork() -> (Arclength<Pitchfork, SemismoothNewton>, Point) {
+    let mut driver = on_the_trivial_branch(true);
+    for _ in 0..100 {
+        match driver.step() {
+            Step::Accepted(p) if !p.events.is_empty() => return (driver, p),
+            Step::Finished(end) => panic!("ended before the branch point: {end:?}"),
+            _ => {}
+        }
+    }
+    panic!("no branch point in 100 steps");
+}
+
+#[test]
+fn detects_the_pitchfork_and_switches_onto_either_side() {
+    let (mut driver, at) = at_the_pitchfork();
+    assert!(
+        matches!(at.events[..], [Event::BranchPoint { parameter }] if parameter > 0.0 && parameter <= 0.1),
+        "{:?}",
+        at.events
+    );
+    assert!(at.x[0].abs() < 1e-12, "still on the trivial branch");
+    for side in [1.0, -1.0] {
+        let (mut driver, _) = at_the_pitchfork();
+        let switched = driver.switch_branch(side).unwrap();
+        assert!(switched.x[0] * side > 0.0, "side {side}: {:?}", switched.x);
+        assert_eq!(switched.step, at.step + 1);
+        let mut points = vec![switched];
+        let branch = driver.run(&mut crate::continuation::quiet);
+        assert!(matches!(branch.end, EndReason::ParameterOutOfRange { .. }));
+        points.extend(branch.points);
+        assert!(points.len() > 10);
+        for p in &points {
+            assert!(p.x[0] * side > 0.0, "stays on its side");
+            assert!((p.x[0] * p.x[0] - p.parameter).abs() < 1e-8, "{p:?}");
+            assert!((p.x[1] - p.parameter).abs() < 1e-8);
+        }
+        assert!(points.last().unwrap().parameter > 0.9);
+    }
+    // Switched once, the bracket is gone; the side must be +-1.
+    assert!(matches!(
+        driver.switch_branch(0.5),
+        Err(ContinuationError::InvalidOption { .. })
+    ));
+    driver.switch_branch(1.0).unwrap();
+    assert!(matches!(
+        driver.switch_branch(1.0),
+        Err(ContinuationError::NoBranchPoint { .. })
+    ));
+}
+
+#[test]
+fn branch_points_are_not_watched_when_switched_off() {
+    let mut driver = on_the_trivial_branch(false);
+    let branch = driver.run(&mut crate::continuation::quiet);
+    assert!(branch.points.len() > 10);
+    assert!(branch
+        .points
+        .iter()
+        .all(|p| p.events.is_empty() && p.x[0] == 0.0));
+    assert!(matches!(
+        driver.switch_branch(1.0),
+        Err(ContinuationError::NoBranchPoint { .. })
+    ));
 }

@@ -12,7 +12,7 @@ use nonsmooth_modes::continuation::{EndReason, Rejection, SequentialOptions, Spe
 use nonsmooth_modes::modal::{
     arclength_backbone_observed, backbone, backbone_speculative_with, backbone_with,
     grazing_energy, parameter_branch, ArclengthBackboneOptions, BackboneObserver, BackboneOptions,
-    BackbonePoint, ParameterSteps, PeriodGrid,
+    BackbonePoint, ParameterSteps, PeriodGrid, SwitchAt,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::system::HarmonicBalanceSettings;
@@ -115,6 +115,10 @@ pub(crate) fn arclength_backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResul
         arclength,
         escape: d.flag("escape", 0.5).then(|| stall_escape(d)),
         trivial_energy: d.real("trivial_energy", 0.0..=1e-3),
+        switch: d.flag("switch", 0.3).then(|| SwitchAt {
+            branch_point: d.size("switch branch point", 0..=3),
+            side: d.choice("switch side", &[1.0, -1.0], &[0.0, f64::NAN, 2.0]),
+        }),
     };
     let solver = solver(d, c)?;
     // The observer sees rejected steps too, so an unbounded run (a shrink factor close to 1

@@ -213,6 +213,7 @@ pub(crate) fn arclength_options(d: &mut Draw) -> ArclengthOptions {
         jump_ratio: d.real("jump_ratio", 0.5..=10.0),
         max_turn: d.real("max_turn", 0.1..=3.0),
         max_rejections: d.size("max_rejections", 0..=20),
+        branch_points: d.flag("branch points", 0.5),
     }
 }
 
