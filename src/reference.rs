@@ -30,13 +30,30 @@ pub fn robin_bar_with_obstacle(spring_stiffness: f64, gap: f64) -> Result<BarSys
     b.build()
 }
 
+/// Bar 2 of the paper's two-bar configuration `(l, c, alpha)`, read with the paper's own
+/// definition (§2.1) `alpha = E1 A1 / (E2 A2)`: length `l`, wave speed `c`, axial stiffness
+/// `EA_2 = 1 / alpha` (bar 1 is the unit bar).
+///
+/// The paper's balance `u_x(1) = alpha w_y(l)` (eq. 30) is the force balance only for the
+/// inverse ratio; that equation is the slip, not the definition. Read as `EA_2/EA_1 = alpha`,
+/// configuration 2 `(3.8, 4, 4)` gives bar 2 the impedance `EA/c = 1` and travel time
+/// `l/c = 0.95` of configuration 1 `(0.95, 1, 1)`: the contact sees the same bar, every
+/// backbone coincides, and the configuration could not show what the paper chose it for
+/// (a different design at equal natural frequencies). `docs/theory.md` §3 says more;
+/// `tests/two_bars.rs` checks that the other reading reproduces configuration 1.
+///
+/// # Errors
+/// [`ModelError::NotPositive`] naming `alpha` for a non-positive or non-finite ratio, and
+/// the errors of [`Bar::new`].
+pub fn paper_second_bar(length: f64, wave_speed: f64, alpha: f64) -> Result<Bar, ModelError> {
+    let alpha = crate::check::positive("paper stiffness ratio alpha = E1A1/(E2A2)", alpha)?;
+    Bar::new(length, wave_speed, 1.0 / alpha)
+}
+
 /// Two bars clamped at their left ends whose right ends face each other across a gap `g0`
 /// (the paper's two-bar system, its Fig. 1c): bar 1 is the unit bar, bar 2 is `second`.
 ///
-/// The paper's triplets `(l, c, alpha)` map to `second = Bar::new(l, c, alpha)`: we read
-/// `alpha` as `EA_2 / EA_1`, the reading under which the paper's balance
-/// `u_x(1) = alpha w_y(l)` is the force balance (its definition `alpha = E1A1/(E2A2)` is the
-/// inverse; formulation §3).
+/// The paper's triplets `(l, c, alpha)` give `second` through [`paper_second_bar`].
 ///
 /// # Errors
 /// If `gap` is not positive and finite.

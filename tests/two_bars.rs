@@ -156,3 +156,63 @@ fn degenerate_harmonic_of_two_identical_bars() {
         distance(&a, &reference.x)
     );
 }
+
+/// Backbone of NSM1 of the two-bar system with bar 2 `second`, `m = 20`, `T = 3.9 -> 3.3`
+/// (from 3.95, the grazing seed of configuration 2 slides to rest).
+fn nsm1_of(second: Bar) -> Vec<BackbonePoint> {
+    let system = two_bars_in_contact(second, GAP).unwrap();
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: 3.9,
+            end: 3.3,
+            steps: 25,
+        },
+        ..Default::default()
+    };
+    let settings = HarmonicBalanceSettings::default();
+    backbone(&system, settings, &options, SemismoothNewton::default())
+        .unwrap()
+        .points
+}
+
+/// The paper's configuration 2 `(3.8, 4, 4)` read as `EA_2/EA_1 = alpha` gives bar 2 the
+/// impedance `EA/c` and travel time `l/c` of configuration 1 `(0.95, 1, 1)`: the contact sees
+/// the same bar, and the backbones coincide point for point (frequencies, normalised energies,
+/// bar 1's unknowns). Read with the paper's definition `alpha = E1A1/(E2A2)`
+/// (`paper_second_bar`, what the figures use), configuration 2 is another system.
+#[test]
+fn the_other_reading_of_configuration_2_is_configuration_1() {
+    use nonsmooth_modes::reference::paper_second_bar;
+    let one = nsm1_of(paper_second_bar(0.95, 1.0, 1.0).unwrap());
+    let other_reading = nsm1_of(Bar::new(3.8, 4.0, 4.0).unwrap());
+    let two = nsm1_of(paper_second_bar(3.8, 4.0, 4.0).unwrap());
+    assert_eq!(one.len(), other_reading.len());
+    let converged = one.iter().filter(|p| p.converged).count();
+    assert!(converged >= 20, "{converged} converged");
+    for (a, b) in one.iter().zip(&other_reading) {
+        assert_eq!(a.converged, b.converged, "T = {}", a.period);
+        assert!((a.omega - b.omega).abs() <= 1e-12 * a.omega);
+        let de = (a.energy_normalized - b.energy_normalized).abs();
+        assert!(
+            de <= 1e-8 * a.energy_normalized.max(1.0),
+            "T = {}: {de:e}",
+            a.period
+        );
+        if a.converged {
+            let d = distance(&bar_unknowns(&a.x, 0), &bar_unknowns(&b.x, 0));
+            assert!(d < 1e-8, "T = {}: bar 1 differs by {d:e}", a.period);
+        }
+    }
+    let differing = one
+        .iter()
+        .zip(&two)
+        .filter(|(a, b)| a.converged && b.converged)
+        .filter(|(a, b)| (a.energy_normalized / b.energy_normalized - 1.0).abs() > 0.05)
+        .count();
+    assert!(
+        differing >= 10,
+        "{differing} points differ by more than 5 %"
+    );
+    assert!(paper_second_bar(3.8, 4.0, 0.0).is_err());
+    assert!(paper_second_bar(3.8, 4.0, f64::NAN).is_err());
+}
