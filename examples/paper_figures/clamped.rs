@@ -60,6 +60,9 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
         ("c", pick(&runs[1], 1.29, 0.05)),
         ("d", pick(&runs[2], 2.58, 0.05)),
     ];
+    for (name, p) in &picks {
+        stats.lettered(name, p.is_some());
+    }
     let mut panels = Vec::new();
     let mut marks = Vec::new();
     for ((name, p), r) in picks.into_iter().zip(&runs) {
@@ -121,7 +124,7 @@ fn arclength_nsm1(ctx: &Ctx, system: &BarSystem, m: usize, w1: f64) -> Res<Run> 
         }
     );
     Ok(Run {
-        label: format!("arclength m={m}"),
+        label: format!("NSM1 arclength m = {m}"),
         m,
         points,
         exact: Some(Exact::new(1, 1)?),
@@ -137,7 +140,7 @@ pub fn fig08(ctx: &Ctx) -> Res<Stats> {
     let mut runs = Vec::new();
     let exact = first_mode_curve()?;
     for m in [20usize, 40] {
-        let seq = nsm1(ctx, &system, "sequential", m)?;
+        let seq = nsm1(ctx, &system, &format!("NSM1 sequential m = {m}"), m)?;
         let arc = arclength_nsm1(ctx, &system, m, w1)?;
         stats.count([&seq, &arc]);
         let arc_line: Vec<(f64, f64)> = arc
@@ -155,10 +158,7 @@ pub fn fig08(ctx: &Ctx) -> Res<Stats> {
         let mut p = backbone_panel(format!("NSM1, m = {m}"), &branches, Some(&exact));
         p.y_range = Some((0.5, 400.0));
         panels.push(Panel::Lines(p));
-        runs.push(Run {
-            label: format!("sequential m={m}"),
-            ..seq
-        });
+        runs.push(seq);
         runs.push(arc);
     }
     let refs: Vec<&Run> = runs.iter().collect();

@@ -1,6 +1,7 @@
 //! What every figure group uses: the run context and its output files, the harmonic-balance
 //! settings, backbone runs, point selection and the panels built from points.
 
+use crate::summary::Item;
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
 use nonsmooth_modes::modal::diagnostics::EndHistory;
@@ -43,15 +44,25 @@ pub struct Stats {
     pub files: Vec<String>,
     /// A one-line remark for the progress line.
     pub note: String,
+    /// Its rows of `summary.csv`: branches and lettered points.
+    pub items: Vec<Item>,
 }
 
 impl Stats {
-    /// Counts the points of `runs`.
+    /// Counts the points of `runs`, each a branch row of `summary.csv`.
     pub fn count<'a>(&mut self, runs: impl IntoIterator<Item = &'a Run>) {
         for run in runs {
+            let converged = run.converged().count();
             self.points += run.points.len();
-            self.converged += run.points.iter().filter(|p| p.converged).count();
+            self.converged += converged;
+            self.items
+                .push(Item::branch(&run.label, converged, run.points.len()));
         }
+    }
+
+    /// Records whether the paper's lettered point `letter` was found.
+    pub fn lettered(&mut self, letter: &str, found: bool) {
+        self.items.push(Item::point(letter, found));
     }
 }
 

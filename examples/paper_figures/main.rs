@@ -6,7 +6,9 @@
 //!     [--only 5,7,14]
 //! ```
 //!
-//! `--out` (default `figures/`) receives `figNN_<name>.svg` and `figNN_<name>.csv`; `--quick`
+//! `--out` (default `figures/`) receives `figNN_<name>.svg` and `figNN_<name>.csv`, and
+//! `summary.csv` (`figure,item,converged,total,found`: one row per branch and per lettered
+//! point of the paper); `--quick`
 //! runs coarser grids and fewer harmonics (for CI); `--only` restricts the run to the listed
 //! figures. Progress is printed per figure, then a summary table (figure, points computed,
 //! converged, seconds, files). The gallery section of `docs/validation.md` describes every figure
@@ -24,6 +26,7 @@ mod clamped;
 mod common;
 mod residual;
 mod robin;
+mod summary;
 mod two_bar;
 
 use common::{Ctx, Res, Stats};
@@ -223,6 +226,20 @@ fn main() -> ExitCode {
         total.elapsed().as_secs_f64(),
         Path::new(&args.out).display()
     );
+    println!("{}", summary::LEGEND);
+    let figures: Vec<(&str, &[summary::Item])> = rows
+        .iter()
+        .filter_map(|r| {
+            r.result
+                .as_ref()
+                .ok()
+                .map(|s| (r.figure.as_str(), &s.items[..]))
+        })
+        .collect();
+    if let Err(e) = summary::write(&args.out, &figures) {
+        eprintln!("paper_figures: cannot write summary.csv: {e}");
+        failed += 1;
+    }
     if failed > 0 {
         ExitCode::FAILURE
     } else {

@@ -51,6 +51,9 @@ pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
         .iter()
         .filter_map(|&(t, n)| pick(&r40, t, 0.0).map(|p| (n, p)))
         .collect();
+    for (_, letter) in targets {
+        s10.lettered(letter, picks.iter().any(|(name, _)| *name == letter));
+    }
     bb.legend = LegendPosition::UpperLeft;
     let marks: Vec<&BackbonePoint> = picks.iter().map(|(_, p)| *p).collect();
     ctx.backbone_figure(
@@ -140,6 +143,7 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
     let mut panels = Vec::new();
     let mut marks = Vec::new();
     for (name, p) in [("e", e), ("d", d)] {
+        stats.lettered(name, p.is_some());
         if let Some(p) = p {
             marks.push(p);
             let title = format!("point {name}: {}", frequency_energy(p, w1));
@@ -212,6 +216,7 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     let mut marks = Vec::new();
     let mut notes = Vec::new();
     for (name, p) in [("g", g), ("f", f)] {
+        stats.lettered(name, p.is_some());
         if let Some((p, c, gr)) = p {
             marks.push(p);
             notes.push(format!("{name}: {c} contact(s), {gr} grazing(s)"));

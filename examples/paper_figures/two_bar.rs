@@ -156,6 +156,11 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     .into_iter()
     .filter_map(|(name, p)| p.map(|p| (name, p)))
     .collect();
+    // d (NSM1 with internal resonances of both bars) and g (the second NSM2 sub-branch) are
+    // not searched for yet.
+    for letter in ["b", "c", "d", "e", "f", "g"] {
+        stats.lettered(letter, picks.iter().any(|(name, _)| *name == letter));
+    }
     let marks: Vec<&BackbonePoint> = picks.iter().map(|(_, p)| *p).collect();
     let panels = named_snapshots(tb, &picks)?;
     ctx.backbone_figure(
@@ -388,9 +393,9 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
     let tb = TwoBar::new(
         (0.95, 2.0, 1.0),
         &[
-            Branch::new("family 1 (mode 1)", 1, (3.95, 3.45), ctx.steps(101)),
+            Branch::new("NSM1 (family 1)", 1, (3.95, 3.45), ctx.steps(101)),
             Branch::new(
-                "family 2 (mode 2)",
+                "NSM2 (family 2)",
                 2,
                 (2.0 * PI / w12 - 0.01, 1.45),
                 ctx.steps(91),
@@ -408,15 +413,31 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
         None,
     );
     bb.x_guides = vec![1.0, 1.13, 0.5 * w12 / w1, w12 / w1, 1.25 * w12 / w1];
-    let mut picks = Vec::new();
-    for (r, targets) in runs.iter().zip([[3.8, 3.6], [1.8, 1.6]]) {
-        picks.extend(targets.into_iter().filter_map(|t| pick(r, t, 0.0)));
+    // The paper's a and b: family 1 in the middle of [omega_1^(1), omega_1^(2)/2] and inside
+    // [omega_1^(2)/2, 1.13 omega_1^(1)], found only if the nearest converged point is inside.
+    // Its c, d and e (bar 1 in NSM6 sub5, NSM3 sub2 softening and hardening) need bar 1's
+    // harmonic content, not checked yet: the snapshots of family 2 near T = 1.8 and 1.6
+    // are drawn unlettered ("2a", "2b").
+    let half = 0.5 * w12 / w1;
+    let family1 = [("a", 1.0, half), ("b", half, 1.13)].map(|(letter, lo, hi)| {
+        let target = 2.0 * PI / (0.5 * (lo + hi) * w1);
+        let p = pick(&runs[0], target, 0.0).filter(|p| (lo..hi).contains(&(p.omega / w1)));
+        (letter, p)
+    });
+    for (letter, p) in &family1 {
+        stats.lettered(letter, p.is_some());
     }
-    bb.legend = LegendPosition::UpperLeft;
-    let named: Vec<(&str, &BackbonePoint)> = ["a", "b", "c", "d"]
+    for letter in ["c", "d", "e"] {
+        stats.lettered(letter, false);
+    }
+    let family2 = [("2a", 1.8), ("2b", 1.6)].map(|(name, t)| (name, pick(&runs[1], t, 0.0)));
+    let named: Vec<(&str, &BackbonePoint)> = family1
         .into_iter()
-        .zip(picks.iter().copied())
+        .chain(family2)
+        .filter_map(|(name, p)| p.map(|p| (name, p)))
         .collect();
+    let picks: Vec<&BackbonePoint> = named.iter().map(|(_, p)| *p).collect();
+    bb.legend = LegendPosition::UpperLeft;
     let panels = named_snapshots(&tb, &named)?;
     ctx.backbone_figure(
         &mut stats,
@@ -424,7 +445,7 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
         &Figure::new(
             "Fig. 18: two bars (0.95, 2, 1) (dashed: omega_1^(1), 1.13 omega_1^(1), omega_1^(2)/2, omega_1^(2), 1.25 omega_1^(2))",
             3,
-            marked(bb, "points a-d", &picks, w1, panels),
+            marked(bb, "points a, b; 2a, 2b", &picks, w1, panels),
         ),
         &tb.runs(),
         w1,
