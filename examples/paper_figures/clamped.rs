@@ -53,7 +53,8 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
     bb.series
         .push(reference_line("exact NSM2, NSM2 sub2", exact_nsm2));
     bb.series.push(reference_line("", exact_sub2));
-    bb.legend = LegendPosition::UpperRight;
+    // NSM2 rises in the upper right corner and NSM2 sub2 in the upper left.
+    bb.legend = LegendPosition::UpperMiddle;
     let basis = settings(m).cosine_basis()?;
     let picks = [
         ("a", pick(&runs[0], 3.6, 0.05)),

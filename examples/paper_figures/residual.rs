@@ -502,7 +502,9 @@ fn histories(title: String, t: &[f64], [u, ux, r]: [&[f64]; 3]) -> Res<Panel> {
     p.series[1].color = Some(BLUE);
     p.series[2].color = Some(RED);
     p.y_range = Some((-2.6, 1.6));
-    p.legend = LegendPosition::LowerRight;
+    p.y_label = "contact-end values / g0".into();
+    // The strain's dips fill the lower corners; the flight leaves the upper middle free.
+    p.legend = LegendPosition::UpperMiddle;
     Ok(p.into())
 }
 

@@ -210,7 +210,13 @@ pub fn fig15(ctx: &Ctx, tb: &TwoBar, points: &[BackbonePoint]) -> Res<Stats> {
                 .with_color(YELLOW)
                 .dashed(),
         ];
-        panel.legend = LegendPosition::LowerRight;
+        // Where neither panel has data: (a)'s triangle leaves the upper right free, (b)'s
+        // strain dips fill the lower corners.
+        panel.legend = if tag == "a" {
+            LegendPosition::UpperRight
+        } else {
+            LegendPosition::LowerMiddle
+        };
         panels.push(Panel::Lines(panel));
         table.push(format!("t_{tag}"), h1.time);
         for (n, c) in [

@@ -100,6 +100,8 @@ where
         LegendPosition::UpperRight => Some(SeriesLabelPosition::UpperRight),
         LegendPosition::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
         LegendPosition::LowerRight => Some(SeriesLabelPosition::LowerRight),
+        LegendPosition::UpperMiddle => Some(SeriesLabelPosition::UpperMiddle),
+        LegendPosition::LowerMiddle => Some(SeriesLabelPosition::LowerMiddle),
     };
     if let (true, Some(position)) = (any_label, position) {
         chart

@@ -151,6 +151,10 @@ pub enum LegendPosition {
     LowerLeft,
     /// Lower right corner.
     LowerRight,
+    /// Middle of the upper edge (for data in both upper corners).
+    UpperMiddle,
+    /// Middle of the lower edge.
+    LowerMiddle,
     /// No legend.
     Hidden,
 }
