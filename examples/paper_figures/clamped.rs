@@ -1,21 +1,15 @@
 //! Figs. 7-9: backbones of the clamped bar against the exact families, sequential against
 //! arclength continuation, and the internally resonant solutions of the first mode.
 
-use crate::common::{marked, settings};
+use crate::common::{arclength_run, arclength_series, marked, settings};
 use crate::common::{
     omega_1, pick, point_map, reference_line, run, series, Branch, Ctx, Exact, Res, Run, Stats,
     BLUE, GAP, GREEN, RED, YELLOW,
 };
-use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
-use nonsmooth_modes::modal::{
-    arclength_backbone, ArclengthBackboneOptions, BackbonePoint, StallEscape,
-};
+use nonsmooth_modes::modal::BackbonePoint;
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
-use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::BarSystem;
-use std::f64::consts::PI;
-use std::ops::ControlFlow;
 
 /// The exact first mode `(Omega/omega_1, E/E_g)` for `T` from 3.99 down to 3.04.
 fn first_mode_curve() -> Res<Vec<(f64, f64)>> {
@@ -88,50 +82,6 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
     Ok(stats)
 }
 
-/// The first nonsmooth mode by arclength continuation from `T = 3.95` with `m` harmonics.
-fn arclength_nsm1(ctx: &Ctx, system: &BarSystem, m: usize, w1: f64) -> Res<Run> {
-    let mut points = Vec::new();
-    let options = ArclengthBackboneOptions {
-        start_period: 3.95,
-        omega_range: (2.0 * PI / 3.96, 2.0 * PI / 3.05),
-        arclength: ArclengthOptions {
-            max_steps: if ctx.quick { 150 } else { 2000 },
-            ..Default::default()
-        },
-        escape: Some(StallEscape::default()),
-        ..Default::default()
-    };
-    let (_, branch) = arclength_backbone(
-        system,
-        settings(m),
-        &options,
-        SemismoothNewton::default(),
-        |p| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        },
-    )?;
-    let reached = points
-        .iter()
-        .map(|p| p.omega / w1)
-        .fold(f64::NEG_INFINITY, f64::max);
-    println!(
-        "    arclength m = {m}: {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
-        points.len(),
-        branch.rejections,
-        match &branch.end {
-            EndReason::ParameterOutOfRange { .. } => "range".to_string(),
-            other => format!("{other:?}"),
-        }
-    );
-    Ok(Run {
-        label: format!("NSM1 arclength m = {m}"),
-        m,
-        points,
-        exact: Some(Exact::new(1, 1)?),
-    })
-}
-
 /// Fig. 8: first NSM by sequential and arclength continuation, m = 20 and 40.
 pub fn fig08(ctx: &Ctx) -> Res<Stats> {
     let mut stats = Stats::default();
@@ -142,20 +92,10 @@ pub fn fig08(ctx: &Ctx) -> Res<Stats> {
     let exact = first_mode_curve()?;
     for m in [20usize, 40] {
         let seq = nsm1(ctx, &system, &format!("NSM1 sequential m = {m}"), m)?;
-        let arc = arclength_nsm1(ctx, &system, m, w1)?;
+        let arc = arclength_run(ctx, &system, m, (3.95, 3.05), w1)?.with_exact(Exact::new(1, 1)?);
         stats.count([&seq, &arc]);
-        let arc_line: Vec<(f64, f64)> = arc
-            .points
-            .iter()
-            .map(|p| (p.omega / w1, p.energy_normalized))
-            .collect();
-        let branches = [
-            series(&seq, w1, GREEN, Marker::Circle),
-            Series::line("arclength", arc_line)
-                .with_color(BLUE)
-                .with_marker(Marker::Circle)
-                .with_size(1),
-        ];
+        let mut branches = vec![series(&seq, w1, GREEN, Marker::Circle)];
+        branches.extend(arclength_series(&arc, w1, BLUE, true));
         let mut p = backbone_panel(format!("NSM1, m = {m}"), &branches, Some(&exact));
         p.y_range = Some((0.5, 400.0));
         panels.push(Panel::Lines(p));

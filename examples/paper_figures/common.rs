@@ -2,12 +2,13 @@
 //! settings, backbone runs, point selection and the panels built from points.
 
 use crate::summary::Item;
+use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, Event};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
 use nonsmooth_modes::modal::diagnostics::EndHistory;
 use nonsmooth_modes::modal::{
-    backbone, displacement_grid, end_history, grazing_energy, BackboneOptions, BackbonePoint,
-    PeriodGrid,
+    arclength_backbone, backbone, displacement_grid, end_history, grazing_energy,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, PeriodGrid, StallEscape,
 };
 use nonsmooth_modes::plot::{
     render_svg, space_time_panel, Figure, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
@@ -16,7 +17,9 @@ use nonsmooth_modes::plot::{
 use nonsmooth_modes::reference::ClampedFamily;
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
+use std::f64::consts::PI;
 use std::io::Write as _;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 /// Result of a figure: any error ends that figure only.
@@ -435,4 +438,83 @@ pub fn frequency_energy(p: &BackbonePoint, omega_1: f64) -> String {
         p.omega / omega_1,
         p.energy_normalized
     )
+}
+
+/// The first nonsmooth mode of `system` by arclength continuation with `m` harmonics, from
+/// `T = start` while `T` stays in `[end, start + 0.01]`, with the stall escape.
+pub fn arclength_run(
+    ctx: &Ctx,
+    system: &BarSystem,
+    m: usize,
+    (start, end): (f64, f64),
+    w1: f64,
+) -> Res<Run> {
+    let mut points = Vec::new();
+    let options = ArclengthBackboneOptions {
+        start_period: start,
+        omega_range: (2.0 * PI / (start + 0.01), 2.0 * PI / end),
+        arclength: ArclengthOptions {
+            max_steps: if ctx.quick { 150 } else { 2000 },
+            ..Default::default()
+        },
+        escape: Some(StallEscape::default()),
+        ..Default::default()
+    };
+    let (_, branch) = arclength_backbone(
+        system,
+        settings(m),
+        &options,
+        SemismoothNewton::default(),
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )?;
+    let reached = points
+        .iter()
+        .map(|p| p.omega / w1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!(
+        "    arclength m = {m}: {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
+        points.len(),
+        branch.rejections,
+        match &branch.end {
+            EndReason::ParameterOutOfRange { .. } => "range".to_string(),
+            other => format!("{other:?}"),
+        }
+    );
+    Ok(Run {
+        label: format!("NSM1 arclength m = {m}"),
+        m,
+        points,
+        exact: None,
+    })
+}
+
+/// An arclength run drawn as a line broken where the stall escape jumped (a jump is no part of
+/// the branch), with the landing points marked; with `markers`, every point as a small dot.
+pub fn arclength_series(run: &Run, w1: f64, color: Rgb, markers: bool) -> [Series; 2] {
+    let jumped = |p: &BackbonePoint| p.events.iter().any(|e| matches!(e, Event::Jump { .. }));
+    let mut line = Vec::with_capacity(run.points.len());
+    let mut jumps = Vec::new();
+    for p in &run.points {
+        let at = (p.omega / w1, p.energy_normalized);
+        if jumped(p) {
+            // A non-finite point breaks the line.
+            line.push((f64::NAN, f64::NAN));
+            jumps.push(at);
+        }
+        line.push(at);
+    }
+    let mut line = Series::line(run.label.clone(), line)
+        .with_color(color)
+        .with_size(1);
+    if markers {
+        line = line.with_marker(Marker::Circle);
+    }
+    let jumps = Series::markers("jump past a stall (lands here)", jumps)
+        .with_color(color)
+        .with_marker(Marker::Cross)
+        .with_size(5);
+    [line, jumps]
 }

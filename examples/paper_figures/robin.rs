@@ -2,11 +2,11 @@
 //! fields, second mode, and the third subharmonic of the second mode.
 
 use crate::common::{
-    field, frequency_energy, map_panel, marked, omega_1, pick, point_map, run, series, settings,
-    Branch, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_run, arclength_series, field, frequency_energy, map_panel, marked, omega_1, pick,
+    point_map, run, series, settings, Branch, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use nonsmooth_modes::modal::{law_history, BackbonePoint};
-use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker};
+use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
@@ -31,15 +31,16 @@ pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
         )
     };
     let (r20, r40) = (nsm1(20)?, nsm1(40)?);
-    s10.count([&r20, &r40]);
-    let mut bb = backbone_panel(
-        "Robin bar (k = 0.5): NSM1",
-        &[
-            series(&r20, w1, GREEN, Marker::Circle),
-            series(&r40, w1, BLUE, Marker::Triangle).with_size(2),
-        ],
-        None,
-    );
+    // Arclength at m = 40 fills the interval before omega_2/4 (1.211 to 1.259) where the
+    // sequential run converges one point: the paper's remark on its Fig. 10.
+    let arc = arclength_run(ctx, &system, 40, (9.5, 6.0), w1)?;
+    s10.count([&r20, &r40, &arc]);
+    let mut branches = vec![
+        series(&r20, w1, GREEN, Marker::Circle),
+        series(&r40, w1, BLUE, Marker::Triangle).with_size(2),
+    ];
+    branches.extend(arclength_series(&arc, w1, PALETTE[4], false));
+    let mut bb = backbone_panel("Robin bar (k = 0.5): NSM1", &branches, None);
     bb.x_guides = vec![OMEGA_2 / 4.0 / w1];
     // Points a, b, c on the m = 40 branch: low energy, around omega_2/4, high energy.
     let targets = [
@@ -64,7 +65,7 @@ pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
             1,
             marked(bb, "points a, b, c (m = 40)", &marks, w1, Vec::new()),
         ),
-        &[&r20, &r40],
+        &[&r20, &r40, &arc],
         w1,
     )?;
 
