@@ -310,8 +310,12 @@ pub fn fig04(ctx: &Ctx) -> Res<Stats> {
     );
     let mut table = Table::default();
     let mut time = Vec::new();
+    let mut penetrations = Vec::new();
     for (&m, color) in ms.iter().zip([RED, BLUE]) {
         let [t, u, _, res] = clamped_histories(ctx, &mut stats, m, period)?;
+        // u is in units of g0: the obstacle is at 1.
+        let most = u.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b)) - 1.0;
+        penetrations.push(format!("m = {m}: {:.2} % of g0", 100.0 * most.max(0.0)));
         disp.series
             .push(Series::from_columns(format!("m = {m}"), &t, &u).with_color(color));
         comp.series
@@ -330,13 +334,24 @@ pub fn fig04(ctx: &Ctx) -> Res<Stats> {
     }
     disp.y_guides = vec![1.0];
     disp.legend = LegendPosition::LowerRight;
-    comp.legend = LegendPosition::UpperRight;
+    // The residual peaks at contact closing and opening fill the upper corners.
+    comp.legend = LegendPosition::LowerMiddle;
+    // The contact plateau magnified: the truncated motions penetrate the obstacle slightly.
+    let mut zoom = disp.clone();
+    zoom.title = format!(
+        "contact plateau, zoom (penetration {})",
+        penetrations.join(", ")
+    );
+    zoom.x_range = Some((0.0, 0.4));
+    zoom.y_range = Some((0.985, 1.015));
+    zoom.legend = LegendPosition::LowerLeft;
+    stats.note = format!("largest penetration {}", penetrations.join(", "));
     table.push("u_over_g0_exact", ue);
     table.push_front("t", time);
     let figure = Figure::new(
         format!("Fig. 4: Signorini condition at T = {period}, exact vs FD-BEM"),
-        2,
-        vec![disp.into(), comp.into()],
+        3,
+        vec![disp.into(), zoom.into(), comp.into()],
     );
     ctx.svg(&mut stats, "fig04_signorini.svg", &figure)?;
     ctx.table(&mut stats, "fig04_signorini.csv", &table)?;
