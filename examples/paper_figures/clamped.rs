@@ -6,10 +6,12 @@ use crate::common::{
     omega_1, pick, point_map, reference_line, run, series, Branch, Ctx, Exact, Res, Run, Stats,
     BLUE, GAP, GREEN, RED, YELLOW,
 };
-use nonsmooth_modes::modal::BackbonePoint;
+use nonsmooth_modes::fourier::CosineBasis;
+use nonsmooth_modes::modal::{harmonic_energies, BackbonePoint};
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::system::BarSystem;
+use std::f64::consts::PI;
 
 /// The exact first mode `(Omega/omega_1, E/E_g)` for `T` from 3.99 down to 3.04.
 fn first_mode_curve() -> Res<Vec<(f64, f64)>> {
@@ -132,6 +134,20 @@ fn spikes(run: &Run, exact: Exact) -> Vec<&BackbonePoint> {
     spikes
 }
 
+/// The internal resonance of a spike point `p` of NSM1: the harmonic `n > 1` carrying the most
+/// energy, and the clamped-free mode `j` whose frequency `(2j - 1) pi / 2` is nearest to
+/// `n Omega`.
+fn resonance(system: &BarSystem, basis: &CosineBasis, p: &BackbonePoint) -> Res<(usize, usize)> {
+    let energies = harmonic_energies(system, basis, &p.x, p.omega)?;
+    let n = (2..energies.len())
+        .max_by(|&a, &b| energies[a].total_cmp(&energies[b]))
+        .unwrap_or(1);
+    let j = ((n as f64 * p.omega / (PI / 2.0) + 1.0) / 2.0)
+        .round()
+        .max(1.0) as usize;
+    Ok((n, j))
+}
+
 /// Fig. 9: internally resonant solutions of the first NSM with m = 40 (points on spikes).
 pub fn fig09(ctx: &Ctx) -> Res<Stats> {
     let mut stats = Stats::default();
@@ -152,11 +168,14 @@ pub fn fig09(ctx: &Ctx) -> Res<Stats> {
     let mut panels = Vec::new();
     let mut notes = Vec::new();
     for (p, name) in spikes.iter().zip(["a", "b", "c"]) {
-        notes.push(format!("{name}: T={:.3} x{:.2}", p.period, ratio(p)));
-        let title = format!(
-            "({name}) T = {:.3}, Omega/omega_1 = {:.3}, E/E_exact = {:.2}",
+        let (n, j) = resonance(&system, &basis, p)?;
+        notes.push(format!(
+            "{name}: T={:.3} x{:.2}, NSM1 with NSM{j} (harmonic {n})",
             p.period,
-            p.omega / w1,
+            ratio(p)
+        ));
+        let title = format!(
+            "({name}) NSM1 with NSM{j} ({n} Omega ~ omega_{j}), E/E_exact {:.2}",
             ratio(p)
         );
         panels.push(point_map(&system, &basis, p, 80, title)?);
