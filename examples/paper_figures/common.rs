@@ -248,6 +248,31 @@ impl Run {
     pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
         self.points.iter().filter(|p| p.converged)
     }
+
+    /// The run up to the end of its branch, and the rest labelled `beyond`: the branch ends
+    /// at its last converged point before the first `gap` steps in a row that did not
+    /// converge (failed, or slid to rest).
+    pub fn split_at_end(&self, gap: usize, beyond: &str) -> (Run, Run) {
+        let mut end = self.points.len();
+        let mut misses = 0;
+        for (i, p) in self.points.iter().enumerate() {
+            misses = if p.converged { 0 } else { misses + 1 };
+            if misses == gap {
+                end = i + 1 - gap;
+                break;
+            }
+        }
+        let part = |label: &str, points: &[BackbonePoint]| Run {
+            label: label.to_string(),
+            m: self.m,
+            points: points.to_vec(),
+            exact: self.exact,
+        };
+        (
+            part(&self.label, &self.points[..end]),
+            part(beyond, &self.points[end..]),
+        )
+    }
 }
 
 /// What to continue: mode and subharmonic of the seed, and the period grid.

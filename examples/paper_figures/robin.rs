@@ -118,14 +118,21 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
         m,
         &Branch::new("NSM2", 2, (1.90, 1.45), ctx.steps(91)),
     )?;
-    stats.count([&r]);
+    // The continuation loses the branch where its energy blows up (it slides to rest at the
+    // next steps); the converged points after that are isolated solutions, drawn apart.
+    let (branch, beyond) = r.split_at_end(END_GAP, "NSM2 past its end (isolated)");
+    stats.count([&branch, &beyond]);
     let mut bb = backbone_panel(
         "Robin bar: NSM2, m = 20",
-        &[series(&r, w1, RED, Marker::Circle)],
+        &[
+            series(&branch, w1, RED, Marker::Circle),
+            series(&beyond, w1, RED, Marker::Ring),
+        ],
         None,
     );
-    let conv: Vec<&BackbonePoint> = r.converged().collect();
-    // e: low energy; d: the largest local excess over its neighbours (internal resonance).
+    // e: low energy; d: the largest local excess over its neighbours (an internal resonance)
+    // along the first unbroken run of converged steps, below the blow-up.
+    let conv: Vec<&BackbonePoint> = branch.points.iter().take_while(|p| p.converged).collect();
     let e = conv
         .iter()
         .find(|p| p.period < 1.86)
@@ -161,11 +168,16 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
             3,
             marked(bb, "points e, d", &marks, w1, panels),
         ),
-        &[&r],
+        &[&branch, &beyond],
         w1,
     )?;
     Ok(stats)
 }
+
+/// Consecutive steps without a converged point after which a backbone of these figures counts
+/// as ended (sequential runs visit the whole grid; beyond its end they find only isolated
+/// solutions).
+const END_GAP: usize = 3;
 
 /// Number of separate contact intervals per period (force above 2% of its maximum) and of
 /// near-grazings (gap minima below 5% of g0 without contact).
