@@ -7,8 +7,9 @@ use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
 use nonsmooth_modes::modal::diagnostics::EndHistory;
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, displacement_grid, end_history, grazing_energy,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, PeriodGrid, StallEscape,
+    arclength_backbone, backbone, displacement_grid, end_history, energy_backbone, grazing_energy,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
+    PeriodGrid, StallEscape,
 };
 use nonsmooth_modes::plot::{
     render_svg, space_time_panel, Figure, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
@@ -308,6 +309,30 @@ impl<'a> Branch<'a> {
             ..self
         }
     }
+}
+
+/// NSM `mode` of `system` with `m` harmonics, continued in the energy level from the mode's
+/// own grazing energy to 300 times it ([`EnergyGrid::for_mode`]).
+pub fn energy_run(system: &BarSystem, m: usize, label: &str, mode: usize) -> Res<Run> {
+    let options = EnergyBackboneOptions {
+        levels: EnergyGrid::for_mode(system, mode)?,
+        mode,
+        ..Default::default()
+    };
+    let points = energy_backbone(system, settings(m), &options, SemismoothNewton::default())?;
+    let ok = points.iter().filter(|p| p.converged).count();
+    println!(
+        "    {label:<28} m = {m:<3} E/E_g {:.3} -> {:.3}: {ok}/{} converged",
+        options.levels.start,
+        options.levels.end,
+        points.len()
+    );
+    Ok(Run {
+        label: label.to_string(),
+        m,
+        points: points.points,
+        exact: None,
+    })
 }
 
 /// Follows `branch` of `system` with `m` harmonics, visiting the whole grid.

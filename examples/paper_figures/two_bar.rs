@@ -4,8 +4,9 @@
 //! interface, and a time-domain check of one point.
 
 use crate::common::{
-    field, frequency_energy, marked, omega_1, over_gap, pick, reference_line, right_end, run,
-    series, settings, Branch, Ctx, Res, Run, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
+    energy_run, field, frequency_energy, marked, omega_1, over_gap, pick, reference_line,
+    right_end, run, series, settings, Branch, Ctx, Res, Run, Stats, Table, BLUE, GAP, GREEN, RED,
+    YELLOW,
 };
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{law_history, BackbonePoint};
@@ -55,9 +56,16 @@ impl TwoBar {
         let branches = [
             nsm1(ctx),
             Branch::new("NSM2 (bar 1)", 3, (1.33, 1.05), ctx.steps(141)),
-            Branch::new("NSM2 (bar 2)", 4, (1.26, 1.0), ctx.steps(131)),
         ];
-        Self::new((0.95, 1.0, 1.0), &branches)
+        Self::new((0.95, 1.0, 1.0), &branches)?.with_nsm2_of_bar_2()
+    }
+
+    /// The system with NSM2 of bar 2 (system mode 4) added, continued in the energy: a period
+    /// grid started at its linear period slides to rest at every step.
+    fn with_nsm2_of_bar_2(mut self) -> Res<Self> {
+        let run = energy_run(&self.system, M, "NSM2 (bar 2)", 4)?;
+        self.runs.push(run);
+        Ok(self)
     }
 
     fn runs(&self) -> Vec<&Run> {
@@ -134,9 +142,12 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     let mut bb = backbone_panel("(0.95, 1, 1): backbones, m = 20", &branches, None);
     let w12 = OMEGA_1_BAR_2;
     bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1, 3.0];
-    bb.legend = LegendPosition::UpperLeft;
+    // NSM1 fills the upper left corner and NSM2 the upper right.
+    bb.legend = LegendPosition::UpperMiddle;
     let conv: Vec<&BackbonePoint> = tb.runs[0].converged().collect();
-    // b, c, e: NSM1 points nearest Omega/omega_1 = 1.07, 1.2, 1.33; f: NSM2 (bar 1).
+    // b, c, d, e: NSM1 points nearest Omega/omega_1 = 1.07, 1.2, 1.27, 1.33 (the paper's
+    // NSM1 panels, in frequency order); f: the first NSM2 sub-branch (bar 1's mode), g: the
+    // second (bar 2's), at the median energy of its converged points.
     let near = |target: f64| {
         conv.iter()
             .min_by(|x, y| {
@@ -147,17 +158,22 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
             .copied()
     };
     let f = tb.runs.get(1).and_then(|r| r.converged().nth(5));
+    let g = tb.runs.get(2).and_then(|r| {
+        let mut on: Vec<&BackbonePoint> = r.converged().collect();
+        on.sort_by(|x, y| x.energy_normalized.total_cmp(&y.energy_normalized));
+        on.get(on.len() / 2).copied()
+    });
     let picks: Vec<(&str, &BackbonePoint)> = [
         ("b", near(1.07)),
         ("c", near(1.2)),
+        ("d", near(1.27)),
         ("e", near(1.33)),
         ("f", f),
+        ("g", g),
     ]
     .into_iter()
     .filter_map(|(name, p)| p.map(|p| (name, p)))
     .collect();
-    // d (NSM1 with internal resonances of both bars) and g (the second NSM2 sub-branch) are
-    // not searched for yet.
     for letter in ["b", "c", "d", "e", "f", "g"] {
         stats.lettered(letter, picks.iter().any(|(name, _)| *name == letter));
     }
@@ -169,7 +185,7 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
         &Figure::new(
             "Fig. 14: two bars (l, c, alpha) = (0.95, 1, 1) (dashed: omega_1^(2), 4/3 omega_1^(2), omega_2^(1))",
             3,
-            marked(bb, "points b, c, e, f", &marks, tb.w1, panels),
+            marked(bb, "points b-g", &marks, tb.w1, panels),
         ),
         &tb.runs(),
         tb.w1,
@@ -352,11 +368,14 @@ pub fn fig17(ctx: &Ctx) -> Res<Stats> {
     // From T = 3.95 the grazing seed of this system slides to rest (bar 2, four times softer,
     // takes the motion); from 3.9 it starts on the branch.
     let nsm1 = Branch::new("NSM1", 1, (3.9, 2.85), ctx.steps(221));
-    let tb = TwoBar::new((3.8, 4.0, 4.0), &[nsm1])?;
+    let tb = TwoBar::new((3.8, 4.0, 4.0), &[nsm1])?.with_nsm2_of_bar_2()?;
     stats.count(&tb.runs);
     let mut bb = backbone_panel(
-        "(3.8, 4, 4), alpha = E1A1/(E2A2): NSM1, m = 20",
-        &[series(&tb.runs[0], tb.w1, GREEN, Marker::Circle)],
+        "(3.8, 4, 4), alpha = E1A1/(E2A2): NSM1 and NSM2, m = 20",
+        &[
+            series(&tb.runs[0], tb.w1, GREEN, Marker::Circle),
+            series(&tb.runs[1], tb.w1, RED, Marker::Circle),
+        ],
         None,
     );
     let w12 = OMEGA_1_BAR_2;
