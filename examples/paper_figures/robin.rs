@@ -3,13 +3,17 @@
 
 use crate::common::{
     arclength_run, arclength_series, field, frequency_energy, map_panel, marked, omega_1, pick,
-    point_map, run, series, settings, Branch, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+    point_map, run, series, settings, Branch, Ctx, Res, Run, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
-use nonsmooth_modes::modal::{law_history, BackbonePoint};
+use nonsmooth_modes::modal::{
+    genuine_subharmonic_backbone_with, law_history, BackboneOptions, BackbonePoint, PeriodGrid,
+};
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 
 /// Ground spring stiffness `k_s` of the paper's Robin bar.
 const ROBIN_K: f64 = 0.5;
@@ -179,23 +183,47 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
 /// solutions).
 const END_GAP: usize = 3;
 
-/// Number of separate contact intervals per period (force above 2% of its maximum) and of
-/// near-grazings (gap minima below 5% of g0 without contact).
-fn contact_count(system: &BarSystem, m: usize, p: &BackbonePoint) -> Res<(usize, usize)> {
+/// Impulse shares below which a third of the period counts as a grazing, and above which as a
+/// contact (of the largest third's impulse).
+const GRAZING_SHARE: f64 = 0.05;
+const CONTACT_SHARE: f64 = 0.2;
+
+/// The contacts and grazings of a sub3 motion: its period in three thirds (from the sample of
+/// least contact force), each a contact when its impulse is at least [`CONTACT_SHARE`] of the
+/// largest third's, a grazing when it is below [`GRAZING_SHARE`] while the gap closes to within
+/// 5 % of `g0`; `None` when a third is neither.
+fn contacts_and_grazings(
+    system: &BarSystem,
+    m: usize,
+    p: &BackbonePoint,
+) -> Res<Option<(usize, usize)>> {
     let problem = NonsmoothSystem::new(system, settings(m))?;
-    let h = law_history(&problem, &p.x, p.omega, 0, 1200)?;
-    let fmax = h.force.iter().cloned().fold(0.0, f64::max);
-    let on: Vec<bool> = h.force.iter().map(|&f| f > 0.02 * fmax).collect();
-    let n = on.len();
-    let contacts = (0..n).filter(|&k| on[k] && !on[(k + n - 1) % n]).count();
-    let mut grazings = 0;
-    for (k, &contact) in on.iter().enumerate() {
-        let (a, b, c) = (h.gap[(k + n - 1) % n], h.gap[k], h.gap[(k + 1) % n]);
-        if b < a && b <= c && b < 0.05 * GAP && !contact {
+    let n = 1200;
+    let h = law_history(&problem, &p.x, p.omega, 0, n)?;
+    let k0 = (0..n)
+        .min_by(|&a, &b| h.force[a].total_cmp(&h.force[b]))
+        .unwrap_or(0);
+    let (mut impulse, mut closest) = ([0.0_f64; 3], [f64::INFINITY; 3]);
+    for j in 0..n {
+        let (k, third) = ((k0 + j) % n, 3 * j / n);
+        impulse[third] += h.force[k].max(0.0);
+        closest[third] = closest[third].min(h.gap[k]);
+    }
+    let largest = impulse.iter().copied().fold(0.0, f64::max);
+    if largest <= 0.0 {
+        return Ok(None);
+    }
+    let (mut contacts, mut grazings) = (0, 0);
+    for (i, c) in impulse.iter().zip(closest) {
+        if *i >= CONTACT_SHARE * largest {
+            contacts += 1;
+        } else if *i < GRAZING_SHARE * largest && c < 0.05 * GAP {
             grazings += 1;
+        } else {
+            return Ok(None);
         }
     }
-    Ok((contacts, grazings))
+    Ok(Some((contacts, grazings)))
 }
 
 /// Fig. 13: Robin bar NSM2 sub3 with m = 60, and points with one or two contacts.
@@ -205,23 +233,55 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     let w1 = omega_1(&system)?;
     let m = if ctx.quick { 40 } else { 60 };
     let t3 = 3.0 * 2.0 * PI / OMEGA_2;
-    let branch = Branch::new("NSM2 sub3", 2, (t3 - 0.02, 4.6), ctx.steps(113)).subharmonic(3);
-    let r = run(&system, m, &branch)?;
+    // The repeated branch (NSM2 traced three times) has three equal contacts; g and f lie on
+    // the genuinely T-periodic branch that leaves it.
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: t3 - 0.02,
+            end: 4.6,
+            steps: ctx.steps(113),
+        },
+        mode: 2,
+        subharmonic: 3,
+        max_consecutive_failures: usize::MAX,
+        ..Default::default()
+    };
+    let mut points = Vec::new();
+    genuine_subharmonic_backbone_with(
+        &system,
+        settings(m),
+        &options,
+        SemismoothNewton::new(NewtonOptions::fail_fast())?,
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )?;
+    let r = Run {
+        label: "NSM2 sub3".into(),
+        m,
+        points,
+        exact: None,
+    };
+    println!(
+        "    NSM2 sub3 (genuine)          m = {m:<3}: {}/{} converged",
+        r.converged().count(),
+        r.points.len()
+    );
     stats.count([&r]);
     let bb = backbone_panel(
         format!("Robin bar: NSM2 sub3, m = {m}"),
         &[series(&r, w1, YELLOW, Marker::Circle)],
         None,
     );
+    // g: one contact and two grazings per period; f: two contacts and one grazing.
     let mut g = None;
     let mut f = None;
     for p in r.converged() {
-        let (c, gr) = contact_count(&system, m, p)?;
-        if c == 1 && g.is_none() && gr >= 1 {
-            g = Some((p, c, gr));
-        }
-        if c == 2 && f.is_none() {
-            f = Some((p, c, gr));
+        match contacts_and_grazings(&system, m, p)? {
+            Some((1, 2)) if g.is_none() => g = Some((p, 1, 2)),
+            Some((2, 1)) if f.is_none() => f = Some((p, 2, 1)),
+            _ => {}
         }
     }
     let basis = settings(m).cosine_basis()?;
@@ -234,7 +294,7 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
             marks.push(p);
             notes.push(format!("{name}: {c} contact(s), {gr} grazing(s)"));
             let title = format!(
-                "point {name}: {c} contact(s), {gr} near-grazing(s), Omega/omega_1 = {:.3}",
+                "point {name}: {c} contact(s), {gr} grazing(s), Omega/omega_1 = {:.3}",
                 p.omega / w1
             );
             panels.push(point_map(&system, &basis, p, 90, title)?);
