@@ -140,6 +140,11 @@ impl Metric {
         self.x_w.get(i).copied().unwrap_or(self.lambda_w)
     }
 
+    /// `<a, b>_W`.
+    pub(super) fn dot(&self, a: &[f64], b: &[f64]) -> f64 {
+        (0..a.len()).map(|i| a[i] * b[i] * self.weight(i)).sum()
+    }
+
     /// `<a, b - c>_W`.
     pub(super) fn dot_diff(&self, a: &[f64], b: &[f64], c: &[f64]) -> f64 {
         (0..a.len())

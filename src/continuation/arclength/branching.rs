@@ -71,7 +71,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         let lu = Lu::factor(&matrix, 0.0).ok()?;
         let metric = &self.metric;
         let orthogonal = |v: &mut Vec<f64>| {
-            let along = metric.dot_diff(tangent, v, &vec![0.0; v.len()]);
+            let along = metric.dot(tangent, v);
             v.iter_mut().zip(tangent).for_each(|(a, t)| *a -= along * t);
             let len = metric.norm(v);
             (len.is_finite() && len > 0.0).then(|| v.iter_mut().for_each(|a| *a /= len))
