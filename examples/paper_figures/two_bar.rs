@@ -9,7 +9,7 @@ use crate::common::{
     YELLOW,
 };
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{law_history, BackbonePoint};
+use nonsmooth_modes::modal::{harmonic_energies_by_bar, law_history, BackbonePoint};
 use nonsmooth_modes::plot::{
     backbone_panel, snapshots_panel, Figure, LegendPosition, LinePanel, Marker, Panel, PlacedBar,
     Placement, Rgb, Series, SpaceTimeField, PALETTE,
@@ -411,6 +411,36 @@ pub fn fig17(ctx: &Ctx) -> Res<Stats> {
     Ok(stats)
 }
 
+/// Bar 1's subharmonic motion in a family-2 point of configuration 3, where bar 2 moves in its
+/// NSM1: `(n, j)` for bar 1 in NSM`j` sub`n`, i.e. its harmonic `n > 1` carrying the most of
+/// its energy (at least half of the most any of its harmonics carries) near its clamped-free
+/// mode `j` (`n Omega` within 5 % of `(2j - 1) pi / 2`); `None` when bar 2 is not in NSM1 (its
+/// harmonic 1 not its largest) or bar 1 has no such harmonic.
+fn subharmonic_of_bar_1(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    p: &BackbonePoint,
+) -> Res<Option<(usize, usize)>> {
+    let by_bar = harmonic_energies_by_bar(system, basis, &p.x, p.omega)?;
+    let largest = |e: &[f64], from: usize| {
+        (from..e.len())
+            .max_by(|&a, &b| e[a].total_cmp(&e[b]))
+            .unwrap_or(from)
+    };
+    let (bar1, bar2) = (&by_bar[0], &by_bar[1]);
+    if largest(bar2, 1) != 1 {
+        return Ok(None);
+    }
+    let n = largest(bar1, 2);
+    let most = bar1.iter().copied().fold(0.0, f64::max);
+    let j = ((n as f64 * p.omega / (PI / 2.0) + 1.0) / 2.0)
+        .round()
+        .max(1.0) as usize;
+    let mode = (2 * j - 1) as f64 * PI / 2.0;
+    let near = (n as f64 * p.omega / mode - 1.0).abs() < 0.05;
+    Ok((bar1[n] >= 0.5 * most && near).then_some((n, j)))
+}
+
 /// Fig. 18: configuration 3 (0.95, 2, 1): the two families and a few fields.
 pub fn fig18(ctx: &Ctx) -> Res<Stats> {
     let mut stats = Stats::default();
@@ -440,9 +470,8 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
     bb.x_guides = vec![1.0, 1.13, 0.5 * w12 / w1, w12 / w1, 1.25 * w12 / w1];
     // The paper's a and b: family 1 in the middle of [omega_1^(1), omega_1^(2)/2] and inside
     // [omega_1^(2)/2, 1.13 omega_1^(1)], found only if the nearest converged point is inside.
-    // Its c, d and e (bar 1 in NSM6 sub5, NSM3 sub2 softening and hardening) need bar 1's
-    // harmonic content, not checked yet: the snapshots of family 2 near T = 1.8 and 1.6
-    // are drawn unlettered ("2a", "2b").
+    // Its c, d and e are family-2 points with bar 2 in NSM1 and bar 1 in NSM6 sub5, NSM3 sub2
+    // below (softening) and above (hardening) omega_3^(1)/2 (`subharmonic_of_bar_1`).
     let half = 0.5 * w12 / w1;
     let family1 = [("a", 1.0, half), ("b", half, 1.13)].map(|(letter, lo, hi)| {
         let target = 2.0 * PI / (0.5 * (lo + hi) * w1);
@@ -452,10 +481,34 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
     for (letter, p) in &family1 {
         stats.lettered(letter, p.is_some());
     }
-    for letter in ["c", "d", "e"] {
-        stats.lettered(letter, false);
+    let basis = settings(M).cosine_basis()?;
+    let mut classified = Vec::new();
+    for p in runs[1].converged() {
+        if let Some(nj) = subharmonic_of_bar_1(&tb.system, &basis, p)? {
+            classified.push((p, nj));
+        }
     }
-    let family2 = [("2a", 1.8), ("2b", 1.6)].map(|(name, t)| (name, pick(&runs[1], t, 0.0)));
+    // The point of NSM`j` sub`n` in bar 1 nearest `omega_j / n`, on the side `side` of it.
+    let nearest = |(n, j): (usize, usize), side: f64| {
+        let centre = (2 * j - 1) as f64 * PI / 2.0 / n as f64;
+        classified
+            .iter()
+            .filter(|(p, nj)| *nj == (n, j) && (p.omega - centre) * side >= 0.0)
+            .min_by(|a, b| {
+                (a.0.omega - centre)
+                    .abs()
+                    .total_cmp(&(b.0.omega - centre).abs())
+            })
+            .map(|(p, _)| *p)
+    };
+    let family2 = [
+        ("c", nearest((5, 6), 1.0).or(nearest((5, 6), -1.0))),
+        ("d", nearest((2, 3), -1.0)),
+        ("e", nearest((2, 3), 1.0)),
+    ];
+    for (letter, p) in &family2 {
+        stats.lettered(letter, p.is_some());
+    }
     let named: Vec<(&str, &BackbonePoint)> = family1
         .into_iter()
         .chain(family2)
@@ -470,7 +523,7 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
         &Figure::new(
             "Fig. 18: two bars (0.95, 2, 1) (dashed: omega_1^(1), 1.13 omega_1^(1), omega_1^(2)/2, omega_1^(2), 1.25 omega_1^(2))",
             3,
-            marked(bb, "points a, b; 2a, 2b", &picks, w1, panels),
+            marked(bb, "points a-e", &picks, w1, panels),
         ),
         &tb.runs(),
         w1,

@@ -40,7 +40,9 @@ pub use linear::{
 };
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
-pub use signature::{contact_intervals, harmonic_energies, subharmonic_share};
+pub use signature::{
+    contact_intervals, harmonic_energies, harmonic_energies_by_bar, subharmonic_share,
+};
 pub use start::{
     FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
 };

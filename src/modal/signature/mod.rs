@@ -33,7 +33,8 @@ use crate::system::{BarSystem, Layout, NonsmoothSystem};
 ///                                           + (Omega/c_b)^2 <phi_i' phi_j'> int u_i u_j dx ),
 /// ```
 ///
-/// the time-averaged energy of harmonic `n` moving alone. For the cosine basis
+/// the time-averaged energy of harmonic `n` moving alone (bar by bar:
+/// [`harmonic_energies_by_bar`]). For the cosine basis
 /// (`phi_n = cos(n theta)`, `phi_0 = 1/2`) this is
 /// `EA/4 (int u_n'^2 dx + (n Omega/c)^2 int u_n^2 dx)` for `n >= 1` and `EA/8 int u_0'^2 dx`
 /// for the constant (`EA/2 int (u_0/2)'^2`: the constant function is `1/2`). The space
@@ -66,6 +67,26 @@ pub fn harmonic_energies<B: Basis>(
     x: &[f64],
     omega: f64,
 ) -> Result<Vec<f64>, SettingsError> {
+    let by_bar = harmonic_energies_by_bar(system, basis, x, omega)?;
+    let mut energies = vec![0.0; basis.harmonics() + 1];
+    for bar in &by_bar {
+        energies.iter_mut().zip(bar).for_each(|(e, b)| *e += b);
+    }
+    Ok(energies)
+}
+
+/// The energies of [`harmonic_energies`] bar by bar: entry `[b][n]` is bar `b`'s share of
+/// `E_n` (the sum over `b` is `E_n`). What identifies a motion in an assembly is often one
+/// bar's harmonic content (bar 1 in its sixth mode on harmonic 5 while bar 2 is in its first).
+///
+/// # Errors
+/// Those of [`harmonic_energies`].
+pub fn harmonic_energies_by_bar<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+) -> Result<Vec<Vec<f64>>, SettingsError> {
     check_length(x, basis.len() * system.unknowns_per_harmonic())?;
     check_frequency(omega)?;
     check_unknowns_finite(x)?;
@@ -83,7 +104,7 @@ pub fn harmonic_energies<B: Basis>(
         groups[n].push(i);
     }
     let layout = Layout::of(system);
-    let mut energies = vec![0.0; m + 1];
+    let mut energies = vec![vec![0.0; m + 1]; system.bars().len()];
     for (n, group) in groups.iter().enumerate() {
         // `<phi_i phi_j> = (c_i c_j + s_i s_j) / 2` for `n >= 1`, `c_i c_j` for `n = 0`;
         // `<phi_i' phi_j'> = n^2 <phi_i phi_j>`.
@@ -100,11 +121,12 @@ pub fn harmonic_energies<B: Basis>(
                     sum += average * (int_dd + k * k * int_uu);
                 }
             }
-            energies[n] += 0.5 * bar.stiffness() * sum;
+            energies[b][n] = (0.5 * bar.stiffness() * sum).max(0.0);
         }
-        energies[n] = energies[n].max(0.0);
     }
-    check_finite("a harmonic's energy", omega, &energies)?;
+    for bar in &energies {
+        check_finite("a harmonic's energy", omega, bar)?;
+    }
     Ok(energies)
 }
 

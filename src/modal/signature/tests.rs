@@ -79,6 +79,32 @@ fn harmonic_energies_sum_to_the_time_averaged_energy() {
     }
 }
 
+/// Bar by bar, the harmonic energies add up to the system's, and a bar at rest carries none:
+/// with bar 2's unknowns zeroed, bar 1 carries all of them.
+#[test]
+fn harmonic_energies_split_by_bar() {
+    let (_, basis, _, omega) = clamped_exact();
+    let second = Bar::new(0.8, 1.3, 2.5).unwrap();
+    let two = two_bars_in_contact(second, 1e-3).unwrap();
+    let mut x: Vec<f64> = (0..basis.len() * 4)
+        .map(|i| 1e-4 * (((7 * i) % 11) as f64 - 5.0))
+        .collect();
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300);
+    let total = harmonic_energies(&two, &basis, &x, omega).unwrap();
+    let by_bar = harmonic_energies_by_bar(&two, &basis, &x, omega).unwrap();
+    assert_eq!(by_bar.len(), 2);
+    for (n, e) in total.iter().enumerate() {
+        assert!(close(by_bar[0][n] + by_bar[1][n], *e), "harmonic {n}");
+    }
+    assert!(by_bar[1].iter().sum::<f64>() > 0.0);
+    // Unknowns per harmonic: bar 1's (A, B), then bar 2's.
+    x.chunks_mut(4).for_each(|c| (c[2], c[3]) = (0.0, 0.0));
+    let by_bar = harmonic_energies_by_bar(&two, &basis, &x, omega).unwrap();
+    let total = harmonic_energies(&two, &basis, &x, omega).unwrap();
+    assert!(by_bar[1].iter().all(|e| *e == 0.0));
+    assert!(by_bar[0].iter().zip(&total).all(|(a, b)| close(*a, *b)));
+}
+
 #[test]
 fn share_is_zero_on_multiples_of_k_and_one_off_them() {
     let (system, basis, x, omega) = clamped_exact();
