@@ -94,7 +94,9 @@ pub fn fig08(ctx: &Ctx) -> Res<Stats> {
     let exact = first_mode_curve()?;
     for m in [20usize, 40] {
         let seq = nsm1(ctx, &system, &format!("NSM1 sequential m = {m}"), m)?;
-        let arc = arclength_run(ctx, &system, m, (3.95, 3.05), w1)?.with_exact(Exact::new(1, 1)?);
+        let label = format!("NSM1 arclength m = {m}");
+        let branch = Branch::new(&label, 1, (3.95, 3.05), 0);
+        let arc = arclength_run(ctx, &system, m, &branch, w1)?.with_exact(Exact::new(1, 1)?);
         stats.count([&seq, &arc]);
         let mut branches = vec![series(&seq, w1, GREEN, Marker::Circle)];
         branches.extend(arclength_series(&arc, w1, BLUE, true));

@@ -490,15 +490,17 @@ pub fn frequency_energy(p: &BackbonePoint, omega_1: f64) -> String {
     )
 }
 
-/// The first nonsmooth mode of `system` by arclength continuation with `m` harmonics, from
-/// `T = start` while `T` stays in `[end, start + 0.01]`, with the stall escape.
+/// `branch` of `system` (its label, mode and periods; not its steps) by arclength
+/// continuation with `m` harmonics, from `T = start` while `T` stays in `[end, start + 0.01]`,
+/// with the stall escape.
 pub fn arclength_run(
     ctx: &Ctx,
     system: &BarSystem,
     m: usize,
-    (start, end): (f64, f64),
+    branch: &Branch<'_>,
     w1: f64,
 ) -> Res<Run> {
+    let (start, end) = branch.periods;
     let mut points = Vec::new();
     let options = ArclengthBackboneOptions {
         start_period: start,
@@ -508,8 +510,11 @@ pub fn arclength_run(
             ..Default::default()
         },
         escape: Some(StallEscape::default()),
+        mode: branch.mode,
+        subharmonic: branch.subharmonic,
         ..Default::default()
     };
+    let label = branch.label;
     let (_, branch) = arclength_backbone(
         system,
         settings(m),
@@ -525,7 +530,7 @@ pub fn arclength_run(
         .map(|p| p.omega / w1)
         .fold(f64::NEG_INFINITY, f64::max);
     println!(
-        "    arclength m = {m}: {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
+        "    {label} (m = {m}): {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
         points.len(),
         branch.rejections,
         match &branch.end {
@@ -534,7 +539,7 @@ pub fn arclength_run(
         }
     );
     Ok(Run {
-        label: format!("NSM1 arclength m = {m}"),
+        label: label.to_string(),
         m,
         points,
         exact: None,

@@ -37,7 +37,8 @@ pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
     let (r20, r40) = (nsm1(20)?, nsm1(40)?);
     // Arclength at m = 40 fills the interval before omega_2/4 (1.211 to 1.259) where the
     // sequential run converges one point: the paper's remark on its Fig. 10.
-    let arc = arclength_run(ctx, &system, 40, (9.5, 6.0), w1)?;
+    let branch = Branch::new("NSM1 arclength m = 40", 1, (9.5, 6.0), 0);
+    let arc = arclength_run(ctx, &system, 40, &branch, w1)?;
     s10.count([&r20, &r40, &arc]);
     let mut branches = vec![
         series(&r20, w1, GREEN, Marker::Circle),

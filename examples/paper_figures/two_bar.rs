@@ -4,9 +4,9 @@
 //! interface, and a time-domain check of one point.
 
 use crate::common::{
-    energy_run, field, frequency_energy, marked, omega_1, over_gap, pick, reference_line,
-    right_end, run, series, settings, Branch, Ctx, Res, Run, Stats, Table, BLUE, GAP, GREEN, RED,
-    YELLOW,
+    arclength_run, arclength_series, energy_run, field, frequency_energy, marked, omega_1,
+    over_gap, pick, reference_line, right_end, run, series, settings, Branch, Ctx, Res, Run, Stats,
+    Table, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{harmonic_energies_by_bar, law_history, BackbonePoint};
@@ -132,13 +132,18 @@ fn named_snapshots(tb: &TwoBar, points: &[(&str, &BackbonePoint)]) -> Res<Vec<Pa
 /// Fig. 14 (and the data of 15 and 16): configuration 1.
 pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     let mut stats = Stats::default();
-    stats.count(&tb.runs);
-    let branches: Vec<Series> = tb
+    // The period grid scatters over NSM2 of bar 1; pseudo-arclength shows its two hardening
+    // sub-branches (from omega_2^(1) and from about 3.23), joined by the escape's jumps.
+    let nsm2_arc = Branch::new("NSM2 (bar 1) arclength", 3, (1.33, 1.05), 0);
+    let arc = arclength_run(ctx, &tb.system, M, &nsm2_arc, tb.w1)?;
+    stats.count(tb.runs.iter().chain([&arc]));
+    let mut branches: Vec<Series> = tb
         .runs
         .iter()
         .zip([GREEN, RED, PALETTE[5]])
         .map(|(r, c)| series(r, tb.w1, c, Marker::Circle))
         .collect();
+    branches.extend(arclength_series(&arc, tb.w1, PALETTE[4], false));
     let mut bb = backbone_panel("(0.95, 1, 1): backbones, m = 20", &branches, None);
     let w12 = OMEGA_1_BAR_2;
     bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1, 3.0];
@@ -187,7 +192,7 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
             3,
             marked(bb, "points b-g", &marks, tb.w1, panels),
         ),
-        &tb.runs(),
+        &tb.runs().into_iter().chain([&arc]).collect::<Vec<_>>(),
         tb.w1,
     )?;
     Ok((stats, marks.into_iter().cloned().collect()))
