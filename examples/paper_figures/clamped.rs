@@ -1,11 +1,11 @@
 //! Figs. 7-9: backbones of the clamped bar against the exact families, sequential against
 //! arclength continuation, and the internally resonant solutions of the first mode.
 
-use crate::common::{arclength_run, arclength_series, marked, settings};
+use crate::common::{arclength_series, marked, settings};
 use crate::common::{
-    omega_1, pick, point_map, reference_line, run, series, Branch, Ctx, Exact, Res, Run, Stats,
-    BLUE, GAP, GREEN, RED, YELLOW,
+    omega_1, point_map, reference_line, series, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
+use crate::runs::{arclength_run, pick, run, Branch, Exact, Run};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{harmonic_energies, BackbonePoint};
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};

@@ -26,6 +26,7 @@ mod clamped;
 mod common;
 mod residual;
 mod robin;
+mod runs;
 mod summary;
 mod two_bar;
 

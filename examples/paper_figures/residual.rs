@@ -3,9 +3,9 @@
 //! contact-end histories against the exact solution.
 
 use crate::common::{
-    over_gap, reference_line, right_end, run, settings, Branch, Ctx, Res, Run, Stats, Table, BLUE,
-    GAP, GREEN, RED,
+    over_gap, reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED,
 };
+use crate::runs::{run, Branch, Run};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{
     convergence_study, diagnose, energy, grazing_energy, law_history, BackbonePoint, PeriodGrid,

@@ -2,9 +2,10 @@
 //! fields, second mode, and the third subharmonic of the second mode.
 
 use crate::common::{
-    arclength_run, arclength_series, field, frequency_energy, map_panel, marked, omega_1, pick,
-    point_map, run, series, settings, Branch, Ctx, Res, Run, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_series, field, frequency_energy, map_panel, marked, omega_1, point_map, series,
+    settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
+use crate::runs::{arclength_run, pick, run, Branch, Run};
 use nonsmooth_modes::modal::{
     genuine_subharmonic_backbone_with, law_history, BackboneOptions, BackbonePoint, PeriodGrid,
 };

@@ -4,10 +4,10 @@
 //! interface, and a time-domain check of one point.
 
 use crate::common::{
-    arclength_run, arclength_series, energy_run, field, frequency_energy, marked, omega_1,
-    over_gap, pick, reference_line, right_end, run, series, settings, Branch, Ctx, Res, Run, Stats,
-    Table, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_series, field, frequency_energy, marked, omega_1, over_gap, reference_line,
+    right_end, series, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
 };
+use crate::runs::{arclength_run, energy_run, pick, run, Branch, Run};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{harmonic_energies_by_bar, law_history, BackbonePoint};
 use nonsmooth_modes::plot::{

@@ -1,0 +1,253 @@
+//! The branches of the figures: what to continue (`Branch`), how (period grid, energy levels,
+//! pseudo-arclength), and the result (`Run`), with the exact clamped-bar branches and the
+//! choice of points on a run.
+
+use crate::common::{settings, Ctx, Res, GAP};
+use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
+use nonsmooth_modes::modal::{
+    arclength_backbone, backbone, energy_backbone, ArclengthBackboneOptions, BackboneOptions,
+    BackbonePoint, EnergyBackboneOptions, EnergyGrid, PeriodGrid, StallEscape,
+};
+use nonsmooth_modes::reference::ClampedFamily;
+use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::system::BarSystem;
+use std::f64::consts::PI;
+use std::ops::ControlFlow;
+
+/// Exact `E/E_g` of a clamped-bar branch: an exact family, on its `subharmonic`-th branch.
+#[derive(Clone, Copy)]
+pub struct Exact {
+    family: ClampedFamily,
+    subharmonic: f64,
+}
+
+impl Exact {
+    /// Family `index` of the clamped bar, followed on its `subharmonic`-th branch.
+    pub fn new(index: usize, subharmonic: usize) -> Res<Self> {
+        Ok(Self {
+            family: ClampedFamily::new(GAP, index)?,
+            subharmonic: subharmonic as f64,
+        })
+    }
+
+    /// `E/E_g` at the branch's period `period`.
+    pub fn at(&self, period: f64) -> f64 {
+        self.family.energy_normalized(period / self.subharmonic)
+    }
+}
+
+/// A backbone computed by sequential continuation in the period.
+pub struct Run {
+    /// Branch name (legend and CSV).
+    pub label: String,
+    /// Number of harmonics.
+    pub m: usize,
+    /// All points, converged or not.
+    pub points: Vec<BackbonePoint>,
+    /// The exact branch it approximates, when known.
+    pub exact: Option<Exact>,
+}
+
+impl Run {
+    /// The run with the exact branch `exact`.
+    pub fn with_exact(self, exact: Exact) -> Self {
+        Self {
+            exact: Some(exact),
+            ..self
+        }
+    }
+
+    /// Its converged points.
+    pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
+        self.points.iter().filter(|p| p.converged)
+    }
+
+    /// The run up to the end of its branch, and the rest labelled `beyond`: the branch ends
+    /// at its last converged point before the first `gap` steps in a row that did not
+    /// converge (failed, or slid to rest).
+    pub fn split_at_end(&self, gap: usize, beyond: &str) -> (Run, Run) {
+        let mut end = self.points.len();
+        let mut misses = 0;
+        for (i, p) in self.points.iter().enumerate() {
+            misses = if p.converged { 0 } else { misses + 1 };
+            if misses == gap {
+                end = i + 1 - gap;
+                break;
+            }
+        }
+        let part = |label: &str, points: &[BackbonePoint]| Run {
+            label: label.to_string(),
+            m: self.m,
+            points: points.to_vec(),
+            exact: self.exact,
+        };
+        (
+            part(&self.label, &self.points[..end]),
+            part(beyond, &self.points[end..]),
+        )
+    }
+}
+
+/// What to continue: mode and subharmonic of the seed, and the period grid.
+pub struct Branch<'a> {
+    /// Branch name.
+    pub label: &'a str,
+    /// Open-contact mode the branch starts from (1-based).
+    pub mode: usize,
+    /// Subharmonic order.
+    pub subharmonic: usize,
+    /// First and last period.
+    pub periods: (f64, f64),
+    /// Steps of the period grid.
+    pub steps: usize,
+}
+
+impl<'a> Branch<'a> {
+    /// The branch of `mode` (subharmonic 1) over `periods` in `steps` steps.
+    pub fn new(label: &'a str, mode: usize, periods: (f64, f64), steps: usize) -> Self {
+        Self {
+            label,
+            mode,
+            subharmonic: 1,
+            periods,
+            steps,
+        }
+    }
+
+    /// The same branch on subharmonic `order`.
+    pub fn subharmonic(self, order: usize) -> Self {
+        Self {
+            subharmonic: order,
+            ..self
+        }
+    }
+}
+
+/// NSM `mode` of `system` with `m` harmonics, continued in the energy level from the mode's
+/// own grazing energy to 300 times it ([`EnergyGrid::for_mode`]).
+pub fn energy_run(system: &BarSystem, m: usize, label: &str, mode: usize) -> Res<Run> {
+    let options = EnergyBackboneOptions {
+        levels: EnergyGrid::for_mode(system, mode)?,
+        mode,
+        ..Default::default()
+    };
+    let points = energy_backbone(system, settings(m), &options, SemismoothNewton::default())?;
+    let ok = points.iter().filter(|p| p.converged).count();
+    println!(
+        "    {label:<28} m = {m:<3} E/E_g {:.3} -> {:.3}: {ok}/{} converged",
+        options.levels.start,
+        options.levels.end,
+        points.len()
+    );
+    Ok(Run {
+        label: label.to_string(),
+        m,
+        points: points.points,
+        exact: None,
+    })
+}
+
+/// Follows `branch` of `system` with `m` harmonics, visiting the whole grid.
+pub fn run(system: &BarSystem, m: usize, branch: &Branch<'_>) -> Res<Run> {
+    let (start, end) = branch.periods;
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start,
+            end,
+            steps: branch.steps,
+        },
+        mode: branch.mode,
+        subharmonic: branch.subharmonic,
+        // Visit the whole grid: failed stretches (near resonances) are reported, not fatal.
+        max_consecutive_failures: usize::MAX,
+        ..Default::default()
+    };
+    let points = backbone(system, settings(m), &options, SemismoothNewton::default())?;
+    let ok = points.iter().filter(|p| p.converged).count();
+    println!(
+        "    {:<28} m = {m:<3} T {start:.4} -> {end:.4}: {ok}/{} converged",
+        branch.label,
+        points.len()
+    );
+    Ok(Run {
+        label: branch.label.to_string(),
+        m,
+        points: points.points,
+        exact: None,
+    })
+}
+
+/// `branch` of `system` (its label, mode and periods; not its steps) by arclength
+/// continuation with `m` harmonics, from `T = start` while `T` stays in `[end, start + 0.01]`,
+/// with the stall escape.
+pub fn arclength_run(
+    ctx: &Ctx,
+    system: &BarSystem,
+    m: usize,
+    branch: &Branch<'_>,
+    w1: f64,
+) -> Res<Run> {
+    let (start, end) = branch.periods;
+    let mut points = Vec::new();
+    let options = ArclengthBackboneOptions {
+        start_period: start,
+        omega_range: (2.0 * PI / (start + 0.01), 2.0 * PI / end),
+        arclength: ArclengthOptions {
+            max_steps: if ctx.quick { 150 } else { 2000 },
+            ..Default::default()
+        },
+        escape: Some(StallEscape::default()),
+        mode: branch.mode,
+        subharmonic: branch.subharmonic,
+        ..Default::default()
+    };
+    let label = branch.label;
+    let (_, branch) = arclength_backbone(
+        system,
+        settings(m),
+        &options,
+        SemismoothNewton::default(),
+        |p| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )?;
+    let reached = points
+        .iter()
+        .map(|p| p.omega / w1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!(
+        "    {label} (m = {m}): {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
+        points.len(),
+        branch.rejections,
+        match &branch.end {
+            EndReason::ParameterOutOfRange { .. } => "range".to_string(),
+            other => format!("{other:?}"),
+        }
+    );
+    Ok(Run {
+        label: label.to_string(),
+        m,
+        points,
+        exact: None,
+    })
+}
+
+/// The converged point whose period is closest to `target`, preferring points whose energy
+/// is within `tolerance` of the run's exact branch if it has one (low-energy, non-resonant
+/// solutions).
+pub fn pick(run: &Run, target: f64, tolerance: f64) -> Option<&BackbonePoint> {
+    let near_exact = |p: &&BackbonePoint| {
+        run.exact
+            .is_none_or(|e| (p.energy_normalized / e.at(p.period) - 1.0).abs() < tolerance)
+    };
+    let by_distance = |a: &&BackbonePoint, b: &&BackbonePoint| {
+        (a.period - target)
+            .abs()
+            .total_cmp(&(b.period - target).abs())
+    };
+    run.converged()
+        .filter(near_exact)
+        .min_by(by_distance)
+        .or_else(|| run.converged().min_by(by_distance))
+}
