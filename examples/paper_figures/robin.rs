@@ -6,12 +6,14 @@ use crate::common::{
     settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use crate::runs::{arclength_run, pick, run, Branch, Run};
+use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{
-    genuine_subharmonic_backbone_with, law_history, BackboneOptions, BackbonePoint, PeriodGrid,
+    energy, genuine_subharmonic_backbone_with, grazing_energy, law_history, subharmonic_share,
+    symmetry_breaking_direction, BackboneOptions, BackbonePoint, PeriodGrid, GENUINE_SHARE,
 };
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
-use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
+use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -228,6 +230,61 @@ fn contacts_and_grazings(
     Ok(Some((contacts, grazings)))
 }
 
+/// Nudges along the symmetry-breaking direction, in units of the largest unknown:
+/// `modal::NUDGES` and a full step either way, which point g needs.
+const WIDE_NUDGES: [f64; 6] = [0.1, -0.1, 0.5, -0.5, 1.0, -1.0];
+
+/// A motion with one contact and two grazings per period reached by leaving the repeated branch
+/// of `run` at fixed frequency: each converged point still on it (share off the multiples of 3
+/// below `GENUINE_SHARE`) nudged along its symmetry-breaking direction by [`WIDE_NUDGES`] and
+/// solved; the first genuinely subharmonic solution with that pattern, as a point at the same
+/// frequency.
+fn one_contact_off_the_repeated_branch(
+    system: &BarSystem,
+    m: usize,
+    run: &Run,
+) -> Res<Option<BackbonePoint>> {
+    let mut problem = NonsmoothSystem::new(system, settings(m))?;
+    let basis = problem.basis().clone();
+    let (e_g, _) = grazing_energy(system)?;
+    let solver = SemismoothNewton::default();
+    for p in run.converged() {
+        if subharmonic_share(system, &basis, &p.x, p.omega, 3)? >= GENUINE_SHARE {
+            continue;
+        }
+        let Some((direction, _)) = symmetry_breaking_direction(&mut problem, &p.x, p.omega, 3)
+        else {
+            continue;
+        };
+        let scale = p.x.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        for nudge in WIDE_NUDGES {
+            let mut y: Vec<f64> = (p.x.iter().zip(&direction))
+                .map(|(v, d)| v + nudge * scale * d)
+                .collect();
+            problem.set_parameter(p.omega);
+            let Ok(info) = solver.solve(&mut problem, &mut y) else {
+                continue;
+            };
+            if subharmonic_share(system, &basis, &y, p.omega, 3)? < GENUINE_SHARE {
+                continue;
+            }
+            let e = energy(system, &basis, &y, p.omega);
+            let point = BackbonePoint {
+                x: y,
+                energy: e,
+                energy_normalized: e / e_g,
+                residual_norm: info.residual_norm,
+                iterations: info.iterations,
+                ..p.clone()
+            };
+            if contacts_and_grazings(system, m, &point)? == Some((1, 2)) {
+                return Ok(Some(point));
+            }
+        }
+    }
+    Ok(None)
+}
+
 /// Fig. 13: Robin bar NSM2 sub3 with m = 60, and points with one or two contacts.
 pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     let mut stats = Stats::default();
@@ -286,6 +343,17 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
             _ => {}
         }
     }
+    let off = match g {
+        Some(_) => None,
+        None => {
+            let repeated = Branch::new("NSM2 sub3 (repeated)", 2, (t3 - 0.02, 4.6), ctx.steps(113));
+            let repeated = run(&system, m, &repeated.subharmonic(3))?;
+            one_contact_off_the_repeated_branch(&system, m, &repeated)?
+        }
+    };
+    if let Some(p) = &off {
+        g = Some((p, 1, 2));
+    }
     let basis = settings(m).cosine_basis()?;
     let mut panels = Vec::new();
     let mut marks = Vec::new();
@@ -294,7 +362,10 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
         stats.lettered(name, p.is_some());
         if let Some((p, c, gr)) = p {
             marks.push(p);
-            notes.push(format!("{name}: {c} contact(s), {gr} grazing(s)"));
+            notes.push(format!(
+                "{name}: {c} contact(s), {gr} grazing(s), {}",
+                frequency_energy(p, w1)
+            ));
             let title = format!(
                 "point {name}: {c} contact(s), {gr} grazing(s), Omega/omega_1 = {:.3}",
                 p.omega / w1
