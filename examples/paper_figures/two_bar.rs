@@ -8,13 +8,18 @@ use crate::common::{
     right_end, series, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use crate::runs::{arclength_run, energy_run, pick, run, Branch, Run};
+use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{harmonic_energies_by_bar, law_history, BackbonePoint};
+use nonsmooth_modes::modal::{
+    branch_seed, energy, grazing_energy, harmonic_energies_by_bar, law_history, BackbonePoint,
+    PointStatus,
+};
 use nonsmooth_modes::plot::{
     backbone_panel, snapshots_panel, Figure, LegendPosition, LinePanel, Marker, Panel, PlacedBar,
     Placement, Rgb, Series, SpaceTimeField, PALETTE,
 };
 use nonsmooth_modes::reference::{paper_second_bar, two_bars_in_contact};
+use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use nonsmooth_modes::verify::{march, periodicity_check, MarchOptions, PeriodicityOptions, State};
 use std::f64::consts::PI;
@@ -446,6 +451,60 @@ fn subharmonic_of_bar_1(
     Ok((bar1[n] >= 0.5 * most && near).then_some((n, j)))
 }
 
+/// Frequencies `Omega / omega_1` above `omega_3^(1)/2 = 2.5` where the paper's point e of
+/// Fig. 18 (bar 1 in NSM3 sub2, hardening) is sought from seeds.
+const ABOVE_HALF_OMEGA_3: [f64; 4] = [2.51, 2.53, 2.56, 2.6];
+
+/// Bar 1 in NSM3 sub2 with bar 2 in NSM1 (the paper's point e of Fig. 18) at the lowest of
+/// [`ABOVE_HALF_OMEGA_3`] where a seed combining bar 2's first mode on harmonic 1 (system mode
+/// 2) and bar 1's third mode on harmonic 2 (system mode 4), in the ratios 1:1, 2:1 and 1:0.5,
+/// converges to a motion in contact with that content.
+fn hardening_nsm3_sub2(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    w1: f64,
+) -> Res<Option<BackbonePoint>> {
+    let mut problem = NonsmoothSystem::new(system, settings(M))?;
+    let (e_g, _) = grazing_energy(system)?;
+    let solver = SemismoothNewton::default();
+    for ratio in ABOVE_HALF_OMEGA_3 {
+        let omega = ratio * w1;
+        let bar_2 = branch_seed(&mut problem, 2, 1, omega)?;
+        let bar_1 = branch_seed(&mut problem, 4, 2, omega)?;
+        for (a, b) in [(1.0, 1.0), (2.0, 1.0), (1.0, 0.5)] {
+            let mut x: Vec<f64> = (bar_2.iter().zip(&bar_1))
+                .map(|(u, v)| a * u + b * v)
+                .collect();
+            problem.set_parameter(omega);
+            let Ok(info) = solver.solve(&mut problem, &mut x) else {
+                continue;
+            };
+            let e = energy(system, basis, &x, omega);
+            let point = BackbonePoint {
+                step: 0,
+                period: 2.0 * PI / omega,
+                omega,
+                energy: e,
+                energy_normalized: e / e_g,
+                converged: true,
+                status: PointStatus::Converged,
+                residual_norm: info.residual_norm,
+                iterations: info.iterations,
+                x,
+                step_size: 0.0,
+                events: Vec::new(),
+            };
+            // Above rest (a seed can slide to it), with the content of e.
+            if point.energy_normalized > 1e-3
+                && subharmonic_of_bar_1(system, basis, &point)? == Some((2, 3))
+            {
+                return Ok(Some(point));
+            }
+        }
+    }
+    Ok(None)
+}
+
 /// Fig. 18: configuration 3 (0.95, 2, 1): the two families and a few fields.
 pub fn fig18(ctx: &Ctx) -> Res<Stats> {
     let mut stats = Stats::default();
@@ -506,10 +565,16 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
             })
             .map(|(p, _)| *p)
     };
+    // Family 2's grid does not reach NSM3 sub2 above omega_3^(1)/2: e is sought from seeds of
+    // the combined motion itself when the run has none.
+    let seeded = match nearest((2, 3), 1.0) {
+        Some(_) => None,
+        None => hardening_nsm3_sub2(&tb.system, &basis, w1)?,
+    };
     let family2 = [
         ("c", nearest((5, 6), 1.0).or(nearest((5, 6), -1.0))),
         ("d", nearest((2, 3), -1.0)),
-        ("e", nearest((2, 3), 1.0)),
+        ("e", nearest((2, 3), 1.0).or(seeded.as_ref())),
     ];
     for (letter, p) in &family2 {
         stats.lettered(letter, p.is_some());
