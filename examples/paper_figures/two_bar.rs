@@ -317,13 +317,14 @@ pub fn fig16(ctx: &Ctx, tb: &TwoBar, p: &BackbonePoint) -> Res<Stats> {
         hb_line("bar 1, FD-BEM", &h1.time, &hb1, Rgb::BLACK),
         hb_line("bar 2, FD-BEM", &h2.time, &hb2, PALETTE[7]),
     ];
-    pos.legend = LegendPosition::LowerRight;
+    // The positions fill the lower right, the force spikes the upper corners.
+    pos.legend = LegendPosition::UpperRight;
     let mut frc = LinePanel::new("contact force", "t", "lambda / g0");
     frc.series = vec![
         Series::from_columns("time domain (step mean)", &tm, &force).with_color(BLUE),
         hb_line("FD-BEM", &law.time, &over_gap(&law.force), Rgb::BLACK),
     ];
-    frc.legend = LegendPosition::UpperRight;
+    frc.legend = LegendPosition::UpperMiddle;
     // Snapshots of the marched field.
     let l2 = tb.system.bars()[1].length();
     let marched = |bar: usize| -> SpaceTimeField {
