@@ -124,3 +124,58 @@ fn bad_starts_are_typed_errors() {
     );
     assert!(matches!(short, Err(Error::Continuation(_))));
 }
+
+/// Steps too coarse for the branch slide to the state of rest (at `T = 3.95`, gap from `1e-3`
+/// to `1e-2` in 5 values): those points reach the observer as collapsed to rest, never as
+/// converged points of the branch, and every converged point is above the trivial-energy floor.
+#[test]
+fn a_gap_branch_that_slides_to_rest_reports_it() {
+    use nonsmooth_modes::modal::PointStatus;
+    let settings = HarmonicBalanceSettings::default();
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let options = BackboneOptions {
+        grid: PeriodGrid {
+            start: 3.96,
+            end: 3.95,
+            steps: 2,
+        },
+        ..Default::default()
+    };
+    let from = backbone(&system, settings, &options, SemismoothNewton::default())
+        .unwrap()
+        .into_iter()
+        .rev()
+        .find(|p| p.converged)
+        .unwrap();
+    let values: Vec<f64> = (0..5).map(|i| 1e-3 + 2.25e-3 * i as f64).collect();
+    let mut seen = Vec::new();
+    parameter_branch(
+        clamped_bar_with_obstacle,
+        settings,
+        (from.x.clone(), from.omega),
+        1e-3,
+        ParameterSteps::Values(values, SequentialOptions::default()),
+        SemismoothNewton::default(),
+        |_, p| {
+            seen.push(p.clone());
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    assert_eq!(seen.len(), 5);
+    let collapsed = seen
+        .iter()
+        .filter(|p| p.status == PointStatus::CollapsedToRest)
+        .count();
+    assert!(
+        collapsed >= 1,
+        "{:?}",
+        seen.iter().map(|p| p.energy_normalized).collect::<Vec<_>>()
+    );
+    for p in &seen {
+        assert_eq!(p.converged, p.status == PointStatus::Converged);
+        if p.converged {
+            assert!(p.energy_normalized > 1e-6, "{}", p.energy_normalized);
+        }
+    }
+}

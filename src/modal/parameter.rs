@@ -12,7 +12,8 @@ use crate::continuation::{
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
 use crate::modal::linear::grazing_energy;
-use crate::modal::point::BackbonePoint;
+use crate::modal::point::{BackbonePoint, PointStatus};
+use crate::modal::BackboneOptions;
 use crate::solve::NonlinearSolver;
 use crate::system::{HarmonicBalanceSettings, ParameterFamily, SystemFamily};
 use std::ops::ControlFlow;
@@ -39,6 +40,10 @@ pub enum ParameterSteps {
 /// A point whose system has no grazing energy (a gap whose `E_g` underflows or overflows,
 /// [`SettingsError::GrazingEnergyOutOfRange`](crate::SettingsError::GrazingEnergyOutOfRange))
 /// reaches the observer with `energy_normalized = NaN`: `E / E_g` is not defined there.
+/// A converged point below the backbones' trivial-energy floor
+/// ([`BackboneOptions::trivial_energy`](crate::modal::BackboneOptions::trivial_energy) times
+/// `E_g` at its parameter) is the state of rest, not a point of the branch: it reaches the
+/// observer as [`PointStatus::CollapsedToRest`] with `converged == false`.
 ///
 /// # Errors
 /// A family that rejects `value`, a system at `value` without grazing energy, invalid
@@ -58,6 +63,7 @@ where
     S: NonlinearSolver,
 {
     let basis = settings.cosine_basis()?;
+    let floor = BackboneOptions::default().trivial_energy;
     let problem = ParameterFamily::at(family.clone(), settings, omega, value)?;
     // Energies are normalised by `E_g`: a start without one is refused, as by `backbone`.
     grazing_energy(&family.build(value)?)?;
@@ -69,7 +75,12 @@ where
         };
         let e = energy(&system, &basis, &p.x, omega);
         let e_g = grazing_energy(&system).map_or(f64::NAN, |g| g.0);
-        observer(p.parameter, &BackbonePoint::from_point(p, omega, e, e_g))
+        let mut point = BackbonePoint::from_point(p, omega, e, e_g);
+        if point.converged && e_g.is_finite() && e <= floor * e_g {
+            point.converged = false;
+            point.status = PointStatus::CollapsedToRest;
+        }
+        observer(p.parameter, &point)
     };
     let mut see = |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report);
     let branch = match steps {
