@@ -5,12 +5,9 @@
 use crate::common::{
     over_gap, reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED,
 };
-use crate::runs::{run, Branch, Run};
+use crate::runs::{run, solved_point, Branch, Run};
 use nonsmooth_modes::continuation::ContinuationProblem;
-use nonsmooth_modes::modal::{
-    convergence_study, diagnose, energy, grazing_energy, law_history, BackbonePoint, PeriodGrid,
-    PointStatus,
-};
+use nonsmooth_modes::modal::{convergence_study, diagnose, law_history, BackbonePoint, PeriodGrid};
 use nonsmooth_modes::plot::{
     histories_panel, Figure, LegendPosition, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
 };
@@ -235,22 +232,7 @@ fn exact_seeded_point(m: usize, period: f64) -> Res<Option<BackbonePoint>> {
         return Ok(None);
     }
     let basis = problem.basis().clone();
-    let e_g = grazing_energy(&system)?.0;
-    let e = energy(&system, &basis, &x, omega);
-    Ok(Some(BackbonePoint {
-        step: 0,
-        period,
-        omega,
-        energy: e,
-        energy_normalized: e / e_g,
-        converged: true,
-        status: PointStatus::Converged,
-        residual_norm: info.residual_norm,
-        iterations: info.iterations,
-        x,
-        step_size: 0.0,
-        events: Vec::new(),
-    }))
+    Ok(Some(solved_point(&system, &basis, (x, omega), &info)?))
 }
 
 /// The main-branch point at `period` (exact-seeded), or the sequential one if that fails.

@@ -4,12 +4,14 @@
 
 use crate::common::{settings, Ctx, Res, GAP};
 use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
+use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, energy_backbone, ArclengthBackboneOptions, BackboneOptions,
-    BackbonePoint, EnergyBackboneOptions, EnergyGrid, PeriodGrid, StallEscape,
+    arclength_backbone, backbone, energy, energy_backbone, grazing_energy,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
+    PeriodGrid, PointStatus, StallEscape,
 };
 use nonsmooth_modes::reference::ClampedFamily;
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::{SemismoothNewton, SolveInfo};
 use nonsmooth_modes::system::BarSystem;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -250,4 +252,30 @@ pub fn pick(run: &Run, target: f64, tolerance: f64) -> Option<&BackbonePoint> {
         .filter(near_exact)
         .min_by(by_distance)
         .or_else(|| run.converged().min_by(by_distance))
+}
+
+/// A motion `x` of `system` solved at the fixed frequency `omega` (not continued), as a
+/// converged point with its energy.
+pub fn solved_point(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    (x, omega): (Vec<f64>, f64),
+    info: &SolveInfo,
+) -> Res<BackbonePoint> {
+    let e_g = grazing_energy(system)?.0;
+    let e = energy(system, basis, &x, omega);
+    Ok(BackbonePoint {
+        step: 0,
+        period: 2.0 * PI / omega,
+        omega,
+        energy: e,
+        energy_normalized: e / e_g,
+        converged: true,
+        status: PointStatus::Converged,
+        residual_norm: info.residual_norm,
+        iterations: info.iterations,
+        x,
+        step_size: 0.0,
+        events: Vec::new(),
+    })
 }

@@ -7,13 +7,10 @@ use crate::common::{
     arclength_series, field, frequency_energy, marked, omega_1, over_gap, reference_line,
     right_end, series, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
 };
-use crate::runs::{arclength_run, energy_run, pick, run, Branch, Run};
+use crate::runs::{arclength_run, energy_run, pick, run, solved_point, Branch, Run};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{
-    branch_seed, energy, grazing_energy, harmonic_energies_by_bar, law_history, BackbonePoint,
-    PointStatus,
-};
+use nonsmooth_modes::modal::{branch_seed, harmonic_energies_by_bar, law_history, BackbonePoint};
 use nonsmooth_modes::plot::{
     backbone_panel, snapshots_panel, Figure, LegendPosition, LinePanel, Marker, Panel, PlacedBar,
     Placement, Rgb, Series, SpaceTimeField, PALETTE,
@@ -466,7 +463,6 @@ fn hardening_nsm3_sub2(
     w1: f64,
 ) -> Res<Option<BackbonePoint>> {
     let mut problem = NonsmoothSystem::new(system, settings(M))?;
-    let (e_g, _) = grazing_energy(system)?;
     let solver = SemismoothNewton::default();
     for ratio in ABOVE_HALF_OMEGA_3 {
         let omega = ratio * w1;
@@ -480,21 +476,7 @@ fn hardening_nsm3_sub2(
             let Ok(info) = solver.solve(&mut problem, &mut x) else {
                 continue;
             };
-            let e = energy(system, basis, &x, omega);
-            let point = BackbonePoint {
-                step: 0,
-                period: 2.0 * PI / omega,
-                omega,
-                energy: e,
-                energy_normalized: e / e_g,
-                converged: true,
-                status: PointStatus::Converged,
-                residual_norm: info.residual_norm,
-                iterations: info.iterations,
-                x,
-                step_size: 0.0,
-                events: Vec::new(),
-            };
+            let point = solved_point(system, basis, (x, omega), &info)?;
             // Above rest (a seed can slide to it), with the content of e.
             if point.energy_normalized > 1e-3
                 && subharmonic_of_bar_1(system, basis, &point)? == Some((2, 3))
