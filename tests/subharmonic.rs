@@ -6,7 +6,7 @@ use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::Basis;
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{
-    branch_seed, genuine_subharmonic_backbone_with, linear_period, subharmonic_share,
+    branch_seed, genuine_subharmonic_backbone, linear_period, subharmonic_share,
     symmetry_breaking_direction, BackboneOptions, PeriodGrid, PointStatus, GENUINE_SHARE,
 };
 use nonsmooth_modes::reference::robin_bar_with_obstacle;
@@ -97,18 +97,10 @@ fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
         ..Default::default()
     };
     let problem = NonsmoothSystem::new(&system, settings(30)).unwrap();
-    let mut points = Vec::new();
-    genuine_subharmonic_backbone_with(
-        &system,
-        settings(30),
-        &options,
-        SemismoothNewton::default(),
-        |p| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
+    let points =
+        genuine_subharmonic_backbone(&system, settings(30), &options, SemismoothNewton::default())
+            .unwrap()
+            .points;
     let share = |p: &nonsmooth_modes::modal::BackbonePoint| {
         subharmonic_share(&system, problem.basis(), &p.x, p.omega, K).unwrap()
     };

@@ -8,15 +8,14 @@ use crate::common::{
 use crate::runs::{arclength_run, pick, run, Branch, Run};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{
-    energy, genuine_subharmonic_backbone_with, grazing_energy, law_history, subharmonic_share,
-    symmetry_breaking_direction, BackboneOptions, BackbonePoint, PeriodGrid, GENUINE_SHARE,
+    energy, grazing_energy, law_history, subharmonic_share, symmetry_breaking_direction,
+    BackbonePoint, GENUINE_SHARE,
 };
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
-use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
-use std::ops::ControlFlow;
 
 /// Ground spring stiffness `k_s` of the paper's Robin bar.
 const ROBIN_K: f64 = 0.5;
@@ -197,13 +196,11 @@ const CONTACT_SHARE: f64 = 0.2;
 /// largest third's, a grazing when it is below [`GRAZING_SHARE`] while the gap closes to within
 /// 5 % of `g0`; `None` when a third is neither.
 fn contacts_and_grazings(
-    system: &BarSystem,
-    m: usize,
+    problem: &NonsmoothSystem,
     p: &BackbonePoint,
 ) -> Res<Option<(usize, usize)>> {
-    let problem = NonsmoothSystem::new(system, settings(m))?;
     let n = 1200;
-    let h = law_history(&problem, &p.x, p.omega, 0, n)?;
+    let h = law_history(problem, &p.x, p.omega, 0, n)?;
     let k0 = (0..n)
         .min_by(|&a, &b| h.force[a].total_cmp(&h.force[b]))
         .unwrap_or(0);
@@ -277,7 +274,7 @@ fn one_contact_off_the_repeated_branch(
                 iterations: info.iterations,
                 ..p.clone()
             };
-            if contacts_and_grazings(system, m, &point)? == Some((1, 2)) {
+            if contacts_and_grazings(&problem, &point)? == Some((1, 2)) {
                 return Ok(Some(point));
             }
         }
@@ -294,39 +291,8 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     let t3 = 3.0 * 2.0 * PI / OMEGA_2;
     // The repeated branch (NSM2 traced three times) has three equal contacts; g and f lie on
     // the genuinely T-periodic branch that leaves it.
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: t3 - 0.02,
-            end: 4.6,
-            steps: ctx.steps(113),
-        },
-        mode: 2,
-        subharmonic: 3,
-        max_consecutive_failures: usize::MAX,
-        ..Default::default()
-    };
-    let mut points = Vec::new();
-    genuine_subharmonic_backbone_with(
-        &system,
-        settings(m),
-        &options,
-        SemismoothNewton::new(NewtonOptions::fail_fast())?,
-        |p| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        },
-    )?;
-    let r = Run {
-        label: "NSM2 sub3".into(),
-        m,
-        points,
-        exact: None,
-    };
-    println!(
-        "    NSM2 sub3 (genuine)          m = {m:<3}: {}/{} converged",
-        r.converged().count(),
-        r.points.len()
-    );
+    let branch = Branch::new("NSM2 sub3", 2, (t3 - 0.02, 4.6), ctx.steps(113)).subharmonic(3);
+    let r = run(&system, m, &branch.genuine())?;
     stats.count([&r]);
     let bb = backbone_panel(
         format!("Robin bar: NSM2 sub3, m = {m}"),
@@ -336,8 +302,9 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     // g: one contact and two grazings per period; f: two contacts and one grazing.
     let mut g = None;
     let mut f = None;
+    let problem = NonsmoothSystem::new(&system, settings(m))?;
     for p in r.converged() {
-        match contacts_and_grazings(&system, m, p)? {
+        match contacts_and_grazings(&problem, p)? {
             Some((1, 2)) if g.is_none() => g = Some((p, 1, 2)),
             Some((2, 1)) if f.is_none() => f = Some((p, 2, 1)),
             _ => {}

@@ -6,12 +6,12 @@ use crate::common::{settings, Ctx, Res, GAP};
 use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, energy, energy_backbone, grazing_energy,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
-    PeriodGrid, PointStatus, StallEscape,
+    arclength_backbone, backbone, energy, energy_backbone, genuine_subharmonic_backbone,
+    grazing_energy, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
+    EnergyBackboneOptions, EnergyGrid, PeriodGrid, PointStatus, StallEscape,
 };
 use nonsmooth_modes::reference::ClampedFamily;
-use nonsmooth_modes::solve::{SemismoothNewton, SolveInfo};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, SolveInfo};
 use nonsmooth_modes::system::BarSystem;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -102,6 +102,9 @@ pub struct Branch<'a> {
     pub periods: (f64, f64),
     /// Steps of the period grid.
     pub steps: usize,
+    /// For a subharmonic: follow the genuinely `T`-periodic branch that leaves the repeated
+    /// one ([`genuine_subharmonic_backbone`]) instead of the repeated branch.
+    pub genuine: bool,
 }
 
 impl<'a> Branch<'a> {
@@ -113,6 +116,15 @@ impl<'a> Branch<'a> {
             subharmonic: 1,
             periods,
             steps,
+            genuine: false,
+        }
+    }
+
+    /// The same subharmonic branch, followed off the repeated one where it leaves it.
+    pub fn genuine(self) -> Self {
+        Self {
+            genuine: true,
+            ..self
         }
     }
 
@@ -164,7 +176,13 @@ pub fn run(system: &BarSystem, m: usize, branch: &Branch<'_>) -> Res<Run> {
         max_consecutive_failures: usize::MAX,
         ..Default::default()
     };
-    let points = backbone(system, settings(m), &options, SemismoothNewton::default())?;
+    let points = if branch.genuine {
+        // As the `backbone` example: each step starts from a converged neighbour.
+        let solver = SemismoothNewton::new(NewtonOptions::fail_fast())?;
+        genuine_subharmonic_backbone(system, settings(m), &options, solver)?
+    } else {
+        backbone(system, settings(m), &options, SemismoothNewton::default())?
+    };
     let ok = points.iter().filter(|p| p.converged).count();
     println!(
         "    {:<28} m = {m:<3} T {start:.4} -> {end:.4}: {ok}/{} converged",

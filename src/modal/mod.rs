@@ -47,7 +47,7 @@ pub use start::{
     FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
 };
 pub use subharmonic::{
-    genuine_subharmonic_backbone_with, leave_subspace, symmetry_breaking_direction, GENUINE_SHARE,
-    NUDGES,
+    genuine_subharmonic_backbone, genuine_subharmonic_backbone_with, leave_subspace,
+    symmetry_breaking_direction, GENUINE_SHARE, NUDGES,
 };
 pub use switch::SwitchAt;

@@ -23,7 +23,7 @@ use crate::fourier::Basis;
 use crate::linalg::{DenseMatrix, Lu};
 use crate::modal::backbone::{backbone_with, BackboneOptions};
 use crate::modal::energy::energy;
-use crate::modal::point::{BackbonePoint, PointStatus};
+use crate::modal::point::{Backbone, BackbonePoint, PointStatus};
 use crate::modal::signature::subharmonic_share;
 use crate::solve::{NonlinearSolver, Problem};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
@@ -151,6 +151,24 @@ pub fn leave_subspace<B: Basis>(
         }
     }
     None
+}
+
+/// [`genuine_subharmonic_backbone_with`] collecting every point, as [`backbone`] does for
+/// [`backbone_with`]: a run that stalls returns what it computed, with its end reason.
+///
+/// [`backbone`]: crate::modal::backbone
+///
+/// # Errors
+/// See [`genuine_subharmonic_backbone_with`].
+pub fn genuine_subharmonic_backbone<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: &BackboneOptions,
+    solver: S,
+) -> Result<Backbone, Error> {
+    Backbone::collect(|see| {
+        genuine_subharmonic_backbone_with(system, settings, options, solver, see)
+    })
 }
 
 /// A genuinely subharmonic backbone: the `K`-fold repeated branch of `options` (`K =
