@@ -6,16 +6,16 @@ use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{geomspace, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, branch_seed, energy, energy_backbone, grazing_energy,
-    split_frequency, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
-    EnergyBackboneOptions, EnergyGrid, EnergyLevel, PeriodGrid, PointStatus,
+    arclength_backbone, backbone, backbone_start, branch_seed, energy, energy_backbone,
+    grazing_energy, split_frequency, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
+    EnergyBackboneOptions, EnergyGrid, EnergyLevel, PeriodGrid, PointStatus, FLOATING_RETRY_DEPTH,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
-use nonsmooth_modes::solve::{Problem, SemismoothNewton};
+use nonsmooth_modes::solve::{Problem, SemismoothNewton, Structured};
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
-use nonsmooth_modes::{ContinuationError, Error};
+use nonsmooth_modes::{ContinuationError, Error, SettingsError};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -182,34 +182,41 @@ fn energy_level_unknowns_end_with_the_frequency() {
 
 /// The free-free bar between walls: its grazing seed slides to a rigid-body rest against a
 /// wall at every period, so the period backbone starts from a seed that penetrates a little
-/// at a slightly higher frequency, walked back to the grid's start. At `m = 20` at least
-/// 90 % of its points converge, and half of them lie within 5 % of the exact family.
+/// at a slightly higher frequency, walked back to the grid's start. With the system's default
+/// options (`BackboneOptions::for_mode`: a second retry, the clamped bar's defaults otherwise),
+/// at `m = 20` and `m = 40` at least 90 % of its points converge, none at rest, and at least
+/// 45 % of them lie within 5 % of the exact family (half at `m = 20`).
 #[test]
 fn free_free_bar_between_walls_has_a_period_backbone() {
     let system = free_free_between_walls();
-    let options = BackboneOptions {
-        grid: PeriodGrid::for_mode(&system, 1, 1).unwrap(),
-        ..Default::default()
-    };
+    let options = BackboneOptions::for_mode(&system, 1, 1).unwrap();
     assert!((options.grid.start - 1.975).abs() < 1e-12);
-    let run = backbone(&system, settings(20), &options, SemismoothNewton::default()).unwrap();
-    let converged: Vec<_> = run.converged().collect();
-    assert!(
-        converged.len() * 10 >= run.len() * 9,
-        "{} of {}",
-        converged.len(),
-        run.len()
+    assert_eq!(options.retry_depth, FLOATING_RETRY_DEPTH);
+    let clamped = clamped_bar_with_obstacle(GAP).unwrap();
+    assert_eq!(
+        BackboneOptions::for_mode(&clamped, 1, 1).unwrap(),
+        BackboneOptions::default()
     );
-    let on_branch = converged
-        .iter()
-        .filter(|p| (p.energy_normalized / free_free_exact(p.period) - 1.0).abs() < 0.05)
-        .count();
-    assert!(
-        on_branch * 2 >= converged.len(),
-        "{on_branch} of {}",
-        converged.len()
-    );
-    assert!(converged.iter().all(|p| p.energy_normalized > 0.5));
+    for (m, on_branch_share) in [(20, 0.5), (40, 0.45)] {
+        let run = backbone(&system, settings(m), &options, SemismoothNewton::default()).unwrap();
+        let converged: Vec<_> = run.converged().collect();
+        assert!(
+            converged.len() * 10 >= run.len() * 9,
+            "m = {m}: {} of {}",
+            converged.len(),
+            run.len()
+        );
+        let on_branch = converged
+            .iter()
+            .filter(|p| (p.energy_normalized / free_free_exact(p.period) - 1.0).abs() < 0.05)
+            .count();
+        assert!(
+            on_branch as f64 >= on_branch_share * converged.len() as f64,
+            "m = {m}: {on_branch} of {}",
+            converged.len()
+        );
+        assert!(converged.iter().all(|p| p.energy_normalized > 0.5));
+    }
 }
 
 /// Over the whole default range (`E/E_g` from 1 to 300), the energy backbone of the clamped
@@ -289,14 +296,61 @@ fn assert_every_contact_touches(system: &BarSystem, points: &[BackbonePoint]) {
     }
 }
 
+/// The chain's branch cannot be entered at the period grid's first period: its start is found
+/// at a higher frequency only ([`backbone_start`]), while the branches of the clamped bar and
+/// of the free-free bar between walls are entered where asked.
+#[test]
+fn the_chains_start_lies_above_the_grids_first_frequency() {
+    let solver = SemismoothNewton::default();
+    let start_of = |system: &BarSystem| {
+        let omega = 2.0 * PI / PeriodGrid::for_mode(system, 1, 1).unwrap().start;
+        let start = backbone_start(system, settings(20), (1, 1), omega, 1e-6, &solver).unwrap();
+        (start, omega)
+    };
+    let chain = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
+    let (start, omega) = start_of(&chain);
+    assert!(
+        start.moved_from(omega) && start.omega > omega,
+        "{} {omega}",
+        start.omega
+    );
+    let mut problem = NonsmoothSystem::new(&chain, settings(20)).unwrap();
+    problem.set_parameter(start.omega);
+    let mut f = vec![0.0; start.x.len()];
+    problem.residual(&start.x, &mut f);
+    let tolerance = 1e-9 * problem.residual_scale();
+    assert!(f.iter().map(|v| v * v).sum::<f64>().sqrt() <= tolerance);
+    for system in [
+        clamped_bar_with_obstacle(GAP).unwrap(),
+        free_free_between_walls(),
+    ] {
+        let (start, omega) = start_of(&system);
+        assert!(!start.moved_from(omega), "{} {omega}", start.omega);
+    }
+    assert!(matches!(
+        backbone_start(&chain, settings(20), (1, 1), -1.0, 1e-6, &solver),
+        Err(Error::Settings(SettingsError::NotPositive { value, .. })) if value == -1.0
+    ));
+    assert!(matches!(
+        backbone_start(&chain, settings(20), (1, 1), omega, f64::NAN, &solver),
+        Err(Error::Continuation(ContinuationError::InvalidOption {
+            what: "trivial_energy",
+            ..
+        }))
+    ));
+}
+
 /// The chain's pseudo-arclength backbone starts from the same robust guesses as the period
 /// backbone, at the frequency where they converge (the grazing seed meets a singular Jacobian:
-/// with every contact open the floating bar's mean position is free); every accepted point
-/// touches both contacts and none sits at rest.
+/// with every contact open the floating bar's mean position is free), and walks its branch
+/// back to the asked start first: the run covers the range from the grid's first period to its
+/// last, its steps are numbered in order, every accepted point touches both contacts and none
+/// sits at rest.
 #[test]
 fn the_chains_arclength_backbone_starts_where_its_guesses_converge() {
     let system = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
     let options = ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap();
+    let grid = PeriodGrid::for_mode(&system, 1, 1).unwrap();
     let mut points = Vec::new();
     let (_, branch) = arclength_backbone(
         &system,
@@ -310,10 +364,16 @@ fn the_chains_arclength_backbone_starts_where_its_guesses_converge() {
     )
     .unwrap();
     assert!(
-        points.len() >= 50,
+        points.len() >= 200,
         "{} points, end {:?}",
         points.len(),
         branch.end
     );
+    let (first, last) = (&points[0], &points[points.len() - 1]);
+    let span = grid.start - grid.end;
+    assert!(first.period > grid.start - 0.05 * span, "{}", first.period);
+    assert!(last.period < grid.end + 0.1 * span, "{}", last.period);
+    assert!(points.windows(2).all(|w| w[1].step > w[0].step));
+    assert_eq!(branch.points.len(), points.len());
     assert_every_contact_touches(&system, &points);
 }

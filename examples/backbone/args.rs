@@ -64,14 +64,18 @@ pub struct Args {
     pub dogleg: bool,
     /// `Some(true)`: fail-fast budget, `Some(false)`: full, `None`: per method.
     pub fail_fast: Option<bool>,
-    pub retry_depth: usize,
+    /// `None`: the run's own default (`BackboneOptions::for_mode` for a period backbone of a
+    /// file, 1 otherwise).
+    pub retry_depth: Option<usize>,
     /// Consecutive failed steps before a sequential run ends as stalled.
     pub max_failures: usize,
     pub selection: Selection,
     /// No speculative retry on a second thread.
     pub serial: bool,
     pub out: Option<String>,
-    pub arclength: bool,
+    /// `--method`: `Some(true)` arclength, `Some(false)` sequential, `None` chosen from the
+    /// system (`runs::arclength_by_default`).
+    pub arclength: Option<bool>,
     pub driver: ArclengthOptions,
     pub omega_range: Option<(f64, f64)>,
     /// `--switch-at N[:SIDE]` of arclength runs.
@@ -136,12 +140,12 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         steps: 181,
         dogleg: false,
         fail_fast: None,
-        retry_depth: 1,
+        retry_depth: None,
         max_failures: BackboneOptions::default().max_consecutive_failures,
         selection: Selection::FirstConverged,
         serial: false,
         out: None,
-        arclength: false,
+        arclength: None,
         driver: ArclengthOptions::default(),
         omega_range: None,
         switch: None,
@@ -208,7 +212,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
                     other => return Err(format!("unknown Newton budget `{other}`").into()),
                 }
             }
-            Long("retry-depth") => a.retry_depth = parser.value()?.parse()?,
+            Long("retry-depth") => a.retry_depth = Some(parser.value()?.parse()?),
             Long("max-failures") => a.max_failures = parser.value()?.parse()?,
             Long("selection") => {
                 a.selection = match parser.value()?.string()?.as_str() {
@@ -221,8 +225,8 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("out") => a.out = Some(parser.value()?.string()?),
             Long("method") => {
                 a.arclength = match parser.value()?.string()?.as_str() {
-                    "sequential" => false,
-                    "arclength" => true,
+                    "sequential" => Some(false),
+                    "arclength" => Some(true),
                     other => return Err(format!("unknown method `{other}`").into()),
                 }
             }
@@ -267,10 +271,10 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         }
         a.system = SystemKind::File(load_assembly(&path)?);
     }
-    if a.switch.is_some() && !a.arclength {
+    if a.switch.is_some() && a.arclength != Some(true) {
         return Err("--switch-at needs --method arclength".into());
     }
-    if a.parameter == Parameter::Energy && a.arclength {
+    if a.parameter == Parameter::Energy && a.arclength == Some(true) {
         return Err("--parameter energy is sequential: it takes no --method arclength".into());
     }
     Ok(Some(a))

@@ -65,7 +65,11 @@
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
-//! escape from internal-resonance stalls; its `event` column marks folds, jumps, grazing and
+//! escape from internal-resonance stalls, walking it back first where its start is found only
+//! above the first period's frequency. Without `--method` a run in the period is sequential,
+//! except for an assembly file whose branch cannot be entered at the first period
+//! (`modal::backbone_start`, `BackboneStart::moved_from`; the three-bar chain), which is
+//! followed by arclength, as stderr says; its `event` column marks folds, jumps, grazing and
 //! branch points (`branch-point`: the sign of the bordered Jacobian's determinant changed),
 //! and `--switch-at N[:SIDE]` leaves the branch at its `N`-th branch point for the branch
 //! crossing there, on side `SIDE` (`1`, the default, or `-1`) of its direction
@@ -82,7 +86,8 @@
 //! runs: each step starts from a converged neighbour and a failed step is skipped) or
 //! `--newton full` (`NewtonOptions::default`, the default of arclength runs, whose stall
 //! escapes solve from far starts). A failed sequential step is retried from up to
-//! `--retry-depth` earlier converged points (`SequentialOptions::retry_depth`, default 1; 0
+//! `--retry-depth` earlier converged points (default 1; 2 for a period backbone of a file
+//! with a bar held only by contacts, `BackboneOptions::for_mode`; 0
 //! switches the retry off). Where the machine has more than one core, the first retry runs on
 //! a second thread beside the first attempt (`backbone_speculative_with`; the same points, bit
 //! for bit); `--serial` keeps everything on one thread. A sequential run ends as stalled

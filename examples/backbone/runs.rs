@@ -2,12 +2,13 @@
 
 use crate::args::{Args, Parameter};
 use crate::output::{header, Sink};
-use crate::systems::{build_system, clamped_gap, default_periods, parameter_value};
+use crate::systems::{build_system, clamped_gap, default_periods, parameter_value, SystemKind};
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, backbone_speculative_with, backbone_with, energy_backbone_with,
-    genuine_subharmonic_backbone_with, parameter_branch, ArclengthBackboneOptions, BackboneOptions,
-    BackbonePoint, EnergyBackboneOptions, EnergyGrid, ParameterSteps, PeriodGrid,
+    arclength_backbone, backbone, backbone_from, backbone_speculative_with, backbone_start,
+    backbone_with, energy_backbone_with, genuine_subharmonic_backbone_with, parameter_branch,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, BackboneStart, EnergyBackboneOptions,
+    EnergyGrid, ParameterSteps, PeriodGrid,
 };
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::NonsmoothSystem;
@@ -38,20 +39,16 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         progress: a.progress,
         subharmonic: a.subharmonic,
     };
-    let solver = if a.dogleg {
-        Solver::Dogleg(Dogleg::default())
-    } else if a.fail_fast.unwrap_or(!a.arclength) {
-        // Sequential steps start from a converged neighbour: give up early.
-        Solver::Newton(SemismoothNewton::new(NewtonOptions::fail_fast())?)
-    } else {
-        // Arclength's stall escapes solve from far starts: the full budget.
-        Solver::Newton(SemismoothNewton::default())
+    let (arclength, start) = match a.arclength {
+        Some(arclength) => (arclength, None),
+        None => method_by_default(a, &system, t0)?,
     };
+    let solver = solver_for(a, arclength)?;
     if a.parameter == Parameter::Energy {
         run_energy(a, &system, solver, &mut sink)?;
     } else if a.parameter != Parameter::Omega {
         run_parameter(a, t0, solver, &mut sink)?;
-    } else if a.arclength {
+    } else if arclength {
         let (lo, hi) = (2.0 * PI / t0, 2.0 * PI / t1);
         let options = ArclengthBackboneOptions {
             start_period: t0,
@@ -74,6 +71,12 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             branch.end, branch.rejections
         );
     } else {
+        // The system's own defaults for a file; the shorthands hold no floating bar and keep
+        // the library's defaults without a linear analysis.
+        let defaults = match a.system {
+            SystemKind::File(_) => BackboneOptions::for_mode(&system, a.mode, a.subharmonic)?,
+            _ => BackboneOptions::default(),
+        };
         let options = BackboneOptions {
             grid: PeriodGrid {
                 start: t0,
@@ -82,10 +85,10 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             },
             mode: a.mode,
             subharmonic: a.subharmonic,
-            retry_depth: a.retry_depth,
+            retry_depth: a.retry_depth.unwrap_or(defaults.retry_depth),
             max_consecutive_failures: a.max_failures,
             selection: a.selection,
-            ..Default::default()
+            ..defaults
         };
         // The problem the rows are evaluated with (the runs keep their own).
         let mut problem = NonsmoothSystem::new(&system, a.settings)?;
@@ -93,6 +96,17 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let (_, end) = if a.subharmonic > 1 && !a.repeated {
             genuine_subharmonic_backbone_with(&system, a.settings, &options, solver, see)?
+        } else if let Some(start) = start {
+            let speculation = (!a.serial && cores >= 2).then(Speculation::default);
+            backbone_from(
+                &system,
+                a.settings,
+                &options,
+                start,
+                speculation,
+                solver,
+                see,
+            )?
         } else if a.serial || cores < 2 {
             backbone_with(&system, a.settings, &options, solver, see)?
         } else {
@@ -108,6 +122,54 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         return Err(e.into());
     }
     Ok((sink.total, sink.converged))
+}
+
+/// The solver of a run: `--solver`, with Newton's budget from `--newton` or, by default,
+/// fail-fast for sequential runs (each step starts from a converged neighbour) and full for
+/// arclength runs (their stall escapes solve from far starts).
+fn solver_for(a: &Args, arclength: bool) -> Result<Solver, Box<dyn std::error::Error>> {
+    Ok(if a.dogleg {
+        Solver::Dogleg(Dogleg::default())
+    } else if a.fail_fast.unwrap_or(!arclength) {
+        Solver::Newton(SemismoothNewton::new(NewtonOptions::fail_fast())?)
+    } else {
+        Solver::Newton(SemismoothNewton::default())
+    })
+}
+
+/// The method of a backbone in the period when `--method` is not given: sequential, except
+/// for an assembly file whose branch cannot be entered at the grid's first period `t0`
+/// (`modal::backbone_start` gets back to a higher frequency only, as on the three-bar chain,
+/// whose floating bar must be pushed hard enough to shuttle within a period). A period grid
+/// from `t0` would start off its branch; pseudo-arclength walks the branch back to `t0` and
+/// follows it through its folds. The shorthands (`--system`) have no floating bar and are
+/// always sequential; so are subharmonic runs and continuation in other parameters. Returns
+/// whether to use arclength and, for a sequential run, the start found (not searched again).
+fn method_by_default(
+    a: &Args,
+    system: &BarSystem,
+    t0: f64,
+) -> Result<(bool, Option<BackboneStart>), Box<dyn std::error::Error>> {
+    if !matches!(a.system, SystemKind::File(_))
+        || a.parameter != Parameter::Omega
+        || a.subharmonic != 1
+    {
+        return Ok((false, None));
+    }
+    let omega = 2.0 * PI / t0;
+    let floor = BackboneOptions::default().trivial_energy;
+    let solver = solver_for(a, false)?;
+    let start = backbone_start(system, a.settings, (a.mode, 1), omega, floor, &solver)?;
+    if !start.moved_from(omega) {
+        return Ok((false, Some(start)));
+    }
+    eprintln!(
+        "backbone: the branch is entered at T = {:.6}, not at the grid's first period \
+         {t0:.6}: it is followed by pseudo-arclength from T0 (--method sequential keeps \
+         the period grid)",
+        2.0 * PI / start.omega
+    );
+    Ok((true, None))
 }
 
 /// Continuation in the energy level `E / E_g` (the frequency an unknown).
@@ -132,7 +194,9 @@ fn run_energy(
         levels,
         mode: a.mode,
         subharmonic: a.subharmonic,
-        retry_depth: a.retry_depth,
+        retry_depth: a
+            .retry_depth
+            .unwrap_or(EnergyBackboneOptions::default().retry_depth),
         max_consecutive_failures: a.max_failures,
         ..Default::default()
     };
@@ -177,7 +241,7 @@ fn run_parameter(
         .clone();
     let family = move |v: f64| build_system(a, parameter, v);
     let (lo, hi) = a.parameter_range.unwrap_or((value / 10.0, value * 10.0));
-    let steps = if a.arclength {
+    let steps = if a.arclength == Some(true) {
         ParameterSteps::Arclength(ArclengthOptions {
             parameter_range: (lo, hi),
             ..a.driver
@@ -190,7 +254,9 @@ fn run_parameter(
             lo
         };
         let options = SequentialOptions {
-            retry_depth: a.retry_depth,
+            retry_depth: a
+                .retry_depth
+                .unwrap_or(SequentialOptions::default().retry_depth),
             max_consecutive_failures: a.max_failures,
             ..Default::default()
         };
@@ -214,7 +280,7 @@ fn run_parameter(
     )?;
     eprintln!(
         "backbone: {} ended: {:?}; {} rejected steps",
-        if a.arclength {
+        if a.arclength == Some(true) {
             "arclength"
         } else {
             "sequential"

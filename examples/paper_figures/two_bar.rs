@@ -153,10 +153,13 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     bb.legend = LegendPosition::UpperMiddle;
     let conv: Vec<&BackbonePoint> = tb.runs[0].converged().collect();
     // b, c, d, e: NSM1 points nearest Omega/omega_1 = 1.07, 1.2, 1.27, 1.33 (the paper's
-    // NSM1 panels, in frequency order); f: the first NSM2 sub-branch (bar 1's mode), g: the
-    // second (bar 2's), at the median energy of its converged points.
+    // NSM1 panels, in frequency order) off the internal-resonance spikes; f: the first NSM2
+    // sub-branch (bar 1's mode), g: the second (bar 2's), at the median energy of its
+    // converged points.
     let near = |target: f64| {
-        conv.iter()
+        (0..conv.len())
+            .filter(|&i| off_spike(&conv, i))
+            .map(|i| &conv[i])
             .min_by(|x, y| {
                 (x.omega / tb.w1 - target)
                     .abs()
@@ -582,4 +585,21 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
         w1,
     )?;
     Ok(stats)
+}
+
+/// Whether the `i`-th of a branch's converged points (in order along the branch) is off an
+/// internal-resonance spike: its energy is at most 1.5 times the median of its neighbours'
+/// (three on each side). Spikes carry extra energy in a resonant harmonic; the paper's
+/// lettered motions lie on the backbone between them.
+fn off_spike(points: &[&BackbonePoint], i: usize) -> bool {
+    let (lo, hi) = (i.saturating_sub(3), (i + 4).min(points.len()));
+    let mut around: Vec<f64> = (lo..hi)
+        .filter(|&j| j != i)
+        .map(|j| points[j].energy_normalized)
+        .collect();
+    if around.is_empty() {
+        return true;
+    }
+    around.sort_by(f64::total_cmp);
+    points[i].energy_normalized <= 1.5 * around[around.len() / 2]
 }

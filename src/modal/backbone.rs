@@ -2,18 +2,17 @@
 //! period, with energies normalised by the first grazing energy.
 
 use crate::continuation::{
-    linspace, Arclength, ArclengthOptions, Branch, EndReason, Observer, PeriodParametrised,
+    linspace, Arclength, ArclengthOptions, Branch, EndReason, Observer, PeriodParametrised, Point,
     Predictor, Rejection, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
 };
 use crate::error::{ContinuationError, Error};
 use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
 use crate::modal::escape::{EscapingArclength, StallEscape};
-use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
 use crate::modal::point::{Backbone, BackbonePoint};
-use crate::modal::start::{first_solution, StartGuesses, START_RATIOS};
+use crate::modal::start::{grazing_and_seed, usable_start, walk_back, BackboneStart};
 use crate::modal::switch::{Runner, SwitchAt};
-use crate::solve::{NonlinearSolver, SmoothingHomotopy};
+use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
 use std::f64::consts::PI;
@@ -59,7 +58,8 @@ pub struct BackboneOptions {
     /// Consecutive failures before the run stops (default 40).
     pub max_consecutive_failures: usize,
     /// Retry a failed step from up to this many earlier converged points
-    /// ([`SequentialOptions::retry_depth`]; default 1).
+    /// ([`SequentialOptions::retry_depth`]; default 1; [`BackboneOptions::for_mode`] derives
+    /// it from the system).
     pub retry_depth: usize,
     /// How a step chooses among the solutions reached from the prediction and the
     /// `retry_depth` earlier converged points ([`SequentialOptions::selection`]; default
@@ -122,7 +122,7 @@ pub fn backbone_with<S: NonlinearSolver>(
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let run = |mut driver: Sequential<_, S>, see: &mut dyn Observer| driver.run(see);
-    drive_backbone(system, settings, options, solver, run, observer)
+    drive_backbone(system, settings, (options, None), solver, run, observer)
 }
 
 /// [`backbone_with`] with the first retry of each failing step run on a second thread beside
@@ -144,7 +144,40 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
     let run = |driver: Sequential<_, S>, see: &mut dyn Observer| {
         Speculative::new(driver, speculation).run(see)
     };
-    drive_backbone(system, settings, options, solver, run, observer)
+    drive_backbone(system, settings, (options, None), solver, run, observer)
+}
+
+/// [`backbone_with`] (`speculation = None`) or [`backbone_speculative_with`] from a start
+/// found beforehand by [`backbone_start`](crate::modal::backbone_start) at the grid's first
+/// frequency, instead of searching it again: a caller who looked at the start (for instance
+/// to choose between this and [`arclength_backbone`] by
+/// [`BackboneStart::moved_from`]) does not pay for the search twice. The start's unknowns are
+/// the first step's guess.
+///
+/// # Errors
+/// See [`backbone_with`]; a start of the wrong size is
+/// [`ContinuationError::Dimension`].
+pub fn backbone_from<S: NonlinearSolver + Clone + Send + 'static>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: &BackboneOptions,
+    start: BackboneStart,
+    speculation: Option<Speculation>,
+    solver: S,
+    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+) -> Result<(f64, EndReason), Error> {
+    let run = |mut driver: Sequential<_, S>, see: &mut dyn Observer| match speculation {
+        Some(speculation) => Speculative::new(driver, speculation).run(see),
+        None => driver.run(see),
+    };
+    drive_backbone(
+        system,
+        settings,
+        (options, Some(start)),
+        solver,
+        run,
+        observer,
+    )
 }
 
 /// The driver of a sequential backbone (seed, grid, acceptance test, energies) with the loop
@@ -152,7 +185,7 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
 fn drive_backbone<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
-    options: &BackboneOptions,
+    (options, start): (&BackboneOptions, Option<BackboneStart>),
     solver: S,
     run: impl FnOnce(Sequential<PeriodParametrised<NonsmoothSystem>, S>, &mut dyn Observer) -> Branch,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
@@ -179,7 +212,7 @@ fn drive_backbone<S: NonlinearSolver>(
         check_frequency_of(&problem, 2.0 * PI / v)?;
     }
     let values = linspace(grid.start, grid.end, grid.steps)?;
-    let (e_g, start) = grazing_and_seed(
+    let (e_g, seed) = grazing_and_seed(
         &mut problem,
         options.mode,
         options.subharmonic,
@@ -187,13 +220,13 @@ fn drive_backbone<S: NonlinearSolver>(
     )?;
     let basis = problem.basis().clone();
     let floor = options.trivial_energy * e_g;
-    let (start, _) = usable_start(
-        &mut problem,
-        &solver,
-        (start, options.subharmonic),
-        2.0 * PI / grid.start,
-        floor,
-    );
+    let start = match start {
+        Some(given) => given.x,
+        None => {
+            let seed = (seed, options.subharmonic);
+            usable_start(&mut problem, &solver, seed, 2.0 * PI / grid.start, floor).0
+        }
+    };
     let seq_options = options.sequential();
     // The acceptance test computes each converged point's energy; the observer reuses it.
     let last_energy = Rc::new(RefCell::new((Vec::new(), f64::NAN, f64::NAN)));
@@ -240,78 +273,6 @@ fn drive_backbone<S: NonlinearSolver>(
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
     });
     Ok((e_g, branch.end))
-}
-
-/// The guess of a period backbone's first step at `omega`. For a system with a bar held only
-/// by contacts (a rigid-body mode of the open-contact system), the grazing seed can slide to
-/// the bar at rest against an obstacle (the free-free bar between two walls): there the seed
-/// is kept where `solver` takes it to a motion of energy above `floor`, else the first such
-/// solution from the guesses of the energy backbone's start around the seed
-/// ([`START_AMPLITUDES`](crate::modal::START_AMPLITUDES); the rigid-body motions added),
-/// solved by `solver` and then by it inside a [`SmoothingHomotopy`], at `omega` and then at
-/// the higher frequencies of [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the
-/// first), walked back to `omega` in a few steps (as far as they converge); else the seed.
-/// Other systems (the paper's three) keep the seed, without a solve. Returns the guess and
-/// the frequency it was last solved at (`omega` for the seed).
-fn usable_start<S: NonlinearSolver>(
-    problem: &mut NonsmoothSystem,
-    solver: &S,
-    (seed, subharmonic): (Vec<f64>, usize),
-    omega: f64,
-    floor: f64,
-) -> (Vec<f64>, f64) {
-    let guesses = StartGuesses::new(problem.system());
-    if !guesses.floating() {
-        return (seed, omega);
-    }
-    let (system, basis) = (problem.system().clone(), problem.basis().clone());
-    let mut above_rest =
-        |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, omega) > floor;
-    if first_solution(problem, &[solver], [seed.clone()], omega, &mut above_rest).is_some() {
-        return (seed, omega);
-    }
-    let homotopy = SmoothingHomotopy::new(solver);
-    let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
-    let found = guesses.ratios().into_iter().find_map(|r| {
-        let at = omega * r / START_RATIOS[0];
-        let above_rest =
-            |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, at) > floor;
-        let tries = guesses.around(problem, &seed, subharmonic);
-        first_solution(problem, &solvers, tries, at, above_rest).map(|x| (x, at))
-    });
-    let Some((mut x, from)) = found else {
-        return (seed, omega);
-    };
-    // Walk the solution back to `omega` in a few steps, each from the last.
-    const WALK: usize = 8;
-    let mut reached = from;
-    for k in 1..=WALK {
-        let at = from + (omega - from) * k as f64 / WALK as f64;
-        let above_rest =
-            |_: &mut NonsmoothSystem, y: &[f64]| energy(&system, &basis, y, at) > floor;
-        match first_solution(problem, &solvers, [x.clone()], at, above_rest) {
-            Some(y) => (x, reached) = (y, at),
-            None => break,
-        }
-    }
-    (x, reached)
-}
-
-/// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
-/// `subharmonic` at `omega`, reusing the first linear mode (found for `E_g`) when `mode == 1`.
-fn grazing_and_seed(
-    problem: &mut NonsmoothSystem,
-    mode: usize,
-    subharmonic: usize,
-    omega: f64,
-) -> Result<(f64, Vec<f64>), Error> {
-    let (e_g, first_mode) = grazing_energy(problem.system())?;
-    let seed = if mode == 1 {
-        seed_from_mode(problem, &first_mode, subharmonic, omega)?
-    } else {
-        branch_seed(problem, mode, subharmonic, omega)?
-    };
-    Ok((e_g, seed))
 }
 
 /// [`backbone_with`] collecting every point: a run that stalls returns what it computed, with
@@ -456,16 +417,42 @@ pub fn arclength_backbone_observed<S: NonlinearSolver>(
         omega0,
         floor,
     );
+    // Where the start lies beyond the asked frequency, the branch is first walked back to it.
+    let (walked, walk_rejections) = walk_back(
+        &problem,
+        &solver,
+        (&start, omega0),
+        2.0 * PI / options.start_period,
+        arclength,
+        (options.escape, floor),
+    );
     let (accept_system, accept_basis) = (system.clone(), basis.clone());
     let driver = Arclength::new(problem, solver, start, omega0, arclength)?
         .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
+    let offset = walked.len();
+    let backbone_point = |p: &Point, offset: usize| {
+        let e = energy(system, &basis, &p.x, p.parameter);
+        let mut point = BackbonePoint::from_point(p, p.parameter, e, e_g);
+        point.step += offset;
+        point
+    };
+    for (k, p) in walked.iter().enumerate() {
+        if observer.point(&backbone_point(p, 0)).is_break() {
+            let points = walked[..=k].to_vec();
+            let end = EndReason::StoppedByObserver;
+            let rejections = walk_rejections;
+            return Ok((
+                e_g,
+                Branch {
+                    points,
+                    rejections,
+                    end,
+                },
+            ));
+        }
+    }
     let mut see = |step: &Step| match step {
-        Step::Accepted(p) => observer.point(&BackbonePoint::from_point(
-            p,
-            p.parameter,
-            energy(system, &basis, &p.x, p.parameter),
-            e_g,
-        )),
+        Step::Accepted(p) => observer.point(&backbone_point(p, offset)),
         Step::Rejected(r) => observer.rejected(r),
         Step::Finished(_) => ControlFlow::Continue(()),
     };
@@ -473,6 +460,11 @@ pub fn arclength_backbone_observed<S: NonlinearSolver>(
         Some(escape) => Runner::Escaping(EscapingArclength::new(driver, escape)?),
         None => Runner::Plain(driver),
     };
-    let branch = runner.run_switching(options.switch, &mut see)?;
+    let mut branch = runner.run_switching(options.switch, &mut see)?;
+    for p in &mut branch.points {
+        p.step += offset;
+    }
+    branch.points.splice(0..0, walked);
+    branch.rejections += walk_rejections;
     Ok((e_g, branch))
 }

@@ -1,5 +1,6 @@
 //! Defaults derived from the system: the period grid and the arclength range of a backbone
-//! from the system's own linear mode, rather than the clamped bar's numbers.
+//! from the system's own linear mode, rather than the clamped bar's numbers, and the depth of
+//! a period backbone's retries from whether a bar is held only by contacts.
 //!
 //! A nonsmooth mode leaves its linear mode at the grazing point, at the linear period
 //! `K T_i` (`T_i = 2 pi / omega_i` of the open-contact mode `i`, `K` the subharmonic order)
@@ -10,8 +11,9 @@
 //! (`4.000000000000001 -> 4`) and the clamped bar gets the paper's grid exactly.
 
 use crate::error::SettingsError;
-use crate::modal::backbone::{ArclengthBackboneOptions, PeriodGrid};
+use crate::modal::backbone::{ArclengthBackboneOptions, BackboneOptions, PeriodGrid};
 use crate::modal::linear::open_mode;
+use crate::modal::start::StartGuesses;
 use crate::system::BarSystem;
 use std::f64::consts::PI;
 
@@ -62,6 +64,43 @@ impl PeriodGrid {
             start: fraction(period, START),
             end: fraction(period, END),
             steps: STEPS,
+        })
+    }
+}
+
+/// Retry depth of a period backbone on a system with a bar held only by contacts (a
+/// rigid-body mode of the open-contact system): [`BackboneOptions::for_mode`].
+pub const FLOATING_RETRY_DEPTH: usize = 2;
+
+impl BackboneOptions {
+    /// The default options for NSM `mode` sub `subharmonic` of `system`: the grid
+    /// [`PeriodGrid::for_mode`], and failed steps retried from up to
+    /// [`FLOATING_RETRY_DEPTH`] earlier converged points on a system with a bar held only by
+    /// contacts (1, the default, otherwise). Such a bar's flights between impacts make the
+    /// truncated branch's internal resonances frequent: on the free-free bar between two
+    /// walls the second retry converges 173 of 181 steps at `m = 40` instead of 162, and 125
+    /// at `m = 80` instead of 92. On the paper's systems it gains 3 to 4 steps at `m = 40`
+    /// and 80 for about 15 % more time, and their backbones keep one retry
+    /// (`docs/performance.md`, "Retry depth"). For the clamped bar these are the defaults.
+    ///
+    /// # Errors
+    /// See [`linear_period`].
+    pub fn for_mode(
+        system: &BarSystem,
+        mode: usize,
+        subharmonic: usize,
+    ) -> Result<Self, SettingsError> {
+        let floating = StartGuesses::new(system).floating();
+        Ok(Self {
+            grid: PeriodGrid::for_mode(system, mode, subharmonic)?,
+            mode,
+            subharmonic,
+            retry_depth: if floating {
+                FLOATING_RETRY_DEPTH
+            } else {
+                Self::default().retry_depth
+            },
+            ..Self::default()
         })
     }
 }

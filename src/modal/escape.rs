@@ -9,7 +9,8 @@
 //! more energy than the backbone they leave) and from the most advanced point reached, it
 //! solves at fixed parameter a little beyond the most advanced parameter
 //! ([`Arclength::solve_at`]), doubling the distance while the solves fail or land on a state
-//! more than `max_norm_ratio` times larger than their start; it then continues from there
+//! more than `max_norm_ratio` times larger than their start (a distance that passes the end
+//! of the parameter range is tried at the end itself, once); it then continues from there
 //! ([`Arclength::restart_from`]) and reports [`Event::Jump`] on that point. The run ends with
 //! [`EndReason::Stalled`] when every attempt fails.
 
@@ -235,11 +236,11 @@ impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
             .fold(f64::NEG_INFINITY, f64::max);
         let mut distance = escape.jump * driver.parameter_scale();
         for _ in 0..escape.max_attempts {
-            // `ahead` and `distance` are in progress coordinates `dir * lambda`.
-            let target = dir * (ahead + distance);
-            if target < lo || target > hi {
-                return self.finish(EndReason::ParameterOutOfRange { parameter: target });
-            }
+            // `ahead` and `distance` are in progress coordinates `dir * lambda`. A jump past
+            // the end of the range is tried once at the end itself.
+            let beyond = dir * (ahead + distance);
+            let target = beyond.clamp(lo, hi);
+            let last = target != beyond;
             for (_, from) in &anchors {
                 let mut x = from.clone();
                 let Ok(info) = driver.solve_at(&mut x, target) else {
@@ -267,6 +268,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
                     point.events.push(Event::Jump { ratio });
                     return Step::Accepted(point);
                 }
+            }
+            if last {
+                return self.finish(EndReason::ParameterOutOfRange { parameter: beyond });
             }
             distance *= 2.0;
         }
@@ -333,8 +337,13 @@ mod tests {
     }
 
     fn driver(max_steps: usize) -> Arclength<Hyperbola, SemismoothNewton> {
+        driver_to(1.5, max_steps)
+    }
+
+    /// The driver on the hyperbola inside `[-1, hi]`.
+    fn driver_to(hi: f64, max_steps: usize) -> Arclength<Hyperbola, SemismoothNewton> {
         let options = ArclengthOptions {
-            parameter_range: (-1.0, 1.5),
+            parameter_range: (-1.0, hi),
             scale: ArclengthScale::Fixed(1.0, 1.0),
             ds_max: 0.05,
             max_steps,
@@ -390,6 +399,28 @@ mod tests {
             plain.points[..n],
             branch.points[..n],
             "the same points before it"
+        );
+    }
+
+    /// Where the range ends between two of the doubling jump distances (here the jumps
+    /// before it land too far out on the branch above `lambda = 1`, the one after it leaves
+    /// the range), the jump is tried at the range's end and lands there: the branch is not
+    /// given up before its end.
+    #[test]
+    fn a_jump_past_the_range_is_tried_at_its_end() {
+        let hi = 1.0042;
+        let mut run = EscapingArclength::new(driver_to(hi, 2000), StallEscape::default()).unwrap();
+        let branch = run.run(&mut crate::continuation::quiet);
+        let last = branch.points.last().unwrap();
+        assert_eq!(last.parameter, hi, "{:?}", branch.end);
+        assert!(last.events.iter().any(|e| matches!(e, Event::Jump { .. })));
+        let mut f = [0.0];
+        Hyperbola { lambda: hi }.residual(&last.x, &mut f);
+        assert!(f[0].abs() < 1e-9, "on the curve: {}", f[0]);
+        assert!(
+            matches!(branch.end, EndReason::ParameterOutOfRange { parameter } if parameter > hi),
+            "{:?}",
+            branch.end
         );
     }
 

@@ -19,10 +19,11 @@ mod subharmonic;
 mod switch;
 
 pub use backbone::{
-    arclength_backbone, arclength_backbone_observed, backbone, backbone_speculative_with,
-    backbone_with, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PeriodGrid,
+    arclength_backbone, arclength_backbone_observed, backbone, backbone_from,
+    backbone_speculative_with, backbone_with, ArclengthBackboneOptions, BackboneObserver,
+    BackboneOptions, PeriodGrid,
 };
-pub use defaults::linear_period;
+pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,
 };
@@ -44,7 +45,8 @@ pub use signature::{
     contact_intervals, harmonic_energies, harmonic_energies_by_bar, subharmonic_share,
 };
 pub use start::{
-    FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
+    backbone_start, BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES,
+    START_AMPLITUDES, START_RATIOS,
 };
 pub use subharmonic::{
     genuine_subharmonic_backbone, genuine_subharmonic_backbone_with, leave_subspace,

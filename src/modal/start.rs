@@ -1,11 +1,21 @@
-//! The guesses that start a branch, for the energy and the period backbones alike: the grazing seed of a linear mode at a few frequencies
-//! and amplitudes, with the motions of floating bars added where the system has any.
+//! Where a branch starts: the guesses of the energy and the period backbones alike (the
+//! grazing seed of a linear mode at a few frequencies and amplitudes, with the motions of
+//! floating bars added where the system has any), the start they lead to, and the walk back
+//! along the branch of an arclength backbone whose start lies beyond the asked frequency.
 
-use crate::continuation::ContinuationProblem;
+use crate::continuation::{
+    Arclength, ArclengthOptions, Branch, ContinuationProblem, Event, Point, Step,
+};
+use crate::error::{ContinuationError, Error};
 use crate::fourier::Basis;
-use crate::modal::linear::{add_on_harmonic, rigid_body_modes, ContactState};
-use crate::solve::NonlinearSolver;
-use crate::system::{BarSystem, NonsmoothSystem};
+use crate::modal::energy::energy;
+use crate::modal::escape::{EscapingArclength, StallEscape};
+use crate::modal::linear::{
+    add_on_harmonic, branch_seed, grazing_energy, rigid_body_modes, seed_from_mode, ContactState,
+};
+use crate::solve::{NonlinearSolver, SmoothingHomotopy};
+use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
+use std::ops::ControlFlow;
 
 /// Frequencies of the start, relative to the linear mode's: `80/79`, `40/39` and `20/19`
 /// (periods `79/80`, `39/40` and `19/20` of the mode's, the first of them the period
@@ -126,4 +136,281 @@ pub(crate) fn first_solution(
         }
     }
     None
+}
+
+/// The guess of a period backbone's first step at `omega`. For a system with a bar held only
+/// by contacts (a rigid-body mode of the open-contact system), the grazing seed can slide to
+/// the bar at rest against an obstacle (the free-free bar between two walls): there the seed
+/// is kept where `solver` takes it to a motion of energy above `floor`, else the first such
+/// solution from the guesses of the energy backbone's start around the seed
+/// ([`START_AMPLITUDES`](crate::modal::START_AMPLITUDES); the rigid-body motions added),
+/// solved by `solver` and then by it inside a [`SmoothingHomotopy`], at `omega` and then at
+/// the higher frequencies of [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the
+/// first), walked back to `omega` in a few steps (as far as they converge); else the seed.
+/// Other systems (the paper's three) keep the seed, without a solve. Returns the guess and
+/// the frequency it was last solved at (`omega` for the seed).
+pub(crate) fn usable_start<S: NonlinearSolver>(
+    problem: &mut NonsmoothSystem,
+    solver: &S,
+    (seed, subharmonic): (Vec<f64>, usize),
+    omega: f64,
+    floor: f64,
+) -> (Vec<f64>, f64) {
+    let guesses = StartGuesses::new(problem.system());
+    if !guesses.floating() {
+        return (seed, omega);
+    }
+    let (system, basis) = (problem.system().clone(), problem.basis().clone());
+    let mut above_rest =
+        |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, omega) > floor;
+    if first_solution(problem, &[solver], [seed.clone()], omega, &mut above_rest).is_some() {
+        return (seed, omega);
+    }
+    let homotopy = SmoothingHomotopy::new(solver);
+    let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
+    let found = guesses.ratios().into_iter().find_map(|r| {
+        let at = omega * r / START_RATIOS[0];
+        let above_rest =
+            |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, at) > floor;
+        let tries = guesses.around(problem, &seed, subharmonic);
+        first_solution(problem, &solvers, tries, at, above_rest).map(|x| (x, at))
+    });
+    let Some((mut x, from)) = found else {
+        return (seed, omega);
+    };
+    // Walk the solution back to `omega` in a few steps, each from the last.
+    const WALK: usize = 8;
+    let mut reached = from;
+    for k in 1..=WALK {
+        let at = from + (omega - from) * k as f64 / WALK as f64;
+        let above_rest =
+            |_: &mut NonsmoothSystem, y: &[f64]| energy(&system, &basis, y, at) > floor;
+        match first_solution(problem, &solvers, [x.clone()], at, above_rest) {
+            Some(y) => (x, reached) = (y, at),
+            None => break,
+        }
+    }
+    (x, reached)
+}
+
+/// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
+/// `subharmonic` at `omega`, reusing the first linear mode (found for `E_g`) when `mode == 1`.
+pub(crate) fn grazing_and_seed(
+    problem: &mut NonsmoothSystem,
+    mode: usize,
+    subharmonic: usize,
+    omega: f64,
+) -> Result<(f64, Vec<f64>), Error> {
+    let (e_g, first_mode) = grazing_energy(problem.system())?;
+    let seed = if mode == 1 {
+        seed_from_mode(problem, &first_mode, subharmonic, omega)?
+    } else {
+        branch_seed(problem, mode, subharmonic, omega)?
+    };
+    Ok((e_g, seed))
+}
+
+/// Where a backbone's branch starts: a guess and the frequency it was last solved at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BackboneStart {
+    /// The unknowns of the start (for a system without a floating bar: the grazing seed,
+    /// unsolved).
+    pub x: Vec<f64>,
+    /// The frequency `Omega` of the start: the asked one, or a higher one where a floating
+    /// bar's branch could be entered only there.
+    pub omega: f64,
+}
+
+impl BackboneStart {
+    /// Whether the branch could be entered only away from the asked frequency `omega` (more
+    /// than `1e-9` relative): a family that does not leave the grazing point there, as on an
+    /// assembly whose floating bar must be pushed hard enough to shuttle within a period.
+    pub fn moved_from(&self, omega: f64) -> bool {
+        (self.omega - omega).abs() > 1e-9 * omega.abs()
+    }
+}
+
+/// The start of the backbone of NSM `mode` sub `subharmonic` at frequency `omega`, as the
+/// period and arclength backbones find it: the grazing seed of the linear mode; for a system
+/// with a bar held only by contacts (a rigid-body mode) the first motion of energy above
+/// `trivial_energy * E_g` reached from the guesses of [`START_RATIOS`] x
+/// [`START_AMPLITUDES`] (with [`FLOATING_RATIOS`], [`FLOATING_AMPLITUDES`] and the rigid-body
+/// motions of [`RIGID_AMPLITUDES`] added), walked back towards `omega` as far as it
+/// converges. [`BackboneStart::moved_from`] tells whether it got back to `omega`: where it
+/// did not, a period grid from `omega` starts off its branch, and pseudo-arclength
+/// ([`crate::modal::arclength_backbone`], which walks the branch back to `omega`) is the
+/// backbone to use.
+///
+/// # Errors
+/// Invalid settings, no linear mode `mode`, a `trivial_energy` that is negative or not
+/// finite, a non-positive or non-finite `omega`.
+pub fn backbone_start<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    (mode, subharmonic): (usize, usize),
+    omega: f64,
+    trivial_energy: f64,
+    solver: &S,
+) -> Result<BackboneStart, Error> {
+    let mut problem = NonsmoothSystem::new(system, settings)?;
+    if !(trivial_energy.is_finite() && trivial_energy >= 0.0) {
+        return Err(ContinuationError::InvalidOption {
+            what: "trivial_energy",
+            value: trivial_energy,
+        }
+        .into());
+    }
+    crate::modal::diagnostics::check_frequency_of(&problem, omega)?;
+    let (e_g, seed) = grazing_and_seed(&mut problem, mode, subharmonic, omega)?;
+    let (x, omega) = usable_start(
+        &mut problem,
+        solver,
+        (seed, subharmonic),
+        omega,
+        trivial_energy * e_g,
+    );
+    Ok(BackboneStart { x, omega })
+}
+
+/// The walk back of an arclength backbone whose start `(x, from)` lies beyond the asked
+/// frequency `omega` in the run's direction `options.direction`: the branch is followed the
+/// other way (with the stall escape, if any) until it leaves the range between `omega` and
+/// the far end of `options.parameter_range`. Returns the walk as the first part of the run:
+/// its points from the far end back to the one before the start, in the run's direction and
+/// numbered from 0 ([`reversed`]), and the walk's rejected steps. The run then goes on from
+/// the start, so that the branch between `omega` and `from` is not lost. A start not beyond
+/// `omega`, or one the driver cannot start from, has no walk.
+pub(crate) fn walk_back<S: NonlinearSolver>(
+    problem: &NonsmoothSystem,
+    solver: &S,
+    (x, from): (&[f64], f64),
+    omega: f64,
+    options: ArclengthOptions,
+    (escape, floor): (Option<StallEscape>, f64),
+) -> (Vec<Point>, usize) {
+    let direction = options.direction.signum();
+    if (from - omega) * direction <= 0.0 {
+        return (Vec::new(), 0);
+    }
+    let (lo, hi) = options.parameter_range;
+    let walk = ArclengthOptions {
+        direction: -direction,
+        parameter_range: if direction > 0.0 {
+            (omega.max(lo), hi)
+        } else {
+            (lo, omega.min(hi))
+        },
+        branch_points: false,
+        ..options
+    };
+    let (system, basis) = (problem.system().clone(), problem.basis().clone());
+    let driver = match Arclength::new(problem.clone(), solver, x.to_vec(), from, walk) {
+        Ok(driver) => driver.with_acceptance(move |y, at| energy(&system, &basis, y, at) > floor),
+        Err(_) => return (Vec::new(), 0),
+    };
+    let mut go_on = |_: &Step| ControlFlow::Continue(());
+    let mut branch: Branch = match escape {
+        Some(escape) => match EscapingArclength::new(driver, escape) {
+            Ok(mut escaping) => escaping.run(&mut go_on),
+            Err(_) => return (Vec::new(), 0),
+        },
+        None => {
+            let mut plain = driver;
+            plain.run(&mut go_on)
+        }
+    };
+    // The walk's first point is the start, which the run itself begins with.
+    if !branch.points.is_empty() {
+        branch.points.remove(0);
+    }
+    (reversed(branch.points), branch.rejections)
+}
+
+/// Points of a branch in the opposite order, numbered from 0, each event moved to the point
+/// that now follows it (an event is reported on the point after it) with its sense turned:
+/// a contact that appeared now vanishes, a fold is at its new point's parameter.
+pub(crate) fn reversed(mut points: Vec<Point>) -> Vec<Point> {
+    let mut events: Vec<Vec<Event>> = points
+        .iter_mut()
+        .map(|p| std::mem::take(&mut p.events))
+        .collect();
+    points.reverse();
+    events.reverse();
+    for (k, p) in points.iter_mut().enumerate() {
+        p.step = k;
+        // Point `n - 1 - k` of the old order is now at `k`; the events between it and the
+        // old point after it (reported on that one, now at `k - 1`) are now reported on it.
+        let moved = if k >= 1 {
+            std::mem::take(&mut events[k - 1])
+        } else {
+            Vec::new()
+        };
+        p.events = moved
+            .into_iter()
+            .map(|e| match e {
+                Event::Fold { .. } => Event::Fold {
+                    parameter: p.parameter,
+                },
+                Event::BranchPoint { .. } => Event::BranchPoint {
+                    parameter: p.parameter,
+                },
+                Event::Grazing { law, contact } => Event::Grazing {
+                    law,
+                    contact: !contact,
+                },
+                other => other,
+            })
+            .collect();
+    }
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(step: usize, parameter: f64, events: Vec<Event>) -> Point {
+        Point {
+            step,
+            parameter,
+            x: vec![parameter],
+            residual_norm: 0.0,
+            iterations: 1,
+            converged: true,
+            error: None,
+            step_size: 0.1,
+            events,
+        }
+    }
+
+    /// Reversed, the points are renumbered from 0 and each event is reported on the point
+    /// that now follows it, in its new sense.
+    #[test]
+    fn reversed_points_carry_their_events_the_other_way() {
+        let appears = Event::Grazing {
+            law: 0,
+            contact: true,
+        };
+        let walk = vec![
+            point(1, 1.0, Vec::new()),
+            point(2, 0.9, vec![appears]),
+            point(3, 0.8, vec![Event::Fold { parameter: 0.8 }]),
+            point(4, 0.7, vec![Event::Jump { ratio: 5.0 }]),
+        ];
+        let back = reversed(walk);
+        let parameters: Vec<f64> = back.iter().map(|p| p.parameter).collect();
+        assert_eq!(parameters, [0.7, 0.8, 0.9, 1.0]);
+        assert!(back.iter().enumerate().all(|(k, p)| p.step == k));
+        // Between 0.8 and 0.7 (reported on 0.7 going down): now reported on 0.8.
+        assert!(back[0].events.is_empty());
+        assert_eq!(back[1].events, [Event::Jump { ratio: 5.0 }]);
+        assert_eq!(back[2].events, [Event::Fold { parameter: 0.9 }]);
+        assert_eq!(
+            back[3].events,
+            [Event::Grazing {
+                law: 0,
+                contact: false
+            }]
+        );
+    }
 }
