@@ -7,8 +7,8 @@ use nonsmooth_modes::bc::{
 use nonsmooth_modes::continuation::{linspace, ContinuationProblem, Sequential, SequentialOptions};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{
-    backbone, branch_seed, grazing_energy, natural_frequencies, BackboneOptions, ContactState,
-    PeriodGrid,
+    arclength_backbone, backbone, branch_seed, grazing_energy, natural_frequencies,
+    ArclengthBackboneOptions, BackboneOptions, ContactState, PeriodGrid,
 };
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{
@@ -880,6 +880,27 @@ fn bad_period_grids() {
         )
         .unwrap_err()
         {
+            Error::Continuation(ContinuationError::InvalidOption { what, value }) => {
+                assert_eq!(what, "trivial_energy");
+                assert!(same(value, v));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    // The arclength backbone checks the same floor.
+    for v in [-1.0, f64::NAN, f64::INFINITY] {
+        let options = ArclengthBackboneOptions {
+            trivial_energy: v,
+            ..Default::default()
+        };
+        let result = arclength_backbone(
+            &system,
+            settings,
+            &options,
+            SemismoothNewton::default(),
+            |_| std::ops::ControlFlow::Continue(()),
+        );
+        match result.unwrap_err() {
             Error::Continuation(ContinuationError::InvalidOption { what, value }) => {
                 assert_eq!(what, "trivial_energy");
                 assert!(same(value, v));

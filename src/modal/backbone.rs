@@ -10,7 +10,9 @@ use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::point::{Backbone, BackbonePoint};
-use crate::modal::start::{grazing_and_seed, usable_start, walk_back, BackboneStart};
+use crate::modal::start::{
+    check_trivial_energy, grazing_and_seed, usable_start, walk_back, BackboneStart,
+};
 use crate::modal::switch::{Runner, SwitchAt};
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
@@ -201,13 +203,7 @@ fn drive_backbone<S: NonlinearSolver>(
             .into());
         }
     }
-    if !(options.trivial_energy.is_finite() && options.trivial_energy >= 0.0) {
-        return Err(ContinuationError::InvalidOption {
-            what: "trivial_energy",
-            value: options.trivial_energy,
-        }
-        .into());
-    }
+    check_trivial_energy(options.trivial_energy)?;
     for v in [grid.start, grid.end] {
         check_frequency_of(&problem, 2.0 * PI / v)?;
     }
@@ -408,7 +404,7 @@ pub fn arclength_backbone_observed<S: NonlinearSolver>(
     if let Some(escape) = options.escape {
         escape.validate()?;
     }
-    let floor = options.trivial_energy * e_g;
+    let floor = check_trivial_energy(options.trivial_energy)? * e_g;
     // A floating bar's branch may start only at a higher frequency than asked.
     let (start, omega0) = usable_start(
         &mut problem,

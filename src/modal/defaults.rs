@@ -80,7 +80,7 @@ impl BackboneOptions {
     /// truncated branch's internal resonances frequent: on the free-free bar between two
     /// walls the second retry converges 173 of 181 steps at `m = 40` instead of 162, and 125
     /// at `m = 80` instead of 92. On the paper's systems it gains 3 to 4 steps at `m = 40`
-    /// and 80 for about 15 % more time, and their backbones keep one retry
+    /// and 80 for 12 to 20 % more time, and their backbones keep one retry
     /// (`docs/performance.md`, "Retry depth"). For the clamped bar these are the defaults.
     ///
     /// # Errors

@@ -210,6 +210,19 @@ pub(crate) fn grazing_and_seed(
     Ok((e_g, seed))
 }
 
+/// The fraction of `E_g` below which a backbone's point counts as at rest, checked: finite
+/// and not negative.
+pub(crate) fn check_trivial_energy(trivial_energy: f64) -> Result<f64, ContinuationError> {
+    if trivial_energy.is_finite() && trivial_energy >= 0.0 {
+        Ok(trivial_energy)
+    } else {
+        Err(ContinuationError::InvalidOption {
+            what: "trivial_energy",
+            value: trivial_energy,
+        })
+    }
+}
+
 /// Where a backbone's branch starts: a guess and the frequency it was last solved at.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BackboneStart {
@@ -253,13 +266,7 @@ pub fn backbone_start<S: NonlinearSolver>(
     solver: &S,
 ) -> Result<BackboneStart, Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
-    if !(trivial_energy.is_finite() && trivial_energy >= 0.0) {
-        return Err(ContinuationError::InvalidOption {
-            what: "trivial_energy",
-            value: trivial_energy,
-        }
-        .into());
-    }
+    check_trivial_energy(trivial_energy)?;
     crate::modal::diagnostics::check_frequency_of(&problem, omega)?;
     let (e_g, seed) = grazing_and_seed(&mut problem, mode, subharmonic, omega)?;
     let (x, omega) = usable_start(
@@ -329,7 +336,7 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
 /// Points of a branch in the opposite order, numbered from 0, each event moved to the point
 /// that now follows it (an event is reported on the point after it) with its sense turned:
 /// a contact that appeared now vanishes, a fold is at its new point's parameter.
-pub(crate) fn reversed(mut points: Vec<Point>) -> Vec<Point> {
+fn reversed(mut points: Vec<Point>) -> Vec<Point> {
     let mut events: Vec<Vec<Event>> = points
         .iter_mut()
         .map(|p| std::mem::take(&mut p.events))
