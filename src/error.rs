@@ -175,6 +175,39 @@ pub enum SettingsError {
         /// Solves tried.
         attempts: usize,
     },
+    /// No start of a frequency-parametrised backbone: every guess tried (the linear mode's
+    /// grazing seed at the asked frequency, then scaled, at higher frequencies and with the
+    /// floating bars set moving) led the solver to the state of rest or did not converge.
+    #[error(
+        "no start for the branch at Omega = {omega}: of {attempts} solves at frequencies up \
+         to {up_to}, {at_rest} reached the state of rest (a motion that does not touch) and \
+         {failed} did not converge"
+    )]
+    StartNotFound {
+        /// The asked frequency.
+        omega: f64,
+        /// The highest frequency tried.
+        up_to: f64,
+        /// Solves tried.
+        attempts: usize,
+        /// Solves that converged to the state of rest.
+        at_rest: usize,
+        /// Solves that did not converge.
+        failed: usize,
+    },
+    /// The open-contact system has a rigid-body motion along which no contact gap closes:
+    /// the bars it moves are held from one side only (a free end, or a contact that can
+    /// push them but never pull them back), so they can drift away and no periodic motion
+    /// touches them.
+    #[error(
+        "bars {bars:?} (0-based) can drift away: a rigid-body motion of theirs closes no contact \
+         gap, so no periodic motion touches them; hold them from both sides (a wall, a \
+         contact, a spring or a clamp)"
+    )]
+    Unconfined {
+        /// The bars the drift moves (0-based indices).
+        bars: Vec<usize>,
+    },
     /// The seed's harmonic exceeds the basis.
     #[error(
         "subharmonic {subharmonic} needs harmonic {subharmonic} but the basis stops at {harmonics}"

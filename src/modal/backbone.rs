@@ -115,7 +115,11 @@ impl Default for BackboneOptions {
 /// [`EndReason::Stalled`], not an error: its points have been handed over).
 ///
 /// # Errors
-/// Invalid settings or options, or a failed seed: nothing was computed.
+/// Invalid settings or options, a failed seed or an assembly with a bar that can drift away
+/// ([`SettingsError::Unconfined`](crate::SettingsError::Unconfined)): nothing was computed.
+/// [`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound) if the start search
+/// found no motion in contact near the first period and no step of the grid converged
+/// either (the steps were handed to `observer`, each with its status).
 pub fn backbone_with<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
@@ -216,11 +220,17 @@ fn drive_backbone<S: NonlinearSolver>(
     )?;
     let basis = problem.basis().clone();
     let floor = options.trivial_energy * e_g;
-    let start = match start {
-        Some(given) => given.x,
+    // Where no start is found near the first period, the grid itself searches on from the
+    // seed: it may enter the branch further on. A run that never does ends on the search's
+    // error, not on points at rest.
+    let (start, not_found) = match start {
+        Some(given) => (given.x, None),
         None => {
-            let seed = (seed, options.subharmonic);
-            usable_start(&mut problem, &solver, seed, 2.0 * PI / grid.start, floor).0
+            let guess = (seed.clone(), options.subharmonic);
+            match usable_start(&mut problem, &solver, guess, 2.0 * PI / grid.start, floor) {
+                Ok((x, _)) => (x, None),
+                Err(e) => (seed, Some(e)),
+            }
         }
     };
     let seq_options = options.sequential();
@@ -256,10 +266,12 @@ fn drive_backbone<S: NonlinearSolver>(
         }
     });
     // Converged points and the solver's last iterates of failed steps alike.
+    let mut entered = false;
     let branch = run(driver, &mut |step: &Step| {
         let Some(p) = step.point() else {
             return ControlFlow::Continue(());
         };
+        entered |= p.converged;
         let omega = 2.0 * PI / p.parameter;
         let known = {
             let last = last_energy.borrow();
@@ -268,7 +280,10 @@ fn drive_backbone<S: NonlinearSolver>(
         let e = known.unwrap_or_else(|| energy(system, &basis, &p.x, omega));
         observer(&BackbonePoint::from_point(p, omega, e, e_g))
     });
-    Ok((e_g, branch.end))
+    match not_found {
+        Some(e) if !entered => Err(e.into()),
+        _ => Ok((e_g, branch.end)),
+    }
 }
 
 /// [`backbone_with`] collecting every point: a run that stalls returns what it computed, with
@@ -412,7 +427,7 @@ pub fn arclength_backbone_observed<S: NonlinearSolver>(
         (start, options.subharmonic),
         omega0,
         floor,
-    );
+    )?;
     // Where the start lies beyond the asked frequency, the branch is first walked back to it.
     let (walked, walk_rejections) = walk_back(
         &problem,

@@ -5,6 +5,7 @@
 mod backbone;
 mod defaults;
 pub mod diagnostics;
+mod drift;
 pub mod energy;
 mod energy_backbone;
 mod escape;
@@ -27,6 +28,7 @@ pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,
 };
+pub use drift::{check_held, drifting_bars};
 pub use energy::{energy, energy_at, energy_gradient};
 pub use energy_backbone::{
     energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, CALM_STEPS,

@@ -6,8 +6,9 @@
 use crate::continuation::{
     Arclength, ArclengthOptions, Branch, ContinuationProblem, Event, Point, Step,
 };
-use crate::error::{ContinuationError, Error};
+use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
+use crate::modal::drift::check_held;
 use crate::modal::energy::energy;
 use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{
@@ -91,22 +92,30 @@ impl StartGuesses {
         self.ratios().len() * per_seed
     }
 
-    /// The guesses around `seed` (a seed on harmonic `harmonic`).
+    /// The seed at each of the amplitudes, without rigid-body motions.
+    pub(crate) fn scaled(&self, seed: &[f64]) -> Vec<Vec<f64>> {
+        self.amplitudes()
+            .into_iter()
+            .map(|a| seed.iter().map(|v| a * v).collect())
+            .collect()
+    }
+
+    /// The guesses around `seed` (a seed on harmonic `harmonic`), each rigid-body motion
+    /// added at the amplitudes `rigid` (in units of the smallest gap).
     pub(crate) fn around<B: Basis>(
         &self,
         problem: &NonsmoothSystem<B>,
-        seed: &[f64],
-        harmonic: usize,
+        (seed, harmonic): (&[f64], usize),
+        rigid: &[f64],
     ) -> Vec<Vec<f64>> {
         let mut guesses = Vec::with_capacity(self.count() / self.ratios().len());
-        for a in self.amplitudes() {
-            let base: Vec<f64> = seed.iter().map(|v| a * v).collect();
+        for base in self.scaled(seed) {
             guesses.push(base.clone());
             if !self.floating() {
                 continue;
             }
             for shape in &self.rigid {
-                for c in RIGID_AMPLITUDES {
+                for &c in rigid {
                     let mut guess = base.clone();
                     add_on_harmonic(problem, shape, harmonic, c * self.gap, &mut guess);
                     guesses.push(guess);
@@ -117,80 +126,135 @@ impl StartGuesses {
     }
 }
 
+/// What the solves of a start search came to: how many were tried, reached a solution the
+/// search refused (the state of rest) or did not converge, and the highest frequency tried.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Tally {
+    pub attempts: usize,
+    pub refused: usize,
+    pub failed: usize,
+    pub up_to: f64,
+}
+
+impl Tally {
+    /// The error of a search that found nothing, at the asked frequency `omega`.
+    pub(crate) fn not_found(&self, omega: f64) -> SettingsError {
+        SettingsError::StartNotFound {
+            omega,
+            up_to: self.up_to.max(omega),
+            attempts: self.attempts,
+            at_rest: self.refused,
+            failed: self.failed,
+        }
+    }
+}
+
 /// The first of `guesses` that one of `solvers` (tried in turn on each guess) takes at
-/// `omega` to a solution that `accept` takes.
+/// `omega` to a solution that `accept` takes; `tally` counts the solves.
 pub(crate) fn first_solution(
     problem: &mut NonsmoothSystem,
     solvers: &[&dyn NonlinearSolver],
     guesses: impl IntoIterator<Item = Vec<f64>>,
-    omega: f64,
+    (omega, tally): (f64, &mut Tally),
     mut accept: impl FnMut(&mut NonsmoothSystem, &[f64]) -> bool,
 ) -> Option<Vec<f64>> {
+    tally.up_to = tally.up_to.max(omega);
     for guess in guesses {
         for solver in solvers {
             let mut x = guess.clone();
             problem.set_parameter(omega);
-            if solver.solve(problem, &mut x).is_ok() && accept(problem, &x) {
+            tally.attempts += 1;
+            if solver.solve(problem, &mut x).is_err() {
+                tally.failed += 1;
+            } else if accept(problem, &x) {
                 return Some(x);
+            } else {
+                tally.refused += 1;
             }
         }
     }
     None
 }
 
-/// The guess of a period backbone's first step at `omega`. For a system with a bar held only
-/// by contacts (a rigid-body mode of the open-contact system), the grazing seed can slide to
-/// the bar at rest against an obstacle (the free-free bar between two walls): there the seed
-/// is kept where `solver` takes it to a motion of energy above `floor`, else the first such
-/// solution from the guesses of the energy backbone's start around the seed
-/// ([`START_AMPLITUDES`](crate::modal::START_AMPLITUDES); the rigid-body motions added),
-/// solved by `solver` and then by it inside a [`SmoothingHomotopy`], at `omega` and then at
+/// The guess of a period backbone's first step at `omega`: the grazing seed where `solver`
+/// takes it to a motion of energy above `floor` (the paper's three systems), else the first
+/// such solution from the guesses of [`StartGuesses`] around the seed, at `omega` and then at
 /// the higher frequencies of [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the
-/// first), walked back to `omega` in a few steps (as far as they converge); else the seed.
-/// Other systems (the paper's three) keep the seed, without a solve. Returns the guess and
+/// first), walked back to `omega` in a few steps (as far as they converge). A seed that only
+/// grazes can slide to rest (a floating bar resting against an obstacle, or an obstacle
+/// whose grazing the rounding leaves just open), a slightly larger one cannot. At each
+/// frequency every guess is solved by `solver` first, and only if none is accepted again
+/// inside a [`SmoothingHomotopy`] (which costs several solves): a search that fails makes at
+/// most `2 StartGuesses::count()` solves, and says what they came to. Returns the guess and
 /// the frequency it was last solved at (`omega` for the seed).
+///
+/// # Errors
+/// [`SettingsError::StartNotFound`] with what the solves came to, if no guess is accepted.
 pub(crate) fn usable_start<S: NonlinearSolver>(
     problem: &mut NonsmoothSystem,
     solver: &S,
     (seed, subharmonic): (Vec<f64>, usize),
     omega: f64,
     floor: f64,
-) -> (Vec<f64>, f64) {
+) -> Result<(Vec<f64>, f64), SettingsError> {
     let guesses = StartGuesses::new(problem.system());
-    if !guesses.floating() {
-        return (seed, omega);
-    }
     let (system, basis) = (problem.system().clone(), problem.basis().clone());
-    let mut above_rest =
-        |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, omega) > floor;
-    if first_solution(problem, &[solver], [seed.clone()], omega, &mut above_rest).is_some() {
-        return (seed, omega);
+    let above_rest_at = |at: f64| {
+        let (system, basis) = (&system, &basis);
+        move |_: &mut NonsmoothSystem, x: &[f64]| energy(system, basis, x, at) > floor
+    };
+    let mut tally = Tally::default();
+    let only = [seed.clone()];
+    if first_solution(
+        problem,
+        &[solver],
+        only,
+        (omega, &mut tally),
+        above_rest_at(omega),
+    )
+    .is_some()
+    {
+        return Ok((seed, omega));
     }
     let homotopy = SmoothingHomotopy::new(solver);
-    let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
     let found = guesses.ratios().into_iter().find_map(|r| {
         let at = omega * r / START_RATIOS[0];
-        let above_rest =
-            |_: &mut NonsmoothSystem, x: &[f64]| energy(&system, &basis, x, at) > floor;
-        let tries = guesses.around(problem, &seed, subharmonic);
-        first_solution(problem, &solvers, tries, at, above_rest).map(|x| (x, at))
+        let tries = guesses.around(problem, (&seed, subharmonic), &RIGID_AMPLITUDES);
+        first_solution(
+            problem,
+            &[solver],
+            tries,
+            (at, &mut tally),
+            above_rest_at(at),
+        )
+        .or_else(|| {
+            let tries = guesses.around(problem, (&seed, subharmonic), &RIGID_AMPLITUDES);
+            first_solution(
+                problem,
+                &[&homotopy],
+                tries,
+                (at, &mut tally),
+                above_rest_at(at),
+            )
+        })
+        .map(|x| (x, at))
     });
     let Some((mut x, from)) = found else {
-        return (seed, omega);
+        return Err(tally.not_found(omega));
     };
     // Walk the solution back to `omega` in a few steps, each from the last.
     const WALK: usize = 8;
+    let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
     let mut reached = from;
     for k in 1..=WALK {
         let at = from + (omega - from) * k as f64 / WALK as f64;
-        let above_rest =
-            |_: &mut NonsmoothSystem, y: &[f64]| energy(&system, &basis, y, at) > floor;
-        match first_solution(problem, &solvers, [x.clone()], at, above_rest) {
+        let last = [x.clone()];
+        match first_solution(problem, &solvers, last, (at, &mut tally), above_rest_at(at)) {
             Some(y) => (x, reached) = (y, at),
             None => break,
         }
     }
-    (x, reached)
+    Ok((x, reached))
 }
 
 /// The first grazing energy `E_g` of the problem's system and the seed of NSM `mode` sub
@@ -201,6 +265,7 @@ pub(crate) fn grazing_and_seed(
     subharmonic: usize,
     omega: f64,
 ) -> Result<(f64, Vec<f64>), Error> {
+    check_held(problem.system())?;
     let (e_g, first_mode) = grazing_energy(problem.system())?;
     let seed = if mode == 1 {
         seed_from_mode(problem, &first_mode, subharmonic, omega)?
@@ -275,7 +340,7 @@ pub fn backbone_start<S: NonlinearSolver>(
         (seed, subharmonic),
         omega,
         trivial_energy * e_g,
-    );
+    )?;
     Ok(BackboneStart { x, omega })
 }
 

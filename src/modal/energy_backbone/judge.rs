@@ -7,7 +7,7 @@ use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
 use crate::modal::point::{BackbonePoint, PointStatus};
 use crate::modal::signature::harmonic_energies;
-use crate::modal::start::{first_solution, StartGuesses};
+use crate::modal::start::{first_solution, StartGuesses, Tally, RIGID_AMPLITUDES};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;
@@ -149,9 +149,14 @@ impl Judge {
     ) -> Option<Vec<f64>> {
         let judge = (self.grazing_energy, self.subharmonic);
         let reference = self.reference.clone();
-        first_solution(&mut self.problem, solvers, guesses, omega, |p, x| {
-            acceptable(p, judge, reference.as_deref(), x, omega).is_some()
-        })
+        let mut tally = Tally::default();
+        first_solution(
+            &mut self.problem,
+            solvers,
+            guesses,
+            (omega, &mut tally),
+            |p, x| acceptable(p, judge, reference.as_deref(), x, omega).is_some(),
+        )
     }
 
     /// The first point of the branch of `linear`: a nonsmooth mode at a fixed frequency just
@@ -178,7 +183,7 @@ impl Judge {
         for ratio in guesses.ratios() {
             let omega = ratio * linear.omega / self.subharmonic as f64;
             let seed = seed_from_mode(&mut self.problem, linear, self.subharmonic, omega)?;
-            let tries = guesses.around(&self.problem, &seed, self.subharmonic);
+            let tries = guesses.around(&self.problem, (&seed, self.subharmonic), &RIGID_AMPLITUDES);
             if let Some(x) = self.solve_at(&solvers, tries, omega) {
                 return Ok((x, omega));
             }

@@ -1,0 +1,254 @@
+//! Backbones of seeded random assemblies, as a new user would compute them: 1 to 4 bars in a
+//! chain, lengths, wave speeds and stiffnesses drawn over a factor of 6 (0.5 to 3), each
+//! outer end clamped, free, on a ground spring or facing a wall, neighbouring bars facing
+//! each other across a contact (so every assembly has a unilateral condition, and bars held
+//! only by contacts are common).
+//!
+//! Some of these assemblies hold a bar from one side only (a free end beyond a contact, a
+//! wall on one side of a bar and nothing on the other): a contact can push such a bar but
+//! nothing pulls it back, so it drifts away after its first impact and no periodic motion
+//! touches it. The crate refuses these with [`SettingsError::Unconfined`]; the others must
+//! give a backbone or a typed reason, never points at rest.
+//!
+//! - `every_assembly_gives_a_branch_or_a_typed_reason` (normal run): the invariants on a
+//!   few assemblies at `m = 8`.
+//! - `random_assembly_census` (`#[ignore]`): the figures of `docs/assemblies.md`, at the
+//!   harmonics `RANDOM_HARMONICS` (default 20) over `RANDOM_COUNT` (default 50) held
+//!   assemblies: `cargo test --release --all-features --test random_assemblies -- --ignored
+//!   --nocapture`.
+
+use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::modal::{backbone, drifting_bars, BackboneOptions};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
+use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
+use nonsmooth_modes::{Error, SettingsError};
+
+/// The gap of every unilateral condition (the results are homogeneous in it).
+const GAP: f64 = 1e-3;
+
+/// SplitMix64: a seeded generator with no dependency.
+struct Draw(u64);
+
+impl Draw {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in `[lo, hi)`.
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in `0..n`.
+    fn index(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+/// What holds an outer end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Outer {
+    Clamped,
+    Free,
+    Spring(f64),
+    Wall,
+}
+
+/// One drawn assembly and how it was drawn.
+struct Drawn {
+    system: BarSystem,
+    description: String,
+}
+
+/// The assembly of `seed`.
+fn draw(seed: u64) -> Drawn {
+    let mut d = Draw(seed);
+    let n = 1 + d.index(4);
+    let bars: Vec<Bar> = (0..n)
+        .map(|_| {
+            let (l, c, k) = (
+                d.uniform(0.5, 3.0),
+                d.uniform(0.5, 3.0),
+                d.uniform(0.5, 3.0),
+            );
+            Bar::new(l, c, k).expect("positive finite values")
+        })
+        .collect();
+    let mut outer = || match d.index(4) {
+        0 => Outer::Clamped,
+        1 => Outer::Free,
+        2 => Outer::Spring(d.uniform(0.5, 3.0)),
+        _ => Outer::Wall,
+    };
+    let (mut left, mut right) = (outer(), outer());
+    // A single bar needs a wall to have a unilateral condition.
+    if n == 1 && left != Outer::Wall && right != Outer::Wall {
+        right = Outer::Wall;
+    }
+    // Something must hold the assembly to the ground.
+    if left == Outer::Free && right == Outer::Free {
+        left = Outer::Wall;
+    }
+    let mut b = AssemblyBuilder::new();
+    let ids: Vec<_> = bars.iter().map(|&bar| b.add_bar(bar)).collect();
+    let hold = |b: &mut AssemblyBuilder, end, how| -> Result<(), nonsmooth_modes::ModelError> {
+        match how {
+            Outer::Clamped => b.dirichlet(end).map(drop),
+            Outer::Free => b.neumann(end).map(drop),
+            Outer::Spring(k) => b.robin(end, k).map(drop),
+            Outer::Wall => b.signorini(end, GAP).map(drop),
+        }
+    };
+    hold(&mut b, ids[0].left(), left).expect("a valid condition");
+    for pair in ids.windows(2) {
+        b.contact(pair[0].right(), pair[1].left(), GAP)
+            .expect("a valid contact");
+    }
+    hold(&mut b, ids[n - 1].right(), right).expect("a valid condition");
+    let description = format!(
+        "seed {seed}: {n} bars {:?}, left {left:?}, right {right:?}",
+        bars.iter()
+            .map(|b| (b.length(), b.wave_speed(), b.stiffness()))
+            .collect::<Vec<_>>()
+    );
+    Drawn {
+        system: b.build().expect("a complete assembly"),
+        description,
+    }
+}
+
+/// What became of one assembly's default backbone.
+#[derive(Debug)]
+enum Outcome {
+    /// Refused: a bar can drift away.
+    Unconfined,
+    /// A typed error before any point.
+    Refused(Error),
+    /// The run: converged points, and those whose time-domain displacement defect is below
+    /// 5 % (`None` where the check was not asked for or cannot be made).
+    Run {
+        converged: usize,
+        checked: Option<usize>,
+    },
+}
+
+/// The default backbone of `system` at `harmonics`, checking the invariants every run must
+/// keep; `verify` marches each converged point one period in time.
+fn run(system: &BarSystem, harmonics: usize, verify: bool) -> Outcome {
+    let settings = HarmonicBalanceSettings {
+        harmonics,
+        ..HarmonicBalanceSettings::default()
+    };
+    let options = match BackboneOptions::for_mode(system, 1, 1) {
+        Ok(options) => options,
+        Err(e) => return Outcome::Refused(e.into()),
+    };
+    let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).expect("valid options");
+    let result = backbone(system, settings, &options, solver);
+    let drifting = drifting_bars(system);
+    let bb = match result {
+        Err(Error::Settings(SettingsError::Unconfined { bars })) => {
+            assert_eq!(Some(bars), drifting, "the error names the drifting bars");
+            return Outcome::Unconfined;
+        }
+        Err(e) => {
+            assert!(drifting.is_none(), "a drifting assembly is refused as such");
+            assert!(!e.to_string().is_empty());
+            return Outcome::Refused(e);
+        }
+        Ok(bb) => bb,
+    };
+    assert!(drifting.is_none(), "a drifting assembly is refused");
+    let converged: Vec<_> = bb.converged().collect();
+    assert!(
+        !converged.is_empty() || bb.error().is_some(),
+        "a run without a converged point ends with a typed reason"
+    );
+    for p in &converged {
+        assert!(p.energy_normalized.is_finite() && p.energy_normalized > options.trivial_energy);
+    }
+    let checked = verify.then(|| {
+        let problem = nonsmooth_modes::system::NonsmoothSystem::new(system, settings)
+            .expect("the settings the backbone used");
+        converged
+            .iter()
+            .filter(|p| {
+                let options = PeriodicityOptions {
+                    adjust_grid: true,
+                    ..PeriodicityOptions::default()
+                };
+                periodicity_check(system, problem.basis(), &p.x, p.omega, &options)
+                    .is_ok_and(|r| r.displacement_defect < 0.05)
+            })
+            .count()
+    });
+    Outcome::Run {
+        converged: converged.len(),
+        checked,
+    }
+}
+
+/// The invariants of every run, on the first assemblies of the sequence at `m = 8`: a
+/// drifting assembly is refused as such, a run without a converged point ends with a typed
+/// reason, and no converged point is at rest or non-finite.
+#[test]
+fn every_assembly_gives_a_branch_or_a_typed_reason() {
+    let mut outcomes = Vec::new();
+    for seed in 0..12 {
+        let drawn = draw(seed);
+        let outcome = run(&drawn.system, 8, false);
+        eprintln!("{}: {outcome:?}", drawn.description);
+        outcomes.push(outcome);
+    }
+    // The sequence holds both kinds, so both paths are exercised.
+    assert!(outcomes.iter().any(|o| matches!(o, Outcome::Unconfined)));
+    assert!(outcomes
+        .iter()
+        .any(|o| matches!(o, Outcome::Run { converged, .. } if *converged > 0)));
+}
+
+fn env_number(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(default)
+}
+
+/// The census of `docs/assemblies.md`: of `RANDOM_COUNT` held assemblies, how many give a
+/// branch of at least 20 converged points whose time-domain displacement defect is below
+/// 5 %, at `RANDOM_HARMONICS` harmonics.
+#[test]
+#[ignore = "minutes; the figures of docs/assemblies.md"]
+fn random_assembly_census() {
+    let count = env_number("RANDOM_COUNT", 50);
+    let harmonics = env_number("RANDOM_HARMONICS", 20);
+    let (mut held, mut good, mut refused, mut unconfined) = (0, 0, 0, 0);
+    let mut seed = 0;
+    while held < count {
+        let drawn = draw(seed);
+        seed += 1;
+        let outcome = run(&drawn.system, harmonics, true);
+        println!("{}: {outcome:?}", drawn.description);
+        match outcome {
+            Outcome::Unconfined => unconfined += 1,
+            Outcome::Refused(e) => {
+                println!("  refused: {e}");
+                held += 1;
+                refused += 1;
+            }
+            Outcome::Run { checked, .. } => {
+                held += 1;
+                good += usize::from(checked.unwrap_or(0) >= 20);
+            }
+        }
+    }
+    println!(
+        "m = {harmonics}: {good} of {held} held assemblies give >= 20 checked points \
+         (defect < 5 %); {refused} refused with a typed reason; {unconfined} drifting \
+         assemblies refused ({seed} drawn)"
+    );
+    assert!(good + refused <= held);
+}
