@@ -3,7 +3,7 @@
 //! Every enum here is `#[non_exhaustive]`: later versions may add variants, so a `match` on
 //! one outside the crate ends with a wildcard arm.
 
-use crate::end::EndRef;
+use crate::end::{BarId, EndRef};
 use thiserror::Error;
 
 /// Errors raised while describing a bar system (bars, boundary conditions, assembly).
@@ -30,7 +30,10 @@ pub enum ModelError {
     #[error("the assembly has no bar")]
     NoBars,
     /// A condition names a bar that the builder did not mint.
-    #[error("condition `{condition}` refers to bar {bar}, but the assembly has {bars} bar(s)")]
+    #[error(
+        "condition `{condition}` refers to {}, but the assembly has {bars} bar(s)",
+        BarId(*.bar)
+    )]
     UnknownBar {
         /// Name of the condition.
         condition: String,
@@ -40,13 +43,13 @@ pub enum ModelError {
         bars: usize,
     },
     /// An end has no boundary condition.
-    #[error("end {end} has no boundary condition")]
+    #[error("{end} has no boundary condition")]
     UnconstrainedEnd {
         /// The free-floating end.
         end: EndRef,
     },
     /// An end has two boundary conditions.
-    #[error("end {end} has two boundary conditions: `{first}` and `{second}`")]
+    #[error("{end} has two boundary conditions: `{first}` and `{second}`")]
     OverconstrainedEnd {
         /// The doubly constrained end.
         end: EndRef,
@@ -56,7 +59,7 @@ pub enum ModelError {
         second: String,
     },
     /// A condition lists the same end twice.
-    #[error("condition `{condition}` lists end {end} twice")]
+    #[error("condition `{condition}` lists the {end} twice")]
     RepeatedEnd {
         /// Name of the condition.
         condition: String,
@@ -496,7 +499,8 @@ pub enum VerifyError {
     },
     /// A bar's travel time `l / c` is not an integer number of steps.
     #[error(
-        "bar {bar} has l/c = {travel_time} = {cells} steps of dt = {dt}: not an integer number of cells"
+        "{} has l/c = {travel_time} = {cells} steps of dt = {dt}: not an integer number of cells",
+        BarId(*.bar)
     )]
     NonMatchingGrid {
         /// Index of the bar.
@@ -517,7 +521,7 @@ pub enum VerifyError {
         high: f64,
     },
     /// A value of the initial state (or a parameter) is NaN or infinite.
-    #[error("non-finite {what} in bar {bar} at index {index}: {value}")]
+    #[error("non-finite {what} in {} at index {index}: {value}", BarId(*.bar))]
     NonFinite {
         /// Which quantity.
         what: &'static str,
@@ -539,7 +543,7 @@ pub enum VerifyError {
         value: f64,
     },
     /// A vector of the initial state has the wrong length.
-    #[error("{what} of bar {bar} has length {got}, expected {expected}")]
+    #[error("{what} of {} has length {got}, expected {expected}", BarId(*.bar))]
     Length {
         /// Which vector.
         what: &'static str,

@@ -45,7 +45,7 @@
 //! | feature | adds |
 //! |---|---|
 //! | `parallel` | [`sweep::backbones`] on rayon's thread pool |
-//! | `serde` | `Serialize` on points, branches and diagnostics; `io::to_json`; assemblies read from and written to TOML or JSON files (`io::assembly`) |
+//! | `serde` (default) | `Serialize` on points, branches and diagnostics; `io::to_json`; assemblies read from and written to TOML or JSON files (`io::assembly`); `default-features = false` leaves it out |
 //! | `plot` | the `plot` module: SVG figures |
 //! | `proptest` | the `strategies` module: proptest strategies |
 //!

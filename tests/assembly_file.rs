@@ -317,35 +317,74 @@ fn build_errors_name_the_bar_the_end_and_the_condition() {
         "type = \"signorini\"\nend = \"a.end\"",
         "type = \"contact\"\nends = [\"a.end\", \"a.end\"]",
     );
-    assert!(matches!(
-        toml_error(&contact_on_itself),
-        AssemblyFileError::Condition {
-            index: 1,
-            type_name: "contact",
-            source: ModelError::RepeatedEnd { .. }
+    let repeated = toml_error(&contact_on_itself);
+    assert_eq!(
+        repeated,
+        AssemblyFileError::RepeatedEnd {
+            condition: 1,
+            end: "a.end".into()
         }
-    ));
+    );
+    assert_eq!(
+        repeated.to_string(),
+        "[[condition]] 2: end `a.end` is listed twice"
+    );
     // An end without a condition, and an end with two.
-    match toml_error(&edited(
+    let unconstrained = toml_error(&edited(
         "[[condition]]\ntype = \"dirichlet\"\nend = \"a.start\"",
         "",
-    )) {
+    ));
+    match &unconstrained {
         AssemblyFileError::End {
             end,
             conditions,
             source: ModelError::UnconstrainedEnd { .. },
-        } => assert_eq!((end.as_str(), conditions), ("a.start", vec![])),
+        } => assert_eq!((end.as_str(), conditions), ("a.start", &vec![])),
         other => panic!("{other:?}"),
     }
+    assert_eq!(
+        unconstrained.to_string(),
+        "end `a.start` has no boundary condition"
+    );
     let two_on_one = format!("{CLAMPED}\n[[condition]]\ntype = \"neumann\"\nend = \"a.end\"\n");
-    match toml_error(&two_on_one) {
+    let overconstrained = toml_error(&two_on_one);
+    match &overconstrained {
         AssemblyFileError::End {
             end,
             conditions,
             source: ModelError::OverconstrainedEnd { .. },
-        } => assert_eq!((end.as_str(), conditions), ("a.end", vec![1, 2])),
+        } => assert_eq!((end.as_str(), conditions), ("a.end", &vec![1, 2])),
         other => panic!("{other:?}"),
     }
+    assert_eq!(
+        overconstrained.to_string(),
+        "end `a.end` has two boundary conditions: [[condition]] 2 and 3"
+    );
+}
+
+/// A file's errors name its ends and bars as the file writes them, never by a Rust index: the
+/// chain without its last condition misses `3.end`, the end of its third bar.
+#[test]
+fn file_errors_use_the_file_names() {
+    let chain = std::fs::read_to_string(example("three_bar_chain.toml")).unwrap();
+    let robin = "[[condition]]\ntype = \"robin\"\nend = \"3.end\"\nstiffness = 0.5\n";
+    assert!(chain.contains(robin));
+    let renamed = chain.replace(robin, "").replace("\"3", "\"b3");
+    let message = toml_error(&renamed).to_string();
+    assert_eq!(message, "end `b3.end` has no boundary condition");
+    // The same system built in Rust names the end by its `BarId` and rank.
+    let mut b = nonsmooth_modes::system::AssemblyBuilder::new();
+    let bars: Vec<_> = (0..3).map(|_| b.add_bar(Bar::unit())).collect();
+    b.dirichlet(bars[0].left())
+        .unwrap()
+        .contact(bars[0].right(), bars[1].left(), 1e-3)
+        .unwrap()
+        .contact(bars[1].right(), bars[2].left(), 1e-3)
+        .unwrap();
+    assert_eq!(
+        b.build().unwrap_err().to_string(),
+        "right end (x = l) of bar 2 (the 3rd added) has no boundary condition"
+    );
 }
 
 #[test]

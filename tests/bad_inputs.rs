@@ -111,7 +111,10 @@ fn assembly_errors_name_the_end_or_condition() {
         ModelError::UnconstrainedEnd { end: two.left() }
     );
     let message = b.build().unwrap_err().to_string();
-    assert!(message.contains("left (x = 0) of bar 1"), "{message}");
+    assert_eq!(
+        message,
+        "left end (x = 0) of bar 1 (the 2nd added) has no boundary condition"
+    );
 
     // An end with two conditions, named in order: each is valid on its own, so the builder
     // takes both and `build` rejects the pair.
@@ -132,10 +135,17 @@ fn assembly_errors_name_the_end_or_condition() {
     let mut b = AssemblyBuilder::new();
     let bar = b.add_bar(Bar::unit());
     b.dirichlet(bar.left()).unwrap();
+    let repeated = b.contact(bar.right(), bar.right(), 0.1).unwrap_err();
     assert!(matches!(
-        b.contact(bar.right(), bar.right(), 0.1),
-        Err(ModelError::RepeatedEnd { end, .. }) if end == bar.right()
+        repeated,
+        ModelError::RepeatedEnd { end, .. } if end == bar.right()
     ));
+    assert!(
+        repeated
+            .to_string()
+            .ends_with("lists the right end (x = l) of bar 0 (the 1st added) twice"),
+        "{repeated}"
+    );
     assert_eq!(
         b.build().unwrap_err(),
         ModelError::UnconstrainedEnd { end: bar.right() }
@@ -163,6 +173,11 @@ fn unknown_bar_from_another_builder() {
         } => {
             assert_eq!((bar, bars), (2, 1));
             assert!(condition.starts_with("Dirichlet"), "{condition}");
+            let message = b.dirichlet(foreign.left()).unwrap_err().to_string();
+            assert!(
+                message.ends_with("refers to bar 2 (the 3rd added), but the assembly has 1 bar(s)"),
+                "{message}"
+            );
         }
         other => panic!("expected UnknownBar, got {other:?}"),
     }

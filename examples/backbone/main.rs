@@ -18,9 +18,9 @@
 //! set by `--gap`, `--robin-stiffness`, `--length2`, `--speed2`, `--stiffness-ratio`; their
 //! bars are named `1` and `2`). `--assembly FILE` reads any assembly from a TOML or JSON file
 //! instead (`io::assembly`, which documents the schema; `examples/assemblies/` has the three
-//! shorthands as files and a three-bar chain). It needs the `serde` feature
-//! (`cargo run --release --features serde --example backbone -- --assembly FILE`; without it
-//! the flag is refused with that command), excludes `--system` and the shorthands' value
+//! shorthands as files and a three-bar chain). It uses the `serde` feature, on by default
+//! (`cargo run --release --example backbone -- --assembly FILE`; a build with
+//! `--no-default-features` refuses the flag with that command), excludes `--system` and the shorthands' value
 //! flags (the values are in the file) and continues in the period (`--parameter omega`) or in
 //! the energy (`--parameter energy`).
 //! A file that cannot be read or built is a usage error, explained on stderr.

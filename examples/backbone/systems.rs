@@ -59,13 +59,13 @@ pub fn load_assembly(path: &str) -> Result<BarSystem, lexopt::Error> {
         .map_err(|e| format!("--assembly {path}: {e}").into())
 }
 
-/// Without the `serde` feature there is no file parser: the flag is refused with the command
-/// that has one.
+/// Without the `serde` feature (on by default, off with `--no-default-features`) there is no
+/// file parser: the flag is refused with the command that has one.
 #[cfg(not(feature = "serde"))]
 pub fn load_assembly(path: &str) -> Result<BarSystem, lexopt::Error> {
     Err(format!(
-        "--assembly needs the `serde` feature: cargo run --release --features serde \
-         --example backbone -- --assembly {path}"
+        "--assembly needs the default feature `serde`, which this build leaves out: \
+         cargo run --release --example backbone -- --assembly {path}"
     )
     .into())
 }

@@ -146,6 +146,127 @@ pub fn complementarity_samples(
 /// at each instant and projects the result on the harmonic basis: one equation per basis
 /// function. The linearised open state (`force = 0`) and closed state (gap motion `= 0`) used
 /// by linear modal analysis come from the same two observables.
+///
+/// # Contract
+///
+/// - The law is returned by [`BoundaryCondition::unilateral`](super::BoundaryCondition) of a
+///   condition on `n` ends, which then pushes `n - 1` linear rows (none for one end, the force
+///   balance for two).
+/// - [`gap`](UnilateralLaw::gap) and [`force`](UnilateralLaw::force) are affine in the
+///   [`Quantity`](super::Quantity)s of the condition's ends, any of them: a gap may contain
+///   force terms (a compliant obstacle, below), a force may combine several ends. Their
+///   coefficients must be finite; [`AssemblyBuilder::add_condition`] checks them.
+/// - [`residual`](UnilateralLaw::residual) is zero exactly on the law's graph and returns an
+///   element of its generalised gradient; `a_c > 0` is the complementarity parameter, which
+///   scales a gap against a force. The default is [`complementarity`], Signorini's
+///   `g >= 0, lambda >= 0, g lambda = 0`, so a law that only moves the gap (as below) keeps it.
+/// - [`smoothed_residual`](UnilateralLaw::smoothed_residual) equals `residual` at
+///   `smoothing = 0`; [`sample`](UnilateralLaw::sample) is only a faster loop over it.
+/// - A spring in the law stores energy: give it through
+///   [`BoundaryCondition::stored_energy`](super::BoundaryCondition::stored_energy), from the
+///   force it carries.
+///
+/// The time-domain check [`verify::periodicity_check`](crate::verify::periodicity_check)
+/// marches rigid obstacles and contacts only: for a gap with strain or force terms it returns
+/// [`VerifyError::Unsupported`](crate::error::VerifyError::Unsupported) instead.
+///
+/// # Example: a compliant obstacle
+///
+/// The end meets a spring of stiffness `k` whose free end is at `g0`. Carrying the force
+/// `lambda`, the spring is compressed by `lambda / k`, so the gap between the end and the
+/// spring is `g = g0 - v + lambda / k` (`v` the outward displacement), and Signorini holds
+/// between `g` and `lambda`: the default residual, with a force term in the gap. Closed, the
+/// contact is a ground spring of stiffness `k` (a [`Robin`](super::Robin) end); as `k` grows
+/// the law tends to the rigid obstacle.
+///
+/// ```
+/// use nonsmooth_modes::bar::{Bar, EndRef};
+/// use nonsmooth_modes::bc::{BoundaryCondition, Observable, Quantity, Term, UnilateralLaw};
+/// use nonsmooth_modes::modal::{backbone, natural_frequencies, BackboneOptions, ContactState, PeriodGrid};
+/// use nonsmooth_modes::solve::SemismoothNewton;
+/// use nonsmooth_modes::system::{AssemblyBuilder, HarmonicBalanceSettings};
+///
+/// #[derive(Debug)]
+/// struct CompliantObstacle {
+///     end: EndRef,
+///     gap: f64,
+///     stiffness: f64,
+/// }
+///
+/// impl BoundaryCondition for CompliantObstacle {
+///     fn name(&self) -> String {
+///         format!("compliant obstacle (gap {}, k {}) at {}", self.gap, self.stiffness, self.end)
+///     }
+///     fn ends(&self) -> Vec<EndRef> {
+///         vec![self.end]
+///     }
+///     // One end and a law: no linear row.
+///     fn unilateral(&self) -> Option<&dyn UnilateralLaw> {
+///         Some(self)
+///     }
+///     // The spring's energy lambda^2 / (2 k), zero while the contact is open.
+///     fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
+///         let force = value(self.end, Quantity::ContactForce).max(0.0);
+///         0.5 * force * force / self.stiffness
+///     }
+/// }
+///
+/// impl UnilateralLaw for CompliantObstacle {
+///     // g = g0 - v + lambda / k: a force term in the gap.
+///     fn gap(&self) -> Observable {
+///         Observable {
+///             offset: self.gap,
+///             terms: vec![
+///                 Term::new(self.end, Quantity::OutwardDisplacement, -1.0),
+///                 Term::new(self.end, Quantity::ContactForce, 1.0 / self.stiffness),
+///             ],
+///         }
+///     }
+///     fn force(&self) -> Observable {
+///         Observable {
+///             offset: 0.0,
+///             terms: vec![Term::new(self.end, Quantity::ContactForce, 1.0)],
+///         }
+///     }
+///     // `residual` is left to its default: Signorini between this gap and this force.
+/// }
+///
+/// let k = 50.0;
+/// let mut b = AssemblyBuilder::new();
+/// let bar = b.add_bar(Bar::unit());
+/// b.dirichlet(bar.left())?
+///     .add_condition(CompliantObstacle { end: bar.right(), gap: 1e-3, stiffness: k })?;
+/// let system = b.build()?;
+///
+/// // Closed, the obstacle is a ground spring of stiffness k.
+/// let mut springy = AssemblyBuilder::new();
+/// let other = springy.add_bar(Bar::unit());
+/// springy.dirichlet(other.left())?.robin(other.right(), k)?;
+/// let closed = natural_frequencies(&system, ContactState::Closed, 10.0)?;
+/// let spring = natural_frequencies(&springy.build()?, ContactState::Open, 10.0)?;
+/// assert_eq!(closed.len(), spring.len());
+/// for (a, b) in closed.iter().zip(&spring) {
+///     assert!((a.omega - b.omega).abs() < 1e-9 * b.omega);
+/// }
+///
+/// // A backbone of its first nonsmooth mode, as for a built-in condition: it hardens (the
+/// // energy grows as the period falls).
+/// let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
+/// let options = BackboneOptions {
+///     grid: PeriodGrid { start: 3.95, end: 3.6, steps: 8 },
+///     ..Default::default()
+/// };
+/// let points = backbone(&system, settings, &options, SemismoothNewton::default())?;
+/// assert!(points.iter().all(|p| p.converged));
+/// assert!(points.windows(2).all(|w| w[1].energy_normalized > w[0].energy_normalized));
+/// # Ok::<(), nonsmooth_modes::Error>(())
+/// ```
+///
+/// `tests/custom_condition.rs` writes the same obstacle with its own residual instead (the
+/// complementarity of `g + lambda / k`, or a penalty `lambda - k max(0, -g)`) and checks that
+/// its backbone tends to the rigid obstacle's as `k` grows.
+///
+/// [`AssemblyBuilder::add_condition`]: crate::system::AssemblyBuilder::add_condition
 pub trait UnilateralLaw: Debug + Send + Sync {
     /// The gap as an affine function of end quantities (its offset is the gap at rest).
     fn gap(&self) -> Observable;

@@ -58,12 +58,19 @@ pub(super) fn build(file: &AssemblyFile) -> Result<Assembly, AssemblyFileError> 
             })?;
         Ok(if left { id.left() } else { id.right() })
     };
+    let names: Vec<String> = file.bar.iter().map(|b| b.name.clone()).collect();
     // The ends of each condition, kept to name the conditions of an end the builder rejects.
     let mut owners: Vec<Vec<EndRef>> = Vec::with_capacity(file.condition.len());
     for (index, entry) in file.condition.iter().enumerate() {
         let resolve = |end: &str| resolve(index, end);
         add(&mut builder, entry, &resolve).map_err(|e| match e {
             Rejected::File(e) => e,
+            Rejected::Model(ModelError::RepeatedEnd { end, .. }) => {
+                AssemblyFileError::RepeatedEnd {
+                    condition: index,
+                    end: end_name(&names, end),
+                }
+            }
             Rejected::Model(source) => AssemblyFileError::Condition {
                 index,
                 type_name: entry.type_name(),
@@ -78,7 +85,6 @@ pub(super) fn build(file: &AssemblyFile) -> Result<Assembly, AssemblyFileError> 
                 .collect(),
         );
     }
-    let names: Vec<String> = file.bar.iter().map(|b| b.name.clone()).collect();
     let system = builder.build().map_err(|source| {
         let end = match &source {
             ModelError::UnconstrainedEnd { end } | ModelError::OverconstrainedEnd { end, .. } => {

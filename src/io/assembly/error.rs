@@ -114,8 +114,16 @@ pub enum AssemblyFileError {
         /// The model's error.
         source: ModelError,
     },
+    /// A contact lists the same end twice.
+    #[error("[[condition]] {}: end `{end}` is listed twice", .condition + 1)]
+    RepeatedEnd {
+        /// Index of the condition.
+        condition: usize,
+        /// The end as written.
+        end: String,
+    },
     /// A condition is rejected by the assembly builder (a gap or stiffness not positive and
-    /// finite, an end listed twice...).
+    /// finite).
     #[error("[[condition]] {} ({type_name}): {source}", .index + 1)]
     Condition {
         /// Index of the condition.
@@ -127,7 +135,7 @@ pub enum AssemblyFileError {
     },
     /// An end has no condition, or two (found by
     /// [`AssemblyBuilder::build`](crate::system::AssemblyBuilder::build)).
-    #[error("end `{end}` {}: {source}", Conditions(.conditions))]
+    #[error("end `{end}` {}", EndProblem(.conditions, .source))]
     End {
         /// The end, as the file writes it.
         end: String,
@@ -168,16 +176,26 @@ impl fmt::Display for Location<'_> {
     }
 }
 
-/// `(no condition)` or `(conditions 2 and 3)`, 1-based.
-struct Conditions<'a>(&'a [usize]);
+/// What is wrong with an end, in the file's terms: `has no boundary condition`, or `has two
+/// boundary conditions: [[condition]] 2 and 3` (1-based). The builder's own message would
+/// name the end and its conditions the way Rust code writes them.
+struct EndProblem<'a>(&'a [usize], &'a ModelError);
 
-impl fmt::Display for Conditions<'_> {
+impl fmt::Display for EndProblem<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let numbers: Vec<String> = self.0.iter().map(|i| (i + 1).to_string()).collect();
-        match numbers.as_slice() {
-            [] => write!(f, "(no condition)"),
-            [one] => write!(f, "(condition {one})"),
-            [init @ .., last] => write!(f, "(conditions {} and {last})", init.join(", ")),
+        let list = match numbers.as_slice() {
+            [] => String::new(),
+            [one] => one.clone(),
+            [init @ .., last] => format!("{} and {last}", init.join(", ")),
+        };
+        match self.1 {
+            ModelError::UnconstrainedEnd { .. } => write!(f, "has no boundary condition"),
+            ModelError::OverconstrainedEnd { .. } => {
+                write!(f, "has two boundary conditions: [[condition]] {list}")
+            }
+            other if numbers.is_empty() => write!(f, "(no condition): {other}"),
+            other => write!(f, "([[condition]] {list}): {other}"),
         }
     }
 }
@@ -293,13 +311,33 @@ mod tests {
             classify(FileFormat::Json, "missing field `gap", None, None),
             AssemblyFileError::Syntax { .. }
         ));
-        let end = AssemblyFileError::End {
-            end: "a.end".into(),
-            conditions: vec![1, 2],
-            source: ModelError::NoBars,
-        };
-        assert!(end
+        let end = |conditions: Vec<usize>, source| {
+            AssemblyFileError::End {
+                end: "a.end".into(),
+                conditions,
+                source,
+            }
             .to_string()
-            .starts_with("end `a.end` (conditions 2 and 3)"));
+        };
+        let right = crate::system::AssemblyBuilder::new()
+            .add_bar(crate::bar::Bar::unit())
+            .right();
+        assert_eq!(
+            end(vec![], ModelError::UnconstrainedEnd { end: right }),
+            "end `a.end` has no boundary condition"
+        );
+        let two = ModelError::OverconstrainedEnd {
+            end: right,
+            first: "x".into(),
+            second: "y".into(),
+        };
+        assert_eq!(
+            end(vec![1, 2], two),
+            "end `a.end` has two boundary conditions: [[condition]] 2 and 3"
+        );
+        assert_eq!(
+            end(vec![0, 1, 4], ModelError::NoBars),
+            "end `a.end` ([[condition]] 1, 2 and 5): the assembly has no bar"
+        );
     }
 }
