@@ -105,3 +105,55 @@ fn a_completed_run_reports_each_step_status() {
     }
     assert!(run.converged().count() >= 170);
 }
+
+/// A start search that finds nothing stops after a bounded number of solves and says what
+/// they came to: a chain of three unequal bars held only by contacts (walls at both outer
+/// ends), whose first family does not leave its grazing point. At most two solves (plain,
+/// then in the smoothing homotopy) per guess: the seed at each frequency and amplitude, and
+/// with each bar's rigid-body motion added at each of the rigid amplitudes.
+#[test]
+fn a_failed_start_search_is_bounded_and_says_why() {
+    use nonsmooth_modes::bar::Bar;
+    use nonsmooth_modes::modal::{
+        backbone_start, linear_period, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES,
+        START_AMPLITUDES, START_RATIOS,
+    };
+    use nonsmooth_modes::system::AssemblyBuilder;
+    let mut b = AssemblyBuilder::new();
+    let bars = [(1.0, 1.0, 1.0), (1.3, 0.8, 1.5), (0.7, 1.2, 0.9)];
+    let ids: Vec<_> = bars
+        .iter()
+        .map(|&(l, c, k)| b.add_bar(Bar::new(l, c, k).unwrap()))
+        .collect();
+    b.signorini(ids[0].left(), 1e-3).unwrap();
+    b.contact(ids[0].right(), ids[1].left(), 1e-3).unwrap();
+    b.contact(ids[1].right(), ids[2].left(), 1e-3).unwrap();
+    b.signorini(ids[2].right(), 1e-3).unwrap();
+    let system = b.build().unwrap();
+    let settings = HarmonicBalanceSettings {
+        harmonics: 8,
+        ..Default::default()
+    };
+    let omega = 2.0 * std::f64::consts::PI / (linear_period(&system, 1, 1).unwrap() * 0.9875);
+    let solver = SemismoothNewton::default();
+    let ratios = START_RATIOS.len() + FLOATING_RATIOS.len();
+    let amplitudes = START_AMPLITUDES.len() + FLOATING_AMPLITUDES.len();
+    let guesses = ratios * amplitudes * (1 + bars.len() * RIGID_AMPLITUDES.len());
+    match backbone_start(&system, settings, (1, 1), omega, 1e-6, &solver) {
+        Err(Error::Settings(SettingsError::StartNotFound {
+            attempts,
+            at_rest,
+            failed,
+            up_to,
+            ..
+        })) => {
+            assert!(
+                attempts <= 1 + 2 * guesses,
+                "{attempts} > 1 + 2 x {guesses}"
+            );
+            assert_eq!(at_rest + failed, attempts);
+            assert!(up_to > omega);
+        }
+        other => panic!("{other:?}"),
+    }
+}
