@@ -1,9 +1,10 @@
 //! The march: every step, each condition turns the waves arriving at its ends into outgoing
 //! waves, resolving impacts and releases at their exact instants.
 
+use super::grid::MAX_MARCH_WORK;
 use super::state::State;
 use super::wave::{Piece, TINY};
-use super::{Condition, Snapshot, VerifyError};
+use super::{Condition, Grid, Snapshot, VerifyError};
 use crate::bar::{End, EndRef};
 use crate::fourier::check_memory;
 
@@ -47,6 +48,9 @@ pub struct StepSummary {
     pub min_contact_force: f64,
     /// Largest penetration `max(0, -g)` seen during the step.
     pub max_penetration: f64,
+    /// Energy removed during the step by merging short pieces
+    /// ([`State::projected_energy`]); 0 while no wave is at its piece limit.
+    pub projected_energy: f64,
 }
 
 /// Steps a [`State`] forward, one (possibly partial) step at a time.
@@ -115,6 +119,17 @@ fn impact(s: f64, end: f64, g: f64, rate: f64) -> Option<f64> {
     }
 }
 
+/// The ends of `condition` without allocating: `(ends, how many)`.
+fn ends_of(condition: &Condition) -> ([EndRef; 2], usize) {
+    match *condition {
+        Condition::Clamped { end }
+        | Condition::Free { end }
+        | Condition::Spring { end, .. }
+        | Condition::Obstacle { end, .. } => ([end, end], 1),
+        Condition::Contact { first, second, .. } => ([first, second], 2),
+    }
+}
+
 impl Integrator {
     /// An integrator starting from `state`.
     pub fn new(state: State, options: MarchOptions) -> Self {
@@ -156,17 +171,20 @@ impl Integrator {
     }
 
     fn advance_unchecked(&mut self, fraction: f64) -> StepSummary {
+        let projected_before = self.state.projected_energy();
         let s0 = self.state.clock;
         let s1 = s0 + fraction;
         let dt = self.state.grid.dt();
         let nb = self.state.bars.len();
         let mut end_strain = vec![[0.0; 2]; nb];
-        let conditions = self.state.model.conditions().to_vec();
-        let mut contact_force = vec![0.0; conditions.len()];
+        let count = self.state.model.conditions().len();
+        let mut contact_force = vec![0.0; count];
         let mut min_force = f64::INFINITY;
         let mut penetration: f64 = 0.0;
-        for (ci, condition) in conditions.iter().enumerate() {
-            let ends = condition.ends();
+        for ci in 0..count {
+            let condition = self.state.model.conditions()[ci];
+            let (ends, ports_used) = ends_of(&condition);
+            let ends = &ends[..ports_used];
             let mut ports = [None, None];
             for (k, end) in ends.iter().enumerate() {
                 let b = end.bar.index();
@@ -195,7 +213,7 @@ impl Integrator {
                 penetration: 0.0,
             };
             let (inc, out) = (&self.incoming, &mut self.outgoing);
-            match (*condition, ports) {
+            match (condition, ports) {
                 (Condition::Clamped { .. }, [Some(mut p), _]) => {
                     for q in &inc[0] {
                         p.emit(&mut out[0], q.end, q.value, -q.value, q.end - q.start);
@@ -324,7 +342,7 @@ impl Integrator {
             for (k, end) in ends.iter().enumerate() {
                 let Some(p) = ports[k] else { continue };
                 let b = end.bar.index();
-                let cells = self.state.grid.cells(b) as f64;
+                let travel = self.state.grid.travel_steps(b);
                 let side = usize::from(end.end == End::Right);
                 let waves = &mut self.state.bars[b];
                 waves.ends[side] = p.u;
@@ -335,7 +353,7 @@ impl Integrator {
                     &mut waves.right
                 };
                 for &(until, value) in &self.outgoing[k] {
-                    wave.push_until(until + cells, value);
+                    wave.push_until(until + travel, value);
                 }
             }
         }
@@ -347,6 +365,7 @@ impl Integrator {
             contact_force,
             min_contact_force: min_force,
             max_penetration: penetration,
+            projected_energy: self.state.projected_energy() - projected_before,
         }
     }
 }
@@ -380,7 +399,8 @@ pub struct ContactHistory {
 pub struct Trajectory {
     /// Instants: 0, then the end of every step.
     pub times: Vec<f64>,
-    /// Energy at each instant (exact for the discrete state, see [`State::energy`]).
+    /// Energy at each instant ([`State::energy`] of the discrete state, from running
+    /// integrals that equal it to rounding).
     pub energy: Vec<f64>,
     /// Every bar end, `[bar 0 left, bar 0 right, bar 1 left, ...]`.
     pub ends: Vec<MarchedEnd>,
@@ -395,6 +415,10 @@ pub struct Trajectory {
     pub min_contact_force: f64,
     /// `max_t |E(t) - E(0)| / E(0)` (absolute if `E(0) = 0`).
     pub energy_drift: f64,
+    /// Energy removed over the march by merging short pieces ([`State::projected_energy`]),
+    /// absolute: with lossless conditions `E(t) + (removed by t) = E(0)` to rounding, so
+    /// `energy_drift E(0)` is at most this much plus rounding.
+    pub projected_energy: f64,
     /// The state at the end.
     pub final_state: State,
 }
@@ -427,14 +451,39 @@ fn check_history(initial: &State, steps: f64, snapshot_every: usize) -> Result<(
     )?)
 }
 
+/// Checks that a march of `steps` steps on `grid` stays within [`MAX_MARCH_WORK`].
+fn check_work(grid: &Grid, steps: f64) -> Result<(), VerifyError> {
+    let (per_step, work) = grid.march_work(steps);
+    if work > MAX_MARCH_WORK as f64 {
+        return Err(VerifyError::TooCostly {
+            steps,
+            per_step,
+            work,
+            limit: MAX_MARCH_WORK as f64,
+        });
+    }
+    Ok(())
+}
+
 /// Marches `initial` over `duration` (full steps, then one partial step for the remainder)
 /// and records end histories, contact histories, energy and snapshots.
+///
+/// **Cost.** A step takes the pieces of the waves that reach the ends during it. The march
+/// caps the pieces of each wave according to its length ([`MARCH_WORK`](super::MARCH_WORK)):
+/// it is exact (no merge) as long as the waves would cost less than about `MARCH_WORK` piece
+/// operations in all; beyond, it keeps at least
+/// [`PIECES_PER_CELL`](super::PIECES_PER_CELL) pieces per cell and merges shorter ones
+/// ([`Trajectory::projected_energy`]). Its work is therefore at most
+/// `2 MARCH_WORK + sum_waves ((steps / nu_b + 1) (2 PIECES_PER_CELL N_b + 2) + steps)`
+/// pieces taken ([`Grid::march_work`]): linear in the number of steps, whatever the travel
+/// times and the impacts. Marches whose bound exceeds [`MAX_MARCH_WORK`] are refused.
 ///
 /// # Errors
 /// [`VerifyError::InvalidParameter`] if `duration` is negative or not finite;
 /// [`VerifyError::TooLarge`] if the histories of its `duration / dt` steps (and its
 /// snapshots) do not fit in the memory budget
-/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+/// [`VerifyError::TooCostly`] if the bound on its work exceeds [`MAX_MARCH_WORK`].
 pub fn march(
     initial: &State,
     duration: f64,
@@ -452,6 +501,8 @@ pub fn march(
     let rest = total - full;
     let partial = (rest > 1e-9).then_some(rest);
     check_history(initial, full + 1.0, options.snapshot_every)?;
+    let planned = full + partial.map_or(0.0, |_| 1.0);
+    check_work(initial.grid(), planned)?;
     let full = full as usize;
     let steps = full + usize::from(partial.is_some());
     let fractions = std::iter::repeat_n(1.0, full).chain(partial);
@@ -478,7 +529,7 @@ pub fn march(
             force: Vec::with_capacity(steps),
         })
         .collect();
-    let e0 = initial.energy();
+    let e0 = initial.tracked_energy();
     let mut times = vec![0.0];
     let mut energy = vec![e0];
     let mut snapshots = Vec::new();
@@ -487,12 +538,15 @@ pub fn march(
     }
     let mut max_penetration = initial.penetration();
     let mut min_contact_force = f64::INFINITY;
-    let mut integrator = Integrator::new(initial.clone(), *options);
+    let mut start = initial.clone();
+    let grid = initial.grid().clone();
+    start.set_resolution(|b| grid.march_resolution(b, planned));
+    let mut integrator = Integrator::new(start, *options);
     for (k, f) in fractions.enumerate() {
         let summary = integrator.advance_unchecked(f);
         let state = integrator.state();
         times.push(summary.time);
-        energy.push(state.energy());
+        energy.push(state.tracked_energy());
         for h in ends.iter_mut() {
             h.displacement.push(state.end_displacement(h.end));
             h.strain
@@ -508,6 +562,8 @@ pub fn march(
             snapshots.push(state.snapshot());
         }
     }
+    let mut final_state = integrator.into_state();
+    final_state.set_resolution(|b| grid.resolution(b));
     let scale = if e0 > 0.0 { e0 } else { 1.0 };
     let energy_drift = energy
         .iter()
@@ -521,6 +577,7 @@ pub fn march(
         max_penetration,
         min_contact_force,
         energy_drift,
-        final_state: integrator.into_state(),
+        projected_energy: final_state.projected_energy() - initial.projected_energy(),
+        final_state,
     })
 }
