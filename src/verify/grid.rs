@@ -100,7 +100,7 @@ impl Grid {
         for (b, bar) in model.bars().iter().enumerate() {
             let travel_time = travel_time(bar);
             let nu = steps_of(travel_time, dt);
-            if !(nu >= 1.0) {
+            if nu < 1.0 {
                 return Err(VerifyError::NonMatchingGrid {
                     bar: b,
                     travel_time,

@@ -137,17 +137,16 @@ mod march;
 mod model;
 mod periodicity;
 mod state;
+mod trajectory;
 mod wave;
 
 pub use crate::error::VerifyError;
 pub use exact::clamped_first_mode;
 pub use grid::{Grid, MARCH_WORK, MAX_MARCH_WORK, PIECES_PER_CELL};
-pub use march::{
-    march, ContactHistory, Integrator, MarchOptions, MarchedEnd, SpringUpdate, StepSummary,
-    Trajectory,
-};
+pub use march::{Integrator, MarchOptions, SpringUpdate, StepSummary};
 pub use model::{Condition, Model};
 pub use periodicity::{
     periodicity_check, periodicity_of_state, PeriodicityOptions, PeriodicityReport,
 };
 pub use state::{BarCells, BarSnapshot, Snapshot, State};
+pub use trajectory::{march, ContactHistory, MarchedEnd, Trajectory};
