@@ -23,9 +23,9 @@ pub const MARCH_WORK: usize = 1 << 24;
 
 /// The most wave-piece operations a [`march`](super::march) may take by its bound
 /// ([`Grid::march_work`]): longer marches are refused with
-/// [`VerifyError::TooCostly`](super::VerifyError::TooCostly). That is about 7e6 steps of one
-/// bar or 3.5e6 of two (a few seconds, `docs/reliability.md`); the memory budget of the
-/// histories alone would allow ten times more.
+/// [`VerifyError::TooCostly`](super::VerifyError::TooCostly). That is about 5.6e6 steps of one
+/// bar or 2.8e6 of two (seconds, `docs/reliability.md`); the memory budget of the histories
+/// alone would allow ten times more.
 pub const MAX_MARCH_WORK: usize = 1 << 27;
 
 /// Doubles held per cell of the grid by a periodicity check: the initial strain, velocity and

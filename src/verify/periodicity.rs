@@ -85,6 +85,7 @@ pub struct PeriodicityReport {
 /// periods, a march shorter than one time step or an infinite march (`periods * period`
 /// overflows); [`VerifyError::TooLarge`]
 /// if the histories of the march do not fit in the memory budget (see [`march`]);
+/// [`VerifyError::TooCostly`] if its work bound exceeds [`MAX_MARCH_WORK`](super::MAX_MARCH_WORK);
 /// [`VerifyError::NonFiniteResult`] if a number of the report overflows.
 pub fn periodicity_of_state(
     initial: &State,
@@ -229,11 +230,13 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
 ///
 /// # Errors
 /// Unsupported conditions, a time step longer than a bar's travel time
-/// ([`VerifyError::NonMatchingGrid`]), a solution vector of the wrong length or with NaN, an `omega` that is not positive and finite or is below
+/// ([`VerifyError::NonMatchingGrid`]), a solution vector of the wrong length or with NaN, an
+/// `omega` that is not positive and finite or is below
 /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY) ([`VerifyError`]);
 /// [`VerifyError::TooLarge`] if the cells of the grid or the histories of the
 /// `periods 2 pi / (omega dt)` steps do not fit in the memory budget
-/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)); [`VerifyError::TooCostly`]
+/// if the march's work bound exceeds [`MAX_MARCH_WORK`](super::MAX_MARCH_WORK).
 pub fn periodicity_check<B: Basis>(
     system: &BarSystem,
     basis: &B,
