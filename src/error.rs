@@ -497,9 +497,11 @@ pub enum VerifyError {
         /// The rejected step.
         dt: f64,
     },
-    /// A bar's travel time `l / c` is not an integer number of steps.
+    /// A bar's travel time `l / c` is shorter than one time step: a wave would cross it
+    /// within a step, before the other end has answered.
     #[error(
-        "{} has l/c = {travel_time} = {cells} steps of dt = {dt}: not an integer number of cells",
+        "{} has l/c = {travel_time} = {cells} steps of dt = {dt}: the time step must not \
+         exceed the travel time of any bar",
         BarId(*.bar)
     )]
     NonMatchingGrid {
@@ -512,7 +514,9 @@ pub enum VerifyError {
         /// `l / (c dt)`.
         cells: f64,
     },
-    /// No time step near the requested one gives every bar an integer number of cells.
+    /// No time step near the requested one gives every bar an integer number of cells
+    /// ([`Grid::nearest`](crate::verify::Grid::nearest), which looks for a commensurate grid;
+    /// any step gives a valid grid).
     #[error("no time step between {low} and {high} gives every bar an integer number of cells")]
     NoAdmissibleGrid {
         /// Smallest step searched.
@@ -580,6 +584,24 @@ pub enum VerifyError {
     /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
     #[error(transparent)]
     TooLarge(#[from] OverBudget),
+    /// A march would take more work than
+    /// [`MAX_MARCH_WORK`](crate::verify::MAX_MARCH_WORK) wave-piece operations (its bound,
+    /// see [`verify::march`](crate::verify::march)).
+    #[error(
+        "a march of {steps} time steps takes up to {work:.3e} wave-piece operations \
+         ({per_step:.1} per step), over the limit of {limit:.3e}: march fewer periods or use \
+         a longer time step"
+    )]
+    TooCostly {
+        /// Steps of the march.
+        steps: f64,
+        /// Bound on the pieces taken at the ends per step, at the grid's resolution.
+        per_step: f64,
+        /// Bound on the pieces taken at the ends over the march.
+        work: f64,
+        /// [`MAX_MARCH_WORK`](crate::verify::MAX_MARCH_WORK).
+        limit: f64,
+    },
 }
 
 /// Any error of the crate.

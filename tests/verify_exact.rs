@@ -147,9 +147,11 @@ fn partial_steps_compose() {
 fn bad_inputs_give_typed_errors() {
     let two = two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 0.1).unwrap();
     let model = Model::from_system(&two).unwrap();
+    // Any step up to the shorter travel time (0.95) is a grid; a longer one is refused.
+    assert!(!Grid::new(&model, 0.007).unwrap().is_commensurate());
     assert!(matches!(
-        Grid::new(&model, 0.007),
-        Err(VerifyError::NonMatchingGrid { .. })
+        Grid::new(&model, 0.96),
+        Err(VerifyError::NonMatchingGrid { bar: 1, .. })
     ));
     for dt in [0.0, -0.01, f64::NAN, f64::INFINITY] {
         assert!(matches!(

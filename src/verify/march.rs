@@ -3,9 +3,8 @@
 
 use super::state::State;
 use super::wave::{Piece, TINY};
-use super::{Condition, Snapshot, VerifyError};
+use super::{Condition, VerifyError};
 use crate::bar::{End, EndRef};
-use crate::fourier::check_memory;
 
 /// How a ground spring is advanced over a piece of constant incoming wave `a`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -21,13 +20,14 @@ pub enum SpringUpdate {
     Midpoint,
 }
 
-/// Options of [`march`] and [`Integrator`].
+/// Options of [`march`](super::march) and [`Integrator`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MarchOptions {
     /// Update of ground springs (default [`SpringUpdate::Exact`]).
     pub spring: SpringUpdate,
-    /// Keep a [`Snapshot`] of the fields every that many steps (0, the default: only none;
-    /// the initial and final states are always available from the [`Trajectory`]).
+    /// Keep a [`Snapshot`](super::Snapshot) of the fields every that many steps (0, the default: only none;
+    /// the initial and final states are always available from the
+    /// [`Trajectory`](super::Trajectory)).
     pub snapshot_every: usize,
 }
 
@@ -47,6 +47,9 @@ pub struct StepSummary {
     pub min_contact_force: f64,
     /// Largest penetration `max(0, -g)` seen during the step.
     pub max_penetration: f64,
+    /// Energy removed during the step by merging short pieces
+    /// ([`State::projected_energy`]); 0 while no wave is at its piece limit.
+    pub projected_energy: f64,
 }
 
 /// Steps a [`State`] forward, one (possibly partial) step at a time.
@@ -115,6 +118,17 @@ fn impact(s: f64, end: f64, g: f64, rate: f64) -> Option<f64> {
     }
 }
 
+/// The ends of `condition` without allocating: `(ends, how many)`.
+fn ends_of(condition: &Condition) -> ([EndRef; 2], usize) {
+    match *condition {
+        Condition::Clamped { end }
+        | Condition::Free { end }
+        | Condition::Spring { end, .. }
+        | Condition::Obstacle { end, .. } => ([end, end], 1),
+        Condition::Contact { first, second, .. } => ([first, second], 2),
+    }
+}
+
 impl Integrator {
     /// An integrator starting from `state`.
     pub fn new(state: State, options: MarchOptions) -> Self {
@@ -155,18 +169,21 @@ impl Integrator {
         Ok(self.advance_unchecked(fraction))
     }
 
-    fn advance_unchecked(&mut self, fraction: f64) -> StepSummary {
+    pub(super) fn advance_unchecked(&mut self, fraction: f64) -> StepSummary {
+        let projected_before = self.state.projected_energy();
         let s0 = self.state.clock;
         let s1 = s0 + fraction;
         let dt = self.state.grid.dt();
         let nb = self.state.bars.len();
         let mut end_strain = vec![[0.0; 2]; nb];
-        let conditions = self.state.model.conditions().to_vec();
-        let mut contact_force = vec![0.0; conditions.len()];
+        let count = self.state.model.conditions().len();
+        let mut contact_force = vec![0.0; count];
         let mut min_force = f64::INFINITY;
         let mut penetration: f64 = 0.0;
-        for (ci, condition) in conditions.iter().enumerate() {
-            let ends = condition.ends();
+        for (ci, force) in contact_force.iter_mut().enumerate() {
+            let condition = self.state.model.conditions()[ci];
+            let (ends, ports_used) = ends_of(&condition);
+            let ends = &ends[..ports_used];
             let mut ports = [None, None];
             for (k, end) in ends.iter().enumerate() {
                 let b = end.bar.index();
@@ -195,7 +212,7 @@ impl Integrator {
                 penetration: 0.0,
             };
             let (inc, out) = (&self.incoming, &mut self.outgoing);
-            match (*condition, ports) {
+            match (condition, ports) {
                 (Condition::Clamped { .. }, [Some(mut p), _]) => {
                     for q in &inc[0] {
                         p.emit(&mut out[0], q.end, q.value, -q.value, q.end - q.start);
@@ -317,14 +334,14 @@ impl Integrator {
                 _ => unreachable!("a condition has as many ports as ends"),
             }
             if condition.is_unilateral() {
-                contact_force[ci] = watch.force / fraction;
+                *force = watch.force / fraction;
                 min_force = min_force.min(watch.min_force);
                 penetration = penetration.max(watch.penetration);
             }
             for (k, end) in ends.iter().enumerate() {
                 let Some(p) = ports[k] else { continue };
                 let b = end.bar.index();
-                let cells = self.state.grid.cells(b) as f64;
+                let travel = self.state.grid.travel_steps(b);
                 let side = usize::from(end.end == End::Right);
                 let waves = &mut self.state.bars[b];
                 waves.ends[side] = p.u;
@@ -335,7 +352,7 @@ impl Integrator {
                     &mut waves.right
                 };
                 for &(until, value) in &self.outgoing[k] {
-                    wave.push_until(until + cells, value);
+                    wave.push_until(until + travel, value);
                 }
             }
         }
@@ -347,180 +364,7 @@ impl Integrator {
             contact_force,
             min_contact_force: min_force,
             max_penetration: penetration,
+            projected_energy: self.state.projected_energy() - projected_before,
         }
     }
-}
-
-/// History of one bar end along a march (the harmonic-balance side is
-/// [`modal::diagnostics::EndHistory`](crate::modal::diagnostics::EndHistory)).
-#[derive(Debug, Clone, PartialEq)]
-pub struct MarchedEnd {
-    /// The end.
-    pub end: EndRef,
-    /// Displacement at each instant of [`Trajectory::times`].
-    pub displacement: Vec<f64>,
-    /// Mean strain `u_x` over each step (one fewer entry than `times`).
-    pub strain: Vec<f64>,
-}
-
-/// History of one unilateral condition.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ContactHistory {
-    /// Index of the condition in the model.
-    pub condition: usize,
-    /// Gap at each instant of [`Trajectory::times`].
-    pub gap: Vec<f64>,
-    /// Mean contact force over each step (one fewer entry than `times`): the impulse of the
-    /// step divided by its length.
-    pub force: Vec<f64>,
-}
-
-/// Result of [`march`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct Trajectory {
-    /// Instants: 0, then the end of every step.
-    pub times: Vec<f64>,
-    /// Energy at each instant (exact for the discrete state, see [`State::energy`]).
-    pub energy: Vec<f64>,
-    /// Every bar end, `[bar 0 left, bar 0 right, bar 1 left, ...]`.
-    pub ends: Vec<MarchedEnd>,
-    /// Every unilateral condition, in model order.
-    pub contacts: Vec<ContactHistory>,
-    /// Snapshots every [`MarchOptions::snapshot_every`] steps (and at `t = 0`).
-    pub snapshots: Vec<Snapshot>,
-    /// Largest penetration over the march (including the initial state).
-    pub max_penetration: f64,
-    /// Smallest contact force over the march (0 if some contact opened; `+inf` without
-    /// unilateral conditions).
-    pub min_contact_force: f64,
-    /// `max_t |E(t) - E(0)| / E(0)` (absolute if `E(0) = 0`).
-    pub energy_drift: f64,
-    /// The state at the end.
-    pub final_state: State,
-}
-
-/// Checks that the histories of a march of `steps` steps from `initial`, with a snapshot
-/// every `snapshot_every` steps, fit in the memory budget: per step the time and the energy,
-/// the displacement and strain of every bar end and the gap and force of every unilateral
-/// condition; per snapshot the three fields of every cell.
-fn check_history(initial: &State, steps: f64, snapshot_every: usize) -> Result<(), VerifyError> {
-    let model = initial.model();
-    let bars = model.bars().len() as f64;
-    let contacts = model
-        .conditions()
-        .iter()
-        .filter(|c| c.is_unilateral())
-        .count() as f64;
-    let per_step = 2.0 + 4.0 * bars + 2.0 * contacts;
-    let snapshots = if snapshot_every > 0 {
-        steps / snapshot_every as f64 + 1.0
-    } else {
-        0.0
-    };
-    let grid = initial.grid();
-    let cells = (0..grid.bars()).map(|b| grid.cells(b) as f64).sum::<f64>();
-    let per_snapshot = 3.0 * cells + bars + 1.0;
-    let doubles = steps * per_step + snapshots * per_snapshot;
-    Ok(check_memory(
-        "the histories of a march (duration / dt steps)",
-        doubles,
-    )?)
-}
-
-/// Marches `initial` over `duration` (full steps, then one partial step for the remainder)
-/// and records end histories, contact histories, energy and snapshots.
-///
-/// # Errors
-/// [`VerifyError::InvalidParameter`] if `duration` is negative or not finite;
-/// [`VerifyError::TooLarge`] if the histories of its `duration / dt` steps (and its
-/// snapshots) do not fit in the memory budget
-/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
-pub fn march(
-    initial: &State,
-    duration: f64,
-    options: &MarchOptions,
-) -> Result<Trajectory, VerifyError> {
-    let dt = initial.grid().dt();
-    let total = duration / dt;
-    if !(duration.is_finite() && duration >= 0.0) {
-        return Err(VerifyError::InvalidParameter {
-            what: "march duration",
-            value: duration,
-        });
-    }
-    let full = (total + 1e-9).floor();
-    let rest = total - full;
-    let partial = (rest > 1e-9).then_some(rest);
-    check_history(initial, full + 1.0, options.snapshot_every)?;
-    let full = full as usize;
-    let steps = full + usize::from(partial.is_some());
-    let fractions = std::iter::repeat_n(1.0, full).chain(partial);
-    let model = initial.model().clone();
-    let mut ends: Vec<MarchedEnd> = (0..model.bars().len())
-        .flat_map(|b| {
-            let id = crate::bar::BarId(b);
-            [id.left(), id.right()]
-        })
-        .map(|end| MarchedEnd {
-            end,
-            displacement: vec![initial.end_displacement(end)],
-            strain: Vec::with_capacity(steps),
-        })
-        .collect();
-    let mut contacts: Vec<ContactHistory> = model
-        .conditions()
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.is_unilateral())
-        .map(|(i, _)| ContactHistory {
-            condition: i,
-            gap: vec![initial.gap(i).unwrap_or(0.0)],
-            force: Vec::with_capacity(steps),
-        })
-        .collect();
-    let e0 = initial.energy();
-    let mut times = vec![0.0];
-    let mut energy = vec![e0];
-    let mut snapshots = Vec::new();
-    if options.snapshot_every > 0 {
-        snapshots.push(initial.snapshot());
-    }
-    let mut max_penetration = initial.penetration();
-    let mut min_contact_force = f64::INFINITY;
-    let mut integrator = Integrator::new(initial.clone(), *options);
-    for (k, f) in fractions.enumerate() {
-        let summary = integrator.advance_unchecked(f);
-        let state = integrator.state();
-        times.push(summary.time);
-        energy.push(state.energy());
-        for h in ends.iter_mut() {
-            h.displacement.push(state.end_displacement(h.end));
-            h.strain
-                .push(summary.end_strain[h.end.bar.index()][usize::from(h.end.end == End::Right)]);
-        }
-        for h in contacts.iter_mut() {
-            h.gap.push(state.gap(h.condition).unwrap_or(0.0));
-            h.force.push(summary.contact_force[h.condition]);
-        }
-        max_penetration = max_penetration.max(summary.max_penetration);
-        min_contact_force = min_contact_force.min(summary.min_contact_force);
-        if options.snapshot_every > 0 && (k + 1) % options.snapshot_every == 0 {
-            snapshots.push(state.snapshot());
-        }
-    }
-    let scale = if e0 > 0.0 { e0 } else { 1.0 };
-    let energy_drift = energy
-        .iter()
-        .fold(0.0f64, |m, e| m.max((e - e0).abs() / scale));
-    Ok(Trajectory {
-        times,
-        energy,
-        ends,
-        contacts,
-        snapshots,
-        max_penetration,
-        min_contact_force,
-        energy_drift,
-        final_state: integrator.into_state(),
-    })
 }

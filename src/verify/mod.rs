@@ -12,12 +12,14 @@
 //!   EA/2 (u_t^2/c^2 + u_x^2) = EA / (4 c^2) (R^2 + L^2).
 //! ```
 //!
-//! On a grid with `dx = c dt` a wave moves exactly one cell per step, so transporting it is a
-//! shift and introduces no error at all. Each wave is stored as a **piecewise-constant function
-//! of its arrival time** at the end it is travelling to (see [`State`](crate::verify::State)): initially one piece per
-//! cell (the cell averages of `u_t -/+ c u_x`), and at an end the incoming piece(s) of a step are
-//! turned into outgoing piece(s) by the boundary condition. With the incoming value `a` and the
-//! outgoing value `b` at an end of outward normal `n` (impedance `Z = EA / c`):
+//! Each wave is stored as a **piecewise-constant function of its arrival time** at the end it
+//! is travelling to (see [`State`](crate::verify::State)), in steps of a common `dt`: a part
+//! that leaves one end of bar `b` at clock `s` reaches the other end at `s + nu_b`, with
+//! `nu_b = l_b / (c_b dt)` ([`Grid::travel_steps`](crate::verify::Grid::travel_steps)).
+//! Transport is this shift and introduces no error at all, whatever `nu_b`; a step is only
+//! bookkeeping at the ends, where the incoming piece(s) of the step are turned into outgoing
+//! piece(s) by the boundary condition. With the incoming value `a` and the outgoing value `b`
+//! at an end of outward normal `n` (impedance `Z = EA / c`):
 //!
 //! ```text
 //!   u_t = (a + b)/2,   u_x = n (b - a)/(2c),   contact force lambda = -EA u_x = n Z (a - b)/2,
@@ -36,7 +38,8 @@
 //! any other. **Release** happens when the incoming wave stops pushing (`w <= 0`), which can only
 //! change at a breakpoint of the incoming wave: it is resolved exactly too, at no cost. Clamped,
 //! free, obstacle and contact ends are lossless (`|b| = |a|` or a lossless impedance junction),
-//! so the discrete energy — computed exactly from the pieces — is conserved to rounding.
+//! so the discrete energy — computed exactly from the pieces — is conserved to rounding (up
+//! to what the merges below remove, which is reported).
 //!
 //! A ground spring is advanced with the **exact** solution of `u' = a - beta u`
 //! (`beta = k_s / Z`) over each piece, and the outgoing wave keeps the exact mean of
@@ -46,6 +49,64 @@
 //! that vanishes as `dt -> 0` ([`SpringUpdate::Exact`](crate::verify::SpringUpdate::Exact)). [`SpringUpdate::Midpoint`](crate::verify::SpringUpdate::Midpoint) instead
 //! imposes the spring law at the midpoint of each piece (implicit midpoint rule): energy is then
 //! conserved to rounding, and the end displacement is second-order accurate.
+//!
+//! # Any travel times
+//!
+//! The initial state holds `N_b = ceil(nu_b)` cells per bar, of length `l_b / N_b` and of
+//! duration `h_b = nu_b / N_b` steps (1 on a **commensurate** grid, where every `nu_b` is an
+//! integer, between 1/2 and 1 otherwise): one piece per cell and wave (the cell means of
+//! `u_t -/+ c u_x`). Snapshots, the energy and the norm are computed on the same cells. The
+//! only requirement is `nu_b >= 1` (a step no longer than any travel time), so that what an
+//! end emits during a step reaches the other end after the step
+//! ([`VerifyError::NonMatchingGrid`](crate::verify::VerifyError::NonMatchingGrid) otherwise).
+//!
+//! On a commensurate grid every breakpoint stays on the lattice of steps, but for those of
+//! impacts. Otherwise the breakpoints of bars of different travel times meet at every
+//! contact that is stuck (and a spring splits its outgoing wave at every step): their
+//! offsets never repeat, and the number of pieces grows with time. The same happens on any
+//! grid under persistent chattering impacts. To keep a step's work bounded, a wave that holds
+//! more than a cap of pieces merges any new piece shorter than `h_b /`
+//! [`PIECES_PER_CELL`](crate::verify::PIECES_PER_CELL) into its neighbour, by their
+//! length-weighted mean: an `L2` projection onto a coarser partition that keeps the
+//! integral of the wave, hence every displacement, and removes exactly
+//!
+//! ```text
+//!   Delta E = Z dt / 4  h_1 h_2 / (h_1 + h_2)  (v_1 - v_2)^2      (h in steps)
+//! ```
+//!
+//! of energy. A wave then never holds more than `cap + PIECES_PER_CELL N_b + 2` pieces (all
+//! but those pushed below the cap are at least `h_b / PIECES_PER_CELL` long). The cap is
+//! `PIECES_PER_CELL N_b` for an [`Integrator`](crate::verify::Integrator) stepping on its own
+//! and, for a [`march`](crate::verify::march), whatever its share of
+//! [`MARCH_WORK`](crate::verify::MARCH_WORK) allows, so that a march of ordinary length
+//! (one or a few periods) is exact and merges nothing. The energy removed is
+//! reported ([`State::projected_energy`](crate::verify::State::projected_energy),
+//! [`StepSummary::projected_energy`](crate::verify::StepSummary::projected_energy),
+//! [`Trajectory::projected_energy`](crate::verify::Trajectory::projected_energy),
+//! [`PeriodicityReport::projected_energy`](crate::verify::PeriodicityReport::projected_energy)):
+//! the lossless conditions conserve `E + removed` to rounding. Each removed part is
+//! orthogonal to what its merge keeps and has the state norm `sqrt(2 Delta E)`; the periodicity
+//! report gives `sqrt(2 sum Delta E) / |X(0)|` as the estimate of the merges' share of its
+//! defect ([`PeriodicityReport::projection_error`](crate::verify::PeriodicityReport::projection_error)).
+//!
+//! Accuracy then is that of the initial cell averages: the defect of an exact linear mode of
+//! two or three bars with incommensurate travel times is first order in `dt`
+//! (`docs/validation.md`). A commensurate grid ([`Grid::nearest`](crate::verify::Grid::nearest),
+//! [`PeriodicityOptions::adjust_grid`](crate::verify::PeriodicityOptions::adjust_grid)) is
+//! never needed, but is still preferred on request.
+//!
+//! Why this rather than a common grid with interpolation: the transport and the impact
+//! instants stay exact for any travel times, the only approximation (the merges) acts where
+//! and when the pieces would multiply and nowhere else, and its error is known exactly. An
+//! interpolating grid would dissipate at every step of every bar, commensurate or not.
+//!
+//! **Cost.** A step takes the pieces that reach the ends during it; a wave holds exactly the
+//! pieces that arrive within the next `nu_b` steps, so with the cap the work of a march is
+//! linear in its steps ([`Grid::march_work`](crate::verify::Grid::march_work) gives the bound),
+//! and marches whose bound exceeds [`MAX_MARCH_WORK`](crate::verify::MAX_MARCH_WORK) are
+//! refused ([`VerifyError::TooCostly`](crate::verify::VerifyError::TooCostly)). The energy
+//! history costs nothing per step: each wave keeps the integral of its square up to date
+//! (compensated sums) as pieces come and go.
 //!
 //! # Which conditions are supported
 //!
@@ -67,7 +128,8 @@
 //! ```
 //!
 //! (twice the elastic energy, plus the end displacements so that rigid shifts count), together
-//! with the largest penetration, the smallest contact force and the energy drift.
+//! with the largest penetration, the smallest contact force, the energy drift and what the
+//! merges removed.
 
 mod exact;
 mod grid;
@@ -75,17 +137,16 @@ mod march;
 mod model;
 mod periodicity;
 mod state;
+mod trajectory;
 mod wave;
 
 pub use crate::error::VerifyError;
 pub use exact::clamped_first_mode;
-pub use grid::Grid;
-pub use march::{
-    march, ContactHistory, Integrator, MarchOptions, MarchedEnd, SpringUpdate, StepSummary,
-    Trajectory,
-};
+pub use grid::{Grid, MARCH_WORK, MAX_MARCH_WORK, PIECES_PER_CELL};
+pub use march::{Integrator, MarchOptions, SpringUpdate, StepSummary};
 pub use model::{Condition, Model};
 pub use periodicity::{
     periodicity_check, periodicity_of_state, PeriodicityOptions, PeriodicityReport,
 };
 pub use state::{BarCells, BarSnapshot, Snapshot, State};
+pub use trajectory::{march, ContactHistory, MarchedEnd, Trajectory};

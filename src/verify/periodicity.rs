@@ -7,11 +7,14 @@ use crate::system::BarSystem;
 /// Options of [`periodicity_check`] and [`periodicity_of_state`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PeriodicityOptions {
-    /// Time step `dt` (default `1/400`: 400 cells per unit length at `c = 1`).
+    /// Time step `dt` (default `1/400`: 400 cells per unit length at `c = 1`). Any step up to
+    /// the shortest travel time `l_b / c_b` of the bars ([`Grid::new`]).
     pub dt: f64,
-    /// If `dt` does not give every bar an integer number of cells: `false` (default) returns
-    /// [`VerifyError::NonMatchingGrid`]; `true` uses the nearest admissible step
-    /// ([`Grid::nearest`]) and reports it in [`PeriodicityReport::dt`].
+    /// `false` (default): march with `dt` itself. `true`: prefer the nearest step between
+    /// `dt / 2` and `2 dt` that gives every bar an integer number of cells
+    /// ([`Grid::nearest`]; on such a commensurate grid the waves never need merging for want
+    /// of a common lattice), and fall back to `dt` if there is none. The step used is
+    /// [`PeriodicityReport::dt`].
     pub adjust_grid: bool,
     /// Update of ground springs (default [`SpringUpdate::Exact`]).
     pub spring: SpringUpdate,
@@ -59,6 +62,20 @@ pub struct PeriodicityReport {
     /// Smallest contact force over the march (0 once a contact opens; never negative; `+inf`
     /// for a system without unilateral condition).
     pub min_contact_force: f64,
+    /// Energy removed by merging short wave pieces over the march, relative to the initial
+    /// energy ([`Trajectory::projected_energy`](super::Trajectory::projected_energy)
+    /// divided by `E(0)`, absolute if `E(0) = 0`): 0 while no wave reaches its piece limit
+    /// ([`Grid::max_pieces`]), which is the rule on a commensurate grid without many impacts.
+    /// With lossless conditions, [`PeriodicityReport::energy_drift`] is at most this plus
+    /// rounding.
+    pub projected_energy: f64,
+    /// Estimate of the error the merges add to [`PeriodicityReport::defect`]:
+    /// `sqrt(2 removed energy) / |X(0)|`, the norm of everything they removed, as if the
+    /// removed parts were mutually orthogonal (each is orthogonal to what its merge keeps;
+    /// they are sub-cell fluctuations from different places and instants). 0 when nothing
+    /// was merged. The defect says something about the checked orbit only where it is well
+    /// above this.
+    pub projection_error: f64,
 }
 
 /// Marches `initial` over `periods * period` and compares the final state with it.
@@ -68,6 +85,7 @@ pub struct PeriodicityReport {
 /// periods, a march shorter than one time step or an infinite march (`periods * period`
 /// overflows); [`VerifyError::TooLarge`]
 /// if the histories of the march do not fit in the memory budget (see [`march`]);
+/// [`VerifyError::TooCostly`] if its work bound exceeds [`MAX_MARCH_WORK`](super::MAX_MARCH_WORK);
 /// [`VerifyError::NonFiniteResult`] if a number of the report overflows.
 pub fn periodicity_of_state(
     initial: &State,
@@ -114,6 +132,11 @@ pub fn periodicity_of_state(
             change = change.max((u1 - u0).abs());
         }
     }
+    let energy_scale = if trajectory.energy[0] > 0.0 {
+        trajectory.energy[0]
+    } else {
+        1.0
+    };
     let report = PeriodicityReport {
         period,
         dt: initial.grid().dt(),
@@ -133,6 +156,12 @@ pub fn periodicity_of_state(
         initial_penetration: initial.penetration(),
         max_penetration: trajectory.max_penetration,
         min_contact_force: trajectory.min_contact_force,
+        projected_energy: trajectory.projected_energy / energy_scale,
+        projection_error: if initial_norm > 0.0 {
+            (2.0 * trajectory.projected_energy).sqrt() / initial_norm
+        } else {
+            (2.0 * trajectory.projected_energy).sqrt()
+        },
     };
     check_report(&report)?;
     Ok(report)
@@ -153,6 +182,8 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
         ("energy drift", r.energy_drift),
         ("initial penetration", r.initial_penetration),
         ("largest penetration", r.max_penetration),
+        ("projected energy", r.projected_energy),
+        ("projection error", r.projection_error),
     ];
     match values.into_iter().find(|(_, v)| !v.is_finite()) {
         Some((what, value)) => Err(VerifyError::NonFiniteResult { what, value }),
@@ -193,13 +224,19 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
 /// # Ok::<(), nonsmooth_modes::Error>(())
 /// ```
 ///
+/// Any travel times: on a grid that is not commensurate the march merges short pieces where
+/// needed and reports what that costs in [`PeriodicityReport::projected_energy`] and
+/// [`PeriodicityReport::projection_error`].
+///
 /// # Errors
-/// Unsupported conditions, a grid that does not match the bars, a solution vector of the
-/// wrong length or with NaN, an `omega` that is not positive and finite or is below
+/// Unsupported conditions, a time step longer than a bar's travel time
+/// ([`VerifyError::NonMatchingGrid`]), a solution vector of the wrong length or with NaN, an
+/// `omega` that is not positive and finite or is below
 /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY) ([`VerifyError`]);
 /// [`VerifyError::TooLarge`] if the cells of the grid or the histories of the
 /// `periods 2 pi / (omega dt)` steps do not fit in the memory budget
-/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)); [`VerifyError::TooCostly`]
+/// if the march's work bound exceeds [`MAX_MARCH_WORK`](super::MAX_MARCH_WORK).
 pub fn periodicity_check<B: Basis>(
     system: &BarSystem,
     basis: &B,
@@ -209,7 +246,10 @@ pub fn periodicity_check<B: Basis>(
 ) -> Result<PeriodicityReport, VerifyError> {
     let model = Model::from_system(system)?;
     let grid = if options.adjust_grid {
-        Grid::nearest(&model, options.dt)?
+        match Grid::nearest(&model, options.dt) {
+            Err(VerifyError::NoAdmissibleGrid { .. }) => Grid::new(&model, options.dt)?,
+            other => other?,
+        }
     } else {
         Grid::new(&model, options.dt)?
     };

@@ -1,7 +1,7 @@
 //! The state of the integrator: the two characteristic waves of every bar and its end
 //! displacements.
 
-use super::wave::{distance_squared, Wave};
+use super::wave::{distance_squared, Resolution, Wave};
 use super::{Condition, Grid, Model, VerifyError};
 use crate::bar::{End, EndRef};
 use crate::fourier::Basis;
@@ -16,7 +16,8 @@ const GAUSS3: [(f64, f64); 3] = [
     (0.887_298_334_620_741_7, 5.0 / 18.0),
 ];
 
-/// Initial data of one bar on its grid of `N` cells (`dx = c dt`).
+/// Initial data of one bar on its grid of `N` cells of length `dx = l / N` (`c dt` on a
+/// commensurate grid).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BarCells {
     /// Displacement `u(0)` of the left end.
@@ -30,7 +31,7 @@ pub struct BarCells {
 /// Fields of one bar at one instant, on its grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BarSnapshot {
-    /// Displacement at the `N + 1` nodes `x_i = i dx`.
+    /// Displacement at the `N + 1` nodes `x_i = i dx` (`dx = l / N`).
     pub displacement: Vec<f64>,
     /// Mean strain of each of the `N` cells.
     pub strain: Vec<f64>,
@@ -48,7 +49,7 @@ pub struct Snapshot {
 }
 
 /// The waves of one bar: `right` travels to `x = l`, `left` to `x = 0`; both are functions
-/// of their arrival clock, defined on `[clock, clock + N)`.
+/// of their arrival clock, defined on `[clock, clock + nu)` (`nu = l / (c dt)`).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BarWaves {
     pub right: Wave,
@@ -61,11 +62,16 @@ pub(crate) struct BarWaves {
 ///
 /// Each bar holds its right-going wave `R = u_t - c u_x` and left-going wave
 /// `L = u_t + c u_x` as piecewise-constant functions of the clock `s = t / dt` at which each
-/// part reaches the end it travels to: at clock `S` the cell `i` (`x in [i dx, (i+1) dx]`)
-/// holds `R` arriving in `[S + N - i - 1, S + N - i)` and `L` arriving in `[S + i, S + i + 1)`.
-/// A step is then only bookkeeping at the ends; the pieces themselves never change. Pieces
-/// start as cells and gain breakpoints inside cells at impact instants. The end
-/// displacements are carried along (the field only knows `u_x` and `u_t`).
+/// part reaches the end it travels to. A wave crosses the bar in `nu = l / (c dt)` steps
+/// ([`Grid::travel_steps`]) and a cell in `h = nu / N` steps ([`Grid::cell_steps`], 1 on a
+/// commensurate grid): at clock `S` the cell `i` (`x in [i dx, (i+1) dx]`, `dx = l / N`)
+/// holds `R` arriving in `[S + nu - (i + 1) h, S + nu - i h)` and `L` arriving in
+/// `[S + i h, S + (i + 1) h)`. A step is then only bookkeeping at the ends; the pieces
+/// themselves never change, except where short pieces are merged to keep their number
+/// bounded ([`State::projected_energy`]). Pieces start as cells and gain breakpoints inside
+/// cells at impact instants and, on a grid that is not commensurate, wherever the waves of
+/// bars of different travel times meet. The end displacements are carried along (the field
+/// only knows `u_x` and `u_t`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
     pub(crate) model: Model,
@@ -120,16 +126,21 @@ impl State {
             }
             let u0 = finite("left displacement", b, 0, data.left_displacement)?;
             let c = bar.wave_speed();
-            let dx = c * grid.dt();
-            let mut right = Wave::new(0.0);
+            let (nu, h) = (grid.travel_steps(b), grid.cell_steps(b));
+            let dx = c * grid.dt() * h;
+            let resolution = grid.resolution(b);
+            let mut right = Wave::with_resolution(0.0, resolution);
             for i in (0..n).rev() {
                 let e = finite("strain", b, i, data.strain[i])?;
                 let v = finite("velocity", b, i, data.velocity[i])?;
-                right.push_until((n - i) as f64, v - c * e);
+                // The last cell ends exactly at `nu`.
+                let until = if i == 0 { nu } else { nu - i as f64 * h };
+                right.push_until(until, v - c * e);
             }
-            let mut left = Wave::new(0.0);
+            let mut left = Wave::with_resolution(0.0, resolution);
             for i in 0..n {
-                left.push_until((i + 1) as f64, data.velocity[i] + c * data.strain[i]);
+                let until = if i + 1 == n { nu } else { (i + 1) as f64 * h };
+                left.push_until(until, data.velocity[i] + c * data.strain[i]);
             }
             let ul = u0 + dx * data.strain.iter().sum::<f64>();
             bars.push(BarWaves {
@@ -147,7 +158,8 @@ impl State {
     }
 
     /// The state of the fields `field(bar, x) = (u, u_t)`: strain means from the nodal
-    /// displacements (exact), velocity means by 3-point Gauss quadrature in each cell.
+    /// displacements (exact), velocity means by 3-point Gauss quadrature in each of the `N`
+    /// cells of length `l / N`.
     ///
     /// # Errors
     /// As [`State::from_cells`].
@@ -292,13 +304,26 @@ impl State {
     /// piecewise-constant waves (it equals `sum_b EA_b/2 int (u_t^2/c_b^2 + u_x^2) dx` plus the
     /// springs).
     pub fn energy(&self) -> f64 {
+        self.energy_with(|b| {
+            let (w, nu) = (&self.bars[b], self.grid.travel_steps(b));
+            let (_, r2) = w.right.moments(self.clock, self.clock + nu);
+            let (_, l2) = w.left.moments(self.clock, self.clock + nu);
+            r2 + l2
+        })
+    }
+
+    /// [`State::energy`] from the running integrals the waves keep (equal to rounding, in
+    /// `O(bars)` rather than `O(pieces)`): the energy history of a march.
+    pub(crate) fn tracked_energy(&self) -> f64 {
+        self.energy_with(|b| self.bars[b].right.square() + self.bars[b].left.square())
+    }
+
+    /// The energy with `int (R^2 + L^2) ds` of bar `b` given by `squares(b)`.
+    fn energy_with(&self, squares: impl Fn(usize) -> f64) -> f64 {
         let mut e = 0.0;
-        for (b, (w, bar)) in self.bars.iter().zip(self.model.bars()).enumerate() {
-            let n = self.grid.cells(b) as f64;
-            let (_, r2) = w.right.moments(self.clock, self.clock + n);
-            let (_, l2) = w.left.moments(self.clock, self.clock + n);
+        for (b, bar) in self.model.bars().iter().enumerate() {
             let c = bar.wave_speed();
-            e += bar.stiffness() / (4.0 * c * c) * c * self.grid.dt() * (r2 + l2);
+            e += bar.stiffness() / (4.0 * c * c) * c * self.grid.dt() * squares(b);
         }
         for c in self.model.conditions() {
             if let Condition::Spring { end, stiffness } = *c {
@@ -309,14 +334,38 @@ impl State {
         e
     }
 
+    /// Energy removed so far (since the state was built from fields or cells) by the merges
+    /// of short pieces that keep the number of pieces bounded: each merge replaces two pieces
+    /// `(h_1, v_1)`, `(h_2, v_2)` by their mean, which keeps the integral of the wave (hence
+    /// every displacement) and removes exactly `Z dt / 4 h_1 h_2 / (h_1 + h_2) (v_1 - v_2)^2`
+    /// (`Z = EA / c`, `h` in steps) of energy. Zero while no wave reaches its piece limit (to
+    /// rounding: pieces equal to rounding and slivers of `1e-10` steps are always merged);
+    /// never negative. The lossless conditions (all but a spring under
+    /// [`SpringUpdate::Exact`](super::SpringUpdate::Exact)) conserve
+    /// `energy() + projected_energy()` to rounding.
+    ///
+    /// The part a merge removes is orthogonal to what it keeps, and its norm in the state norm
+    /// of [`State::norm`] is `sqrt(2 removed energy)`.
+    pub fn projected_energy(&self) -> f64 {
+        self.model
+            .bars()
+            .iter()
+            .zip(&self.bars)
+            .map(|(bar, w)| {
+                let z = bar.stiffness() / bar.wave_speed();
+                0.25 * z * self.grid.dt() * (w.right.removed() + w.left.removed())
+            })
+            .sum()
+    }
+
     /// The state norm
     /// `|X|^2 = sum_b [EA_b int (u_t^2/c_b^2 + u_x^2) dx + EA_b/l_b (u_b(0)^2 + u_b(l)^2)]`.
     pub fn norm(&self) -> f64 {
-        self.norm_squared_with(|b, clock, n| {
+        self.norm_squared_with(|b, clock, nu| {
             let w = &self.bars[b];
             (
-                w.right.moments(clock, clock + n).1,
-                w.left.moments(clock, clock + n).1,
+                w.right.moments(clock, clock + nu).1,
+                w.left.moments(clock, clock + nu).1,
                 w.ends,
             )
         })
@@ -333,11 +382,11 @@ impl State {
             return Err(VerifyError::MismatchedStates);
         }
         Ok(self
-            .norm_squared_with(|b, clock, n| {
+            .norm_squared_with(|b, clock, nu| {
                 let (w, v) = (&self.bars[b], &other.bars[b]);
                 (
-                    distance_squared(&w.right, clock, &v.right, other.clock, n),
-                    distance_squared(&w.left, clock, &v.left, other.clock, n),
+                    distance_squared(&w.right, clock, &v.right, other.clock, nu),
+                    distance_squared(&w.left, clock, &v.left, other.clock, nu),
                     [w.ends[0] - v.ends[0], w.ends[1] - v.ends[1]],
                 )
             })
@@ -345,14 +394,14 @@ impl State {
     }
 
     /// `sum_b EA_b dt/(2 c_b) (int R^2 + int L^2) ds + EA_b/l_b (u0^2 + ul^2)`, the squared
-    /// integrals `(R, L)` and end values given per bar by `parts(bar, clock, N)`.
+    /// integrals `(R, L)` and end values given per bar by `parts(bar, clock, nu)`.
     fn norm_squared_with(&self, parts: impl Fn(usize, f64, f64) -> (f64, f64, [f64; 2])) -> f64 {
         self.model
             .bars()
             .iter()
             .enumerate()
             .map(|(b, bar)| {
-                let (r2, l2, ends) = parts(b, self.clock, self.grid.cells(b) as f64);
+                let (r2, l2, ends) = parts(b, self.clock, self.grid.travel_steps(b));
                 let c = bar.wave_speed();
                 bar.stiffness() * self.grid.dt() / (2.0 * c) * (r2 + l2)
                     + bar.stiffness() / bar.length() * (ends[0] * ends[0] + ends[1] * ends[1])
@@ -360,7 +409,8 @@ impl State {
             .sum()
     }
 
-    /// Cell means of strain and velocity and nodal displacements of every bar.
+    /// Cell means of strain and velocity and nodal displacements of every bar, on its `N`
+    /// cells of length `l / N`.
     pub fn snapshot(&self) -> Snapshot {
         let bars = self
             .bars
@@ -370,16 +420,20 @@ impl State {
             .map(|(b, (w, bar))| {
                 let n = self.grid.cells(b);
                 let c = bar.wave_speed();
-                let dx = c * self.grid.dt();
+                let (nu, h) = (self.grid.travel_steps(b), self.grid.cell_steps(b));
+                let dx = c * self.grid.dt() * h;
                 let s = self.clock;
                 let mut strain = Vec::with_capacity(n);
                 let mut velocity = Vec::with_capacity(n);
                 let mut displacement = Vec::with_capacity(n + 1);
                 displacement.push(w.ends[0]);
                 for i in 0..n {
-                    let top = s + (n - i) as f64;
-                    let (r, _) = w.right.moments(top - 1.0, top);
-                    let (l, _) = w.left.moments(s + i as f64, s + i as f64 + 1.0);
+                    // Cell means: integrals over one cell duration `h` (1 when commensurate).
+                    let top = s + (nu - i as f64 * h);
+                    let (r, _) = w.right.moments(top - h, top);
+                    let bottom = s + i as f64 * h;
+                    let (l, _) = w.left.moments(bottom, bottom + h);
+                    let (r, l) = (r / h, l / h);
                     strain.push((l - r) / (2.0 * c));
                     velocity.push(0.5 * (r + l));
                     displacement.push(displacement[i] + dx * strain[i]);
@@ -397,7 +451,16 @@ impl State {
         }
     }
 
-    /// Total number of wave pieces (a measure of the cost of a step).
+    /// Sets the resolution of every wave: `resolution(bar)`.
+    pub(crate) fn set_resolution(&mut self, resolution: impl Fn(usize) -> Resolution) {
+        for (b, w) in self.bars.iter_mut().enumerate() {
+            w.right.set_resolution(resolution(b));
+            w.left.set_resolution(resolution(b));
+        }
+    }
+
+    /// Total number of wave pieces (a measure of the cost of a step), at most
+    /// `sum_b 2 Grid::max_pieces(b)` ([`Grid::max_pieces`]).
     pub fn pieces(&self) -> usize {
         self.bars.iter().map(|w| w.right.len() + w.left.len()).sum()
     }
