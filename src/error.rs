@@ -296,6 +296,26 @@ pub enum SettingsError {
         /// The fundamental frequency.
         omega: f64,
     },
+    /// An index names an item the system does not have (a bar, a unilateral law): it is not
+    /// below their count.
+    #[error("{what} {index} is out of range: there are {count}")]
+    IndexOutOfRange {
+        /// Which index.
+        what: &'static str,
+        /// The rejected index.
+        index: usize,
+        /// How many items there are (valid indices are `0..count`).
+        count: usize,
+    },
+    /// A request within the memory budget that the allocator refused all the same (the
+    /// process has less memory than the budget left): returned instead of aborting.
+    #[error("{what} needs {bytes:.3e} bytes, which the allocator refused")]
+    AllocationFailed {
+        /// What was requested.
+        what: &'static str,
+        /// Bytes asked for.
+        bytes: f64,
+    },
 }
 
 /// Errors of a nonlinear solve.
@@ -334,7 +354,8 @@ pub enum SolveError {
         step: f64,
     },
     /// The residual norm stopped decreasing: not below `stall_ratio` times its value `window`
-    /// iterations earlier (see [`NewtonOptions::stall_window`](crate::solve::NewtonOptions)).
+    /// iterations earlier (see [`NewtonOptions::stall_window`](crate::solve::NewtonOptions),
+    /// and [`Dogleg::STALL_WINDOW`](crate::solve::Dogleg::STALL_WINDOW) for the dogleg).
     #[error("stagnated at iteration {iteration}: residual norm {residual_norm:e}, {earlier_residual_norm:e} {window} iterations earlier")]
     Stagnated {
         /// Iteration at which it was detected.

@@ -11,6 +11,16 @@ use std::ops::{Index, IndexMut};
 mod staircase;
 pub(crate) use staircase::{Staircase, StaircaseLu};
 
+/// The entries of an `nrows x ncols` matrix.
+///
+/// # Panics
+/// If their number overflows `usize`.
+fn entries(nrows: usize, ncols: usize) -> usize {
+    nrows
+        .checked_mul(ncols)
+        .expect("DenseMatrix: nrows x ncols overflows usize")
+}
+
 /// A dense, column-major `f64` matrix.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct DenseMatrix {
@@ -21,11 +31,14 @@ pub struct DenseMatrix {
 
 impl DenseMatrix {
     /// A matrix of zeros.
+    ///
+    /// # Panics
+    /// If `nrows x ncols` overflows `usize` (or does not fit in memory).
     pub fn zeros(nrows: usize, ncols: usize) -> Self {
         Self {
             nrows,
             ncols,
-            data: vec![0.0; nrows * ncols],
+            data: vec![0.0; entries(nrows, ncols)],
         }
     }
 
@@ -45,11 +58,15 @@ impl DenseMatrix {
     }
 
     /// Resizes to `nrows x ncols`, all zero.
+    ///
+    /// # Panics
+    /// If `nrows x ncols` overflows `usize` (or does not fit in memory).
     pub fn reset(&mut self, nrows: usize, ncols: usize) {
+        let len = entries(nrows, ncols);
         self.nrows = nrows;
         self.ncols = ncols;
         self.data.clear();
-        self.data.resize(nrows * ncols, 0.0);
+        self.data.resize(len, 0.0);
     }
 
     /// Column `j` as a mutable slice.
@@ -57,12 +74,17 @@ impl DenseMatrix {
     /// # Panics
     /// If `j >= ncols`.
     pub fn column_mut(&mut self, j: usize) -> &mut [f64] {
+        assert!(j < self.ncols, "column index in range");
         let n = self.nrows;
         &mut self.data[j * n..(j + 1) * n]
     }
 
     /// Column `j` as a slice (the storage is column-major).
+    ///
+    /// # Panics
+    /// If `j >= ncols`.
     pub fn column(&self, j: usize) -> &[f64] {
+        assert!(j < self.ncols, "column index in range");
         &self.data[j * self.nrows..(j + 1) * self.nrows]
     }
 
@@ -104,14 +126,14 @@ impl DenseMatrix {
 impl Index<(usize, usize)> for DenseMatrix {
     type Output = f64;
     fn index(&self, (i, j): (usize, usize)) -> &f64 {
-        debug_assert!(i < self.nrows && j < self.ncols);
+        assert!(i < self.nrows && j < self.ncols, "matrix index in range");
         &self.data[j * self.nrows + i]
     }
 }
 
 impl IndexMut<(usize, usize)> for DenseMatrix {
     fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
-        debug_assert!(i < self.nrows && j < self.ncols);
+        assert!(i < self.nrows && j < self.ncols, "matrix index in range");
         &mut self.data[j * self.nrows + i]
     }
 }

@@ -194,9 +194,15 @@ impl ClampedFirstMode {
     /// from `u_j(1) = B_j sin(k_j)/k_j` or `u_x,j(1) = B_j cos(k_j)`, whichever is better
     /// conditioned (`k_j = 2 pi j / T`). The constant basis function is `1/2`, so harmonic 0
     /// carries twice the mean. A starting point for Newton and an oracle for tests.
+    ///
+    /// # Panics
+    /// If `2 (harmonics + 1)` values overflow `usize` (or do not fit in memory).
     pub fn unknowns(&self, harmonics: usize) -> Vec<f64> {
         let omega = 2.0 * PI / self.period;
-        let mut x = vec![0.0; 2 * (harmonics + 1)];
+        let len = (harmonics.checked_add(1))
+            .and_then(|n| n.checked_mul(2))
+            .expect("ClampedFirstMode::unknowns: 2 (harmonics + 1) overflows usize");
+        let mut x = vec![0.0; len];
         x[1] = 2.0 * self.displacement_mean();
         for j in 1..=harmonics {
             let k = j as f64 * omega;

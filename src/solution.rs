@@ -25,10 +25,10 @@
 
 use crate::bar::EndRef;
 use crate::error::SettingsError;
-use crate::fourier::{check_memory, Basis, CosineBasis};
+use crate::fourier::{Basis, CosineBasis};
 use crate::modal::diagnostics::{
-    check_finite, check_motion, diagnose, displacement_grid, end_history, law_history, EndHistory,
-    FieldGrid, LawHistory, PointDiagnostics,
+    check_finite, check_motion, checked_displacement_grid, checked_end_history, diagnose,
+    law_history, EndHistory, FieldGrid, LawHistory, PointDiagnostics,
 };
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
@@ -142,32 +142,29 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// Histories of one bar end over a period on `samples` instants.
     ///
     /// # Errors
-    /// [`SettingsError::Length`] if `end` names a bar the system does not have;
+    /// [`SettingsError::IndexOutOfRange`] if `end` names a bar the system does not have;
     /// [`SettingsError::TooLarge`] if the `4 samples` values do not fit in the memory budget
-    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)), and
+    /// [`SettingsError::AllocationFailed`] if they do but the allocator refuses them;
     /// [`SettingsError::NonFiniteResult`] if a value comes out NaN or infinite.
     pub fn end_history(&self, end: EndRef, samples: usize) -> Result<EndHistory, SettingsError> {
-        self.check_bar(end.bar.index())?;
-        check_memory("the samples of an end history", 4.0 * samples as f64)?;
-        let h = end_history(
+        checked_end_history(
             self.system(),
             self.problem.basis(),
-            self.x,
-            self.omega,
+            (self.x, self.omega),
             end,
             samples,
-        );
-        let values = h.time.iter().chain(&h.displacement).chain(&h.strain);
-        check_finite("a value of an end history", self.omega, values)?;
-        Ok(h)
+        )
     }
 
     /// `u(x, t)` of bar `bar` on `positions x instants` points over a period.
     ///
     /// # Errors
-    /// [`SettingsError::Length`] if there is no bar `bar`; [`SettingsError::TooLarge`] if the
-    /// `positions instants` values (with the axes) do not fit in the memory budget
-    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+    /// [`SettingsError::IndexOutOfRange`] if there is no bar `bar`;
+    /// [`SettingsError::TooLarge`] if the `positions instants` values (with the axes) do not
+    /// fit in the memory budget
+    /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)), and
+    /// [`SettingsError::AllocationFailed`] if they do but the allocator refuses them;
     /// [`SettingsError::NonFiniteResult`] if a value comes out NaN or infinite.
     pub fn displacement_grid(
         &self,
@@ -175,21 +172,13 @@ impl<'a, B: Basis> Solution<'a, B> {
         positions: usize,
         instants: usize,
     ) -> Result<FieldGrid, SettingsError> {
-        self.check_bar(bar)?;
-        let (p, i) = (positions as f64, instants as f64);
-        check_memory("the values of a displacement grid", p * i + p + i)?;
-        let g = displacement_grid(
+        checked_displacement_grid(
             self.system(),
             self.problem.basis(),
-            self.x,
-            self.omega,
+            (self.x, self.omega),
             bar,
-            positions,
-            instants,
-        );
-        let values = g.time.iter().chain(&g.position).chain(&g.displacement);
-        check_finite("a value of a displacement grid", self.omega, values)?;
-        Ok(g)
+            (positions, instants),
+        )
     }
 
     /// Gap, force and pointwise residual of unilateral law `law` over a period.
@@ -243,18 +232,5 @@ impl<'a, B: Basis> Solution<'a, B> {
             self.omega,
             options,
         )
-    }
-
-    fn check_bar(&self, bar: usize) -> Result<(), SettingsError> {
-        let bars = self.system().bars().len();
-        if bar < bars {
-            Ok(())
-        } else {
-            Err(SettingsError::Length {
-                what: "bar index (one past the last bar)",
-                got: bar + 1,
-                expected: bars,
-            })
-        }
     }
 }

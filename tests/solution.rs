@@ -111,7 +111,11 @@ fn bad_requests_are_typed_errors() {
     assert_eq!(rest.energy(), Ok(0.0));
     assert!(matches!(
         rest.displacement_grid(2, 3, 3),
-        Err(SettingsError::Length { .. })
+        Err(SettingsError::IndexOutOfRange {
+            index: 2,
+            count: 2,
+            ..
+        })
     ));
     assert!(rest.law_history(1, 8).is_err());
     assert!(rest.diagnose(0).is_err());

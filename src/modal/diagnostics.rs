@@ -126,13 +126,27 @@ pub struct EndHistory {
     pub contact_force: Vec<f64>,
 }
 
+/// An empty vector with room for exactly `n` values (so that what a budget check counted
+/// is what is allocated: pushing into a vector without it may double its capacity), or
+/// [`SettingsError::AllocationFailed`] naming `what` if the allocator refuses.
+pub(crate) fn reserve_exact(what: &'static str, n: usize) -> Result<Vec<f64>, SettingsError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| SettingsError::AllocationFailed {
+            what,
+            bytes: n as f64 * std::mem::size_of::<f64>() as f64,
+        })?;
+    Ok(v)
+}
+
 /// Histories of the end `end` over one period, on `samples` instants.
 ///
 /// Neither `omega` nor the size of the histories is checked here;
 /// [`Solution::end_history`](crate::solution::Solution::end_history) checks both.
 ///
 /// # Panics
-/// If `end.bar` is not a bar of the system or `x` has the wrong length.
+/// If `end.bar` is not a bar of the system or `x` has the wrong length; if the `4 samples`
+/// values do not fit in memory (`samples` near `usize::MAX`).
 pub fn end_history<B: Basis>(
     system: &BarSystem,
     basis: &B,
@@ -141,6 +155,49 @@ pub fn end_history<B: Basis>(
     end: EndRef,
     samples: usize,
 ) -> EndHistory {
+    let h = EndHistory {
+        time: Vec::with_capacity(samples),
+        displacement: Vec::with_capacity(samples),
+        strain: Vec::with_capacity(samples),
+        contact_force: Vec::with_capacity(samples),
+    };
+    fill_end_history(system, basis, (x, omega), end, samples, h)
+}
+
+/// [`end_history`] with its checks: a bar of the system, `4 samples` values within the
+/// memory budget and allocated exactly (or [`SettingsError::AllocationFailed`]), finite
+/// values.
+pub(crate) fn checked_end_history<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    (x, omega): (&[f64], f64),
+    end: EndRef,
+    samples: usize,
+) -> Result<EndHistory, SettingsError> {
+    check_index("bar index", end.bar.index(), system.bars().len())?;
+    let what = "the samples of an end history";
+    check_memory(what, 4.0 * samples as f64)?;
+    let h = EndHistory {
+        time: reserve_exact(what, samples)?,
+        displacement: reserve_exact(what, samples)?,
+        strain: reserve_exact(what, samples)?,
+        contact_force: reserve_exact(what, samples)?,
+    };
+    let h = fill_end_history(system, basis, (x, omega), end, samples, h);
+    let values = h.time.iter().chain(&h.displacement).chain(&h.strain);
+    check_finite("a value of an end history", omega, values)?;
+    Ok(h)
+}
+
+/// Pushes the `samples` values of each history of [`end_history`] into `h`.
+fn fill_end_history<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    (x, omega): (&[f64], f64),
+    end: EndRef,
+    samples: usize,
+    mut h: EndHistory,
+) -> EndHistory {
     let fields = FieldEvaluator::new(system, basis, x, omega);
     let bar = system.bar(end.bar);
     let position = match end.end {
@@ -148,16 +205,33 @@ pub fn end_history<B: Basis>(
         End::Right => bar.length(),
     };
     let period = 2.0 * PI / omega;
-    let mut h = EndHistory::default();
+    let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
     for k in 0..samples {
         let t = period * k as f64 / samples as f64;
-        let v = fields.at(end.bar.index(), position, omega * t);
+        // `FieldEvaluator::at` with the buffers reused.
+        basis.functions_at(omega * t, &mut phi);
+        basis.derivatives_at(omega * t, &mut dphi);
+        let v = fields.with_functions(end.bar.index(), position, &phi, &dphi);
         h.time.push(t);
         h.displacement.push(v.displacement);
         h.strain.push(v.strain);
         h.contact_force.push(-bar.stiffness() * v.strain);
     }
     h
+}
+
+/// Checks that `index` names one of `count` items ([`SettingsError::IndexOutOfRange`]),
+/// by a comparison that cannot overflow.
+pub(crate) fn check_index(
+    what: &'static str,
+    index: usize,
+    count: usize,
+) -> Result<(), SettingsError> {
+    if index < count {
+        Ok(())
+    } else {
+        Err(SettingsError::IndexOutOfRange { what, index, count })
+    }
 }
 
 /// Displacement `u(x, t)` of one bar on a space-time grid.
@@ -178,7 +252,8 @@ pub struct FieldGrid {
 /// [`Solution::displacement_grid`](crate::solution::Solution::displacement_grid) checks both.
 ///
 /// # Panics
-/// If `bar` is out of range or `x` has the wrong length.
+/// If `bar` is out of range or `x` has the wrong length; if the `positions instants` values
+/// do not fit in memory (their product overflows `usize`, or the allocation fails).
 pub fn displacement_grid<B: Basis>(
     system: &BarSystem,
     basis: &B,
@@ -188,29 +263,76 @@ pub fn displacement_grid<B: Basis>(
     positions: usize,
     instants: usize,
 ) -> FieldGrid {
+    let values = positions
+        .checked_mul(instants)
+        .expect("displacement_grid: positions x instants overflows usize");
+    let g = FieldGrid {
+        position: Vec::with_capacity(positions),
+        time: Vec::with_capacity(instants),
+        displacement: Vec::with_capacity(values),
+    };
+    fill_displacement_grid(system, basis, (x, omega), bar, (positions, instants), g)
+}
+
+/// [`displacement_grid`] with its checks: a bar of the system, `positions instants` values
+/// (with the axes) within the memory budget and allocated exactly (or
+/// [`SettingsError::AllocationFailed`]), finite values.
+pub(crate) fn checked_displacement_grid<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    (x, omega): (&[f64], f64),
+    bar: usize,
+    (positions, instants): (usize, usize),
+) -> Result<FieldGrid, SettingsError> {
+    check_index("bar index", bar, system.bars().len())?;
+    let what = "the values of a displacement grid";
+    let (p, i) = (positions as f64, instants as f64);
+    check_memory(what, p * i + p + i)?;
+    // Within the budget the product fits in `usize`; checked all the same.
+    let values = positions
+        .checked_mul(instants)
+        .ok_or(SettingsError::AllocationFailed {
+            what,
+            bytes: p * i * std::mem::size_of::<f64>() as f64,
+        })?;
+    let g = FieldGrid {
+        position: reserve_exact(what, positions)?,
+        time: reserve_exact(what, instants)?,
+        displacement: reserve_exact(what, values)?,
+    };
+    let g = fill_displacement_grid(system, basis, (x, omega), bar, (positions, instants), g);
+    let values = g.time.iter().chain(&g.position).chain(&g.displacement);
+    check_finite("a value of a displacement grid", omega, values)?;
+    Ok(g)
+}
+
+/// Pushes the axes and values of [`displacement_grid`] into `g`.
+fn fill_displacement_grid<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    (x, omega): (&[f64], f64),
+    bar: usize,
+    (positions, instants): (usize, usize),
+    mut g: FieldGrid,
+) -> FieldGrid {
     let fields = FieldEvaluator::new(system, basis, x, omega);
     let l = system.bars()[bar].length();
     let period = 2.0 * PI / omega;
-    let position: Vec<f64> = (0..positions)
-        .map(|i| l * i as f64 / (positions.max(2) - 1) as f64)
-        .collect();
-    let time: Vec<f64> = (0..instants)
-        .map(|k| period * k as f64 / instants as f64)
-        .collect();
+    let spacing = (positions.max(2) - 1) as f64;
+    g.position
+        .extend((0..positions).map(|i| l * i as f64 / spacing));
+    g.time
+        .extend((0..instants).map(|k| period * k as f64 / instants as f64));
     let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
-    let mut displacement = Vec::with_capacity(positions * instants);
-    for &t in &time {
+    for &t in &g.time {
         basis.functions_at(omega * t, &mut phi);
         basis.derivatives_at(omega * t, &mut dphi);
-        for &p in &position {
-            displacement.push(fields.with_functions(bar, p, &phi, &dphi).displacement);
+        for &p in &g.position {
+            g.displacement
+                .push(fields.with_functions(bar, p, &phi, &dphi).displacement);
         }
     }
-    FieldGrid {
-        position,
-        time,
-        displacement,
-    }
+    g
 }
 
 /// Gap, force and pointwise residual of one unilateral law over a period.
@@ -231,12 +353,14 @@ pub struct LawHistory {
 /// gap and force rows ([`HarmonicRows`]) as the residual, evaluated at any phase.
 ///
 /// # Errors
-/// [`SettingsError::Length`] if `law` is out of range or `x` has the wrong length;
+/// [`SettingsError::IndexOutOfRange`] if `law` is out of range; [`SettingsError::Length`] if
+/// `x` has the wrong length;
 /// [`SettingsError::NotPositive`] or [`SettingsError::FrequencyTooSmall`] for an `omega`
 /// that is not positive and finite or below [`MIN_FREQUENCY`], and `NotPositive` for
 /// unknowns that are not finite; [`SettingsError::TooLarge`] if the `4 samples` values of
 /// the histories do not fit in the memory budget
-/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES));
+/// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)), and
+/// [`SettingsError::AllocationFailed`] if they do but the allocator refuses them;
 /// [`SettingsError::NonFiniteResult`] if an instant, gap, force or residual comes out NaN or
 /// infinite (a frequency whose harmonics overflow or whose period is near `f64::MAX`, huge
 /// unknowns).
@@ -249,15 +373,18 @@ pub fn law_history<B: Basis>(
 ) -> Result<LawHistory, SettingsError> {
     let system = problem.system();
     let laws: Vec<_> = system.laws().collect();
-    let Some(law_ref) = laws.get(law) else {
-        return Err(SettingsError::Length {
-            what: "law index",
-            got: law,
-            expected: laws.len(),
-        });
-    };
+    check_index("law index", law, laws.len())?;
+    let law_ref = laws[law];
     check_motion(problem, x, omega)?;
-    check_memory("the samples of a law history", 4.0 * samples as f64)?;
+    let what = "the samples of a law history";
+    check_memory(what, 4.0 * samples as f64)?;
+    // Exactly what the budget counted: pushing into empty vectors could double it.
+    let mut h = LawHistory {
+        time: reserve_exact(what, samples)?,
+        gap: reserve_exact(what, samples)?,
+        force: reserve_exact(what, samples)?,
+        residual: reserve_exact(what, samples)?,
+    };
     let basis = problem.basis();
     let unknowns = system.unknowns_per_harmonic();
     let rows: Vec<HarmonicRows> = (0..=basis.harmonics())
@@ -274,7 +401,6 @@ pub fn law_history<B: Basis>(
     let (g0, f0) = (law_ref.gap().offset, law_ref.force().offset);
     let mut phi = vec![0.0; basis.len()];
     let period = 2.0 * PI / omega;
-    let mut h = LawHistory::default();
     for k in 0..samples {
         let t = period * k as f64 / samples as f64;
         basis.functions_at(omega * t, &mut phi);
@@ -331,12 +457,18 @@ pub fn diagnose<B: Basis>(
         });
     }
     check_motion(problem, x, omega)?;
+    let what = "the samples of a law history";
     let grid = problem.basis().samples() as f64 * refinement as f64;
-    check_memory("the samples of a law history", 4.0 * grid)?;
-    // Within the budget the product fits in `usize`.
-    let samples = problem.basis().samples() * refinement;
+    check_memory(what, 4.0 * grid)?;
+    // Within the budget the product fits in `usize`; checked all the same.
+    let samples = (problem.basis().samples()).checked_mul(refinement).ok_or(
+        SettingsError::AllocationFailed {
+            what,
+            bytes: grid * std::mem::size_of::<f64>() as f64,
+        },
+    )?;
     let period = 2.0 * PI / omega;
-    let mut residual_norm = Vec::new();
+    let mut residual_norm = Vec::with_capacity(problem.system().contact_count());
     let (mut max_penetration, mut min_contact_force) = (0.0_f64, f64::INFINITY);
     for law in 0..problem.system().contact_count() {
         let h = law_history(problem, x, omega, law, samples)?;

@@ -196,7 +196,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
             self.frontier = Some((p.parameter, p.x.clone()));
         }
         self.history.push_back((p.parameter, p.x.clone()));
-        if self.history.len() > 2 * self.escape.window {
+        // `saturating_mul`: a window near `usize::MAX` must not overflow.
+        if self.history.len() > self.escape.window.saturating_mul(2) {
             self.history.pop_front();
         }
     }

@@ -33,7 +33,12 @@ impl<'a, B: Basis> FieldEvaluator<'a, B> {
     /// # Panics
     /// If `x.len() != basis.len() * 2 * n_bars`.
     pub fn new(system: &'a BarSystem, basis: &'a B, x: &'a [f64], omega: f64) -> Self {
-        assert_eq!(x.len(), basis.len() * system.unknowns_per_harmonic());
+        let expected = basis.len().saturating_mul(system.unknowns_per_harmonic());
+        assert_eq!(
+            x.len(),
+            expected,
+            "FieldEvaluator: the unknowns have the wrong length"
+        );
         Self {
             system,
             basis,

@@ -37,10 +37,13 @@ pub enum ParameterSteps {
 /// reason it ended: a run that stalls returns what it computed, with
 /// [`EndReason::Stalled`](crate::continuation::EndReason::Stalled).
 ///
-/// A point whose system has no grazing energy (a gap whose `E_g` underflows or overflows,
-/// [`SettingsError::GrazingEnergyOutOfRange`](crate::SettingsError::GrazingEnergyOutOfRange))
-/// reaches the observer with `energy_normalized = NaN`: `E / E_g` is not defined there.
-/// A converged point below the backbones' trivial-energy floor
+/// A converged point whose energy `E` or `E / E_g` is not finite reaches the observer as
+/// [`PointStatus::NonFiniteEnergy`] with `converged == false`, the non-finite number left in
+/// it: a parameter value whose system has no grazing energy (a gap whose `E_g` underflows or
+/// overflows,
+/// [`SettingsError::GrazingEnergyOutOfRange`](crate::SettingsError::GrazingEnergyOutOfRange),
+/// gives `energy_normalized = NaN`), or one whose motion's energy leaves the range of `f64`
+/// (a bar length near `f64::MAX`). A converged point below the backbones' trivial-energy floor
 /// ([`BackboneOptions::trivial_energy`](crate::modal::BackboneOptions::trivial_energy) times
 /// `E_g` at its parameter) is the state of rest, not a point of the branch: it reaches the
 /// observer as [`PointStatus::CollapsedToRest`] with `converged == false`.

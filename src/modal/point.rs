@@ -23,8 +23,8 @@ pub struct BackbonePoint {
     pub energy: f64,
     /// `E / E_g`.
     pub energy_normalized: f64,
-    /// The solver converged to a motion that touches (not the state of rest):
-    /// `status == PointStatus::Converged`.
+    /// The solver converged to a motion that touches (not the state of rest), with a finite
+    /// energy: `status == PointStatus::Converged`.
     pub converged: bool,
     /// What became of the step: converged, solver failed (with its error), or collapsed to
     /// the state of rest.
@@ -62,6 +62,8 @@ impl BackbonePoint {
 
     /// The backbone view of a continuation point whose unknowns, `x` at `omega`, are given
     /// apart from it (a point of an energy-level problem holds `(x, Omega)`), with its status.
+    /// A converged point whose energy or `E / E_g` is not finite becomes
+    /// [`PointStatus::NonFiniteEnergy`], not converged.
     pub(crate) fn from_parts(
         p: &Point,
         (x, omega): (&[f64], f64),
@@ -69,13 +71,20 @@ impl BackbonePoint {
         e_g: f64,
         status: PointStatus,
     ) -> Self {
+        let energy_normalized = energy / e_g;
+        let status = match status {
+            PointStatus::Converged if !(energy.is_finite() && energy_normalized.is_finite()) => {
+                PointStatus::NonFiniteEnergy
+            }
+            status => status,
+        };
         Self {
             step: p.step,
             period: 2.0 * PI / omega,
             omega,
             energy,
-            energy_normalized: energy / e_g,
-            converged: p.converged,
+            energy_normalized,
+            converged: status == PointStatus::Converged,
             status,
             residual_norm: p.residual_norm,
             iterations: p.iterations,
@@ -103,6 +112,14 @@ pub enum PointStatus {
     /// energy-level backbone refuses a frequency that is not positive or beyond the
     /// problem's [`max_frequency`](crate::system::Discretization::max_frequency)).
     Rejected,
+    /// The solver converged, but the motion's energy `E` or its normalisation `E / E_g` is
+    /// not finite (NaN or infinite, left in the point): the energy of the motion leaves the
+    /// range of `f64` (a bar length or frequency near the limits of what the constructors
+    /// accept), or the system at a parameter value of
+    /// [`parameter_branch`](crate::modal::parameter_branch) has no grazing energy `E_g`
+    /// ([`SettingsError::GrazingEnergyOutOfRange`]). A point without a finite energy is not
+    /// a point of the backbone.
+    NonFiniteEnergy,
 }
 
 impl PointStatus {
@@ -122,14 +139,15 @@ impl PointStatus {
         }
     }
 
-    /// A short label for tables: `converged`, `solver-failed`, `collapsed-to-rest` or
-    /// `rejected`.
+    /// A short label for tables: `converged`, `solver-failed`, `collapsed-to-rest`,
+    /// `rejected` or `non-finite-energy`.
     pub fn label(&self) -> &'static str {
         match self {
             Self::Converged => "converged",
             Self::SolverFailed(_) => "solver-failed",
             Self::CollapsedToRest => "collapsed-to-rest",
             Self::Rejected => "rejected",
+            Self::NonFiniteEnergy => "non-finite-energy",
         }
     }
 }

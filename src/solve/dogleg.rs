@@ -1,5 +1,6 @@
 //! Powell's hybrid trust-region dogleg method.
 
+use super::newton::Stagnation;
 use super::{
     check_positive, norm, residual_scale, with_workspace, Iteration, NonlinearSolver, Problem,
     SolveInfo, SolveMonitor, Workspace,
@@ -51,8 +52,17 @@ impl DoglegOptions {
 /// the ratio of actual to predicted decrease of `|F|^2`. The paper's solver (Matlab's
 /// `fsolve`), here with the analytic generalised Jacobian instead of finite differences.
 ///
+/// It gives up with [`SolveError::Stagnated`] when its residual norm has not dropped by 1 %
+/// over [`Dogleg::STALL_WINDOW`] iterations ([`Dogleg::STALL_RATIO`]), as MINPACK's `hybrd` gives up when ten
+/// iterations make no progress: accepted steps that creep along a valley of `|F|`, or that
+/// only trade rounding errors once `|F|` has reached its floor, would otherwise go on for as
+/// long as `max_iterations` allows (forever with `usize::MAX` and a tolerance below what
+/// `f64` can reach, such as `1e-300`). A solve that converges cuts its residual far faster.
+///
 /// Reference: M. J. D. Powell, "A hybrid method for nonlinear equations", in Numerical
-/// Methods for Nonlinear Algebraic Equations, Gordon and Breach, 1970, pp. 87–114.
+/// Methods for Nonlinear Algebraic Equations, Gordon and Breach, 1970, pp. 87–114; J. J. Moré,
+/// B. S. Garbow, K. E. Hillstrom, "User guide for MINPACK-1", Argonne ANL-80-74, 1980
+/// (`hybrd`'s test on the progress of the last ten iterations).
 ///
 /// Built by [`Dogleg::new`], which validates the options, or by `Default` (the default
 /// options); the options are private, so no solver holds options that `new` would reject
@@ -70,6 +80,14 @@ pub struct Dogleg {
 }
 
 impl Dogleg {
+    /// Iterations over which the solver must cut its residual norm by
+    /// [`Dogleg::STALL_RATIO`], or give up with [`SolveError::Stagnated`].
+    pub const STALL_WINDOW: usize = 10;
+
+    /// The factor by which the solver must cut its residual norm every
+    /// [`Dogleg::STALL_WINDOW`] iterations: 0.99, a cut of 1 %.
+    pub const STALL_RATIO: f64 = 0.99;
+
     /// A solver with the given options.
     ///
     /// # Errors
@@ -116,10 +134,12 @@ impl NonlinearSolver for Dogleg {
                 lu,
             } = ws;
             let mut r = it.residual_into(x, f, 0)?;
+            let mut progress = Stagnation::new(Self::STALL_WINDOW, Self::STALL_RATIO);
             for iteration in 0..o.max_iterations {
                 if r <= tol {
                     return Ok(it.info(iteration, r));
                 }
+                progress.check(iteration, r)?;
                 let factored = it.factor_jacobian(x, jac, lu, iteration);
                 // A singular Jacobian still allows Cauchy steps; a non-finite one does not.
                 if let Err(e @ SolveError::NonFinite { .. }) = factored {

@@ -222,8 +222,9 @@ impl NonlinearSolver for SemismoothNewton {
 }
 
 /// The last `window + 1` residual norms, in a ring without allocation (windows are capped at
-/// [`Stagnation::CAPACITY`]` - 1`).
-struct Stagnation {
+/// [`Stagnation::CAPACITY`]` - 1`); Newton's stagnation and plateau tests, and the dogleg's
+/// stagnation test.
+pub(super) struct Stagnation {
     window: usize,
     ratio: f64,
     norms: [f64; Stagnation::CAPACITY],
@@ -232,7 +233,7 @@ struct Stagnation {
 impl Stagnation {
     const CAPACITY: usize = 64;
 
-    fn new(window: usize, ratio: f64) -> Self {
+    pub(super) fn new(window: usize, ratio: f64) -> Self {
         Self {
             window: window.min(Self::CAPACITY - 1),
             ratio,
@@ -242,7 +243,7 @@ impl Stagnation {
 
     /// Records `r` at `iteration` and fails if it is not below `ratio` times the norm
     /// `window` iterations earlier.
-    fn check(&mut self, iteration: usize, r: f64) -> Result<(), SolveError> {
+    pub(super) fn check(&mut self, iteration: usize, r: f64) -> Result<(), SolveError> {
         if self.window == 0 {
             return Ok(());
         }

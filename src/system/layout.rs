@@ -25,8 +25,20 @@ impl Layout {
     }
 
     /// Index of coefficient `i`, bar `bar`, Helmholtz component `which` (0: `A`, 1: `B`).
+    ///
+    /// # Panics
+    /// If `bar` is not a bar of the layout, `which` is not 0 or 1, or the index overflows
+    /// `usize` (an index out of range must not land on another unknown).
     pub fn index(&self, i: usize, bar: usize, which: usize) -> usize {
-        (i * self.bars + bar) * 2 + which
+        assert!(
+            bar < self.bars && which < 2,
+            "Layout::index: bar and component in range"
+        );
+        i.checked_mul(self.bars)
+            .and_then(|v| v.checked_add(bar))
+            .and_then(|v| v.checked_mul(2))
+            .map(|v| v + which)
+            .expect("Layout::index: the index overflows usize")
     }
 
     /// The pair `(A, B)` of coefficient `i` and bar `bar` in `x`.

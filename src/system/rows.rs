@@ -188,33 +188,37 @@ impl HarmonicRows {
     }
 
     /// Linear row `r` (length `unknowns()`).
+    ///
+    /// # Panics
+    /// If there is no row `r` (the same for the other row accessors: `r` or `l` at or beyond
+    /// the number of rows or laws).
     pub fn linear_row(&self, r: usize) -> &[f64] {
-        &self.linear[r * self.unknowns..(r + 1) * self.unknowns]
+        row(&self.linear, r, self.unknowns)
     }
 
     /// Derivative of linear row `r` in `omega`.
     pub fn linear_row_derivative(&self, r: usize) -> &[f64] {
-        &self.d_linear[r * self.unknowns..(r + 1) * self.unknowns]
+        row(&self.d_linear, r, self.unknowns)
     }
 
     /// Linear part of the gap of law `l` (the offset is applied in time).
     pub fn gap_row(&self, l: usize) -> &[f64] {
-        &self.gap[l * self.unknowns..(l + 1) * self.unknowns]
+        row(&self.gap, l, self.unknowns)
     }
 
     /// Derivative of [`HarmonicRows::gap_row`] in `omega`.
     pub fn gap_row_derivative(&self, l: usize) -> &[f64] {
-        &self.d_gap[l * self.unknowns..(l + 1) * self.unknowns]
+        row(&self.d_gap, l, self.unknowns)
     }
 
     /// Contact force of law `l` as a row.
     pub fn force_row(&self, l: usize) -> &[f64] {
-        &self.force[l * self.unknowns..(l + 1) * self.unknowns]
+        row(&self.force, l, self.unknowns)
     }
 
     /// Derivative of [`HarmonicRows::force_row`] in `omega`.
     pub fn force_row_derivative(&self, l: usize) -> &[f64] {
-        &self.d_force[l * self.unknowns..(l + 1) * self.unknowns]
+        row(&self.d_force, l, self.unknowns)
     }
 
     /// Whether [`HarmonicRows::regularise`] replaced the linear rows.
@@ -377,6 +381,19 @@ fn scratch<'a, T: Copy + Default, const N: usize>(
         heap.resize(len, T::default());
         heap
     }
+}
+
+/// Row `r` of `width` values of the row-major `data`, by arithmetic that cannot wrap (a huge
+/// `r` must not land on another row).
+///
+/// # Panics
+/// If `data` has no row `r`.
+fn row(data: &[f64], r: usize, width: usize) -> &[f64] {
+    let start = r.checked_mul(width);
+    let range = start.and_then(|s| Some(s..s.checked_add(width)?));
+    range
+        .and_then(|range| data.get(range))
+        .expect("row or law index in range")
 }
 
 #[inline]

@@ -1,6 +1,8 @@
 //! What a case found beyond its result: non-finite numbers in `Ok` results, runs without a
-//! consistent end reason, typed errors that do not display; and which inputs are moderate
-//! enough for the plain-number evaluators to be checked.
+//! consistent end reason, typed errors that do not display, results that contradict their
+//! inputs (an error naming another index or size than the one asked for, more memory held
+//! than the budget counted, a file read back with other numbers than were written); and which
+//! inputs are moderate enough for the plain-number evaluators to be checked.
 
 use nonsmooth_modes::continuation::{Branch, EndReason, Event, Point};
 use nonsmooth_modes::modal::{BackbonePoint, PointStatus};
@@ -13,6 +15,7 @@ use nonsmooth_modes::system::BarSystem;
 pub(crate) struct Checks {
     pub(crate) non_finite: Vec<String>,
     pub(crate) no_end: Vec<String>,
+    pub(crate) wrong: Vec<String>,
 }
 
 impl Checks {
@@ -38,17 +41,28 @@ impl Checks {
         }
     }
 
+    /// A backbone point: its numbers are finite, except the energies of a point marked
+    /// `NonFiniteEnergy` (which must then have one that is not), and `converged` agrees
+    /// with the status.
     pub(crate) fn backbone_point(&mut self, what: &str, p: &BackbonePoint) {
-        let fields = [
+        let energies = [("energy", p.energy), ("E/E_g", p.energy_normalized)];
+        let others = [
             ("period", p.period),
             ("omega", p.omega),
-            ("energy", p.energy),
-            ("E/E_g", p.energy_normalized),
             ("residual norm", p.residual_norm),
             ("step size", p.step_size),
         ];
-        for (name, value) in fields {
-            self.finite(&format!("{what} {name} ({})", p.status.label()), [&value]);
+        let unmeasured = p.status == PointStatus::NonFiniteEnergy;
+        if unmeasured && energies.iter().all(|(_, v)| v.is_finite()) {
+            self.wrong.push(format!(
+                "{what}: NonFiniteEnergy with finite energies {energies:?}"
+            ));
+        }
+        let checked = others
+            .iter()
+            .chain(if unmeasured { &[][..] } else { &energies });
+        for (name, value) in checked {
+            self.finite(&format!("{what} {name} ({})", p.status.label()), [value]);
         }
         self.finite(what, &p.x);
         self.events(what, &p.events);
@@ -77,6 +91,21 @@ impl Checks {
                 branch.end
             ));
         }
+    }
+
+    /// Records a result that contradicts its input when `ok` is false.
+    pub(crate) fn expect(&mut self, ok: bool, what: impl FnOnce() -> String) {
+        if !ok {
+            self.wrong.push(what());
+        }
+    }
+
+    /// A vector returned by a request whose memory was checked against the budget holds
+    /// exactly its values (a capacity rounded up would be memory the budget did not count).
+    pub(crate) fn exact(&mut self, what: &str, v: &Vec<f64>) {
+        self.expect(v.capacity() == v.len(), || {
+            format!("{what}: capacity {} for {} values", v.capacity(), v.len())
+        });
     }
 
     /// A typed error: it displays (the message is the user's explanation).

@@ -1,6 +1,7 @@
 //! The seeded random numbers of the suite and the draws of one case's inputs, each written,
 //! named, into the case's log.
 
+use nonsmooth_modes::fourier::MEMORY_BUDGET_BYTES;
 use std::fmt::{Debug, Write as _};
 use std::ops::RangeInclusive;
 use std::sync::{Arc, Mutex};
@@ -54,6 +55,17 @@ const EDGE_REALS: [f64; 14] = [
 /// Sizes at the edges: none, one, and sizes no memory holds.
 const EDGE_SIZES: [usize; 5] = [0, 1, 1 << 40, usize::MAX - 1, usize::MAX];
 
+/// Tolerances below what `f64` can reach relative to a problem's scale: a quarter of the
+/// machine epsilon, tiny, subnormal (`2.2e-309`, the independent run's) and the least
+/// positive `f64`.
+pub(crate) const FLOOR_TOLERANCES: [f64; 5] = [f64::EPSILON / 4.0, 1e-20, 1e-300, 2.2e-309, 5e-324];
+
+/// The largest count of a request of `per_unit` doubles per unit that fits in the memory
+/// budget ([`MEMORY_BUDGET_BYTES`]).
+pub(crate) fn budget_count(per_unit: f64) -> usize {
+    (MEMORY_BUDGET_BYTES as f64 / 8.0 / per_unit).floor() as usize
+}
+
 /// Draws the inputs of one case and writes each, named, into a log shared with the harness
 /// (which prints it when the case fails, even if it never returns).
 pub(crate) struct Draw {
@@ -97,6 +109,38 @@ impl Draw {
         };
         self.note(name, v);
         v
+    }
+
+    /// A size, or with probability `self.edge / 4` one just past the memory budget of a
+    /// request of `per_unit` doubles per unit ([`budget_count`]): one more, or twice the
+    /// count. (Sizes just under it allocate up to 4 GiB and take minutes; they are run under
+    /// a memory limit by `tests/independent_run.rs`, and every history returned here is
+    /// checked to hold exactly what the budget counted.)
+    pub(crate) fn size_or_budget(
+        &mut self,
+        name: &str,
+        valid: RangeInclusive<usize>,
+        per_unit: f64,
+    ) -> usize {
+        if !self.rng.chance(self.edge / 4.0) {
+            return self.size(name, valid);
+        }
+        let max = budget_count(per_unit);
+        let v = if self.rng.chance(0.5) {
+            max + 1
+        } else {
+            2 * max
+        };
+        self.note(name, v);
+        v
+    }
+
+    /// A tolerance: valid, or with probability `self.edge / 2` one of [`FLOOR_TOLERANCES`].
+    pub(crate) fn tolerance(&mut self, name: &str, valid: RangeInclusive<f64>) -> f64 {
+        if self.rng.chance(self.edge / 2.0) {
+            return self.pick(name, &FLOOR_TOLERANCES);
+        }
+        self.real(name, valid)
     }
 
     pub(crate) fn flag(&mut self, name: &str, p: f64) -> bool {

@@ -20,6 +20,7 @@ enum Outcome {
     Panic(String),
     NonFinite(String),
     NoEnd(String),
+    Wrong(String),
     Hang,
 }
 
@@ -66,6 +67,7 @@ fn run_case(base: u64, index: usize, log: Arc<Mutex<String>>) -> Report {
         }
         Ok(_) if !checks.non_finite.is_empty() => Outcome::NonFinite(checks.non_finite.join("; ")),
         Ok(_) if !checks.no_end.is_empty() => Outcome::NoEnd(checks.no_end.join("; ")),
+        Ok(_) if !checks.wrong.is_empty() => Outcome::Wrong(checks.wrong.join("; ")),
         Ok(Ok(())) => Outcome::Ok,
         Ok(Err(message)) => {
             if std::env::var_os("STRESS_ERRORS").is_some() {
@@ -115,6 +117,7 @@ struct Counts {
     panics: usize,
     non_finite: usize,
     no_end: usize,
+    wrong: usize,
     hangs: usize,
 }
 
@@ -127,14 +130,22 @@ impl Counts {
             Outcome::Panic(_) => self.panics += 1,
             Outcome::NonFinite(_) => self.non_finite += 1,
             Outcome::NoEnd(_) => self.no_end += 1,
+            Outcome::Wrong(_) => self.wrong += 1,
             Outcome::Hang => self.hangs += 1,
         }
     }
 
     fn row(&self, name: &str) -> String {
         format!(
-            "{name:<20} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
-            self.cases, self.ok, self.typed, self.panics, self.non_finite, self.no_end, self.hangs
+            "{name:<20} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
+            self.cases,
+            self.ok,
+            self.typed,
+            self.panics,
+            self.non_finite,
+            self.no_end,
+            self.wrong,
+            self.hangs
         )
     }
 }
@@ -152,8 +163,11 @@ pub(crate) fn run_suite(base: u64, indices: impl Iterator<Item = usize>) -> Vec<
     let mut per_kind: BTreeMap<Kind, Counts> = BTreeMap::new();
     let mut total = Counts::default();
     let mut failures = Vec::new();
+    // The slowest case that answered: (seconds, index, kind).
+    let mut slowest: Option<(f64, usize, Kind)> = None;
     for index in indices {
         let log = Arc::new(Mutex::new(String::new()));
+        let sent = Instant::now();
         worker
             .cases
             .send((index, Arc::clone(&log)))
@@ -162,7 +176,13 @@ pub(crate) fn run_suite(base: u64, indices: impl Iterator<Item = usize>) -> Vec<
             .reports
             .recv_timeout(Duration::from_secs(HANG_SECONDS))
         {
-            Ok(report) => report,
+            Ok(report) => {
+                let seconds = sent.elapsed().as_secs_f64();
+                if slowest.is_none_or(|(s, ..)| seconds > s) {
+                    slowest = Some((seconds, index, report.kind));
+                }
+                report
+            }
             Err(_) => {
                 // The hung thread cannot be stopped: leave it and carry on with a new one.
                 worker = Worker::spawn(base);
@@ -196,13 +216,16 @@ pub(crate) fn run_suite(base: u64, indices: impl Iterator<Item = usize>) -> Vec<
         elapsed.as_secs_f64()
     );
     println!(
-        "{:<20} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
-        "kind", "cases", "ok", "typed", "panic", "nonfin", "no end", "hang"
+        "{:<20} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
+        "kind", "cases", "ok", "typed", "panic", "nonfin", "no end", "wrong", "hang"
     );
     for (kind, counts) in &per_kind {
         println!("{}", counts.row(&format!("{kind:?}")));
     }
     println!("{}", total.row("total"));
+    if let Some((seconds, index, kind)) = slowest {
+        println!("slowest case: {index} ({kind:?}), {seconds:.2} s");
+    }
     println!("aborts: 0 (the process finished)");
     for f in &failures {
         println!(

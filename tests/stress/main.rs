@@ -2,14 +2,22 @@
 //! assemblies with built-in and downstream conditions, harmonic-balance settings, solvers and
 //! their options, the continuation drivers and backbones, post-processing of valid systems),
 //! valid, at the edges and bad: `0`, negative, subnormal, `1e-300`, `1e300`, `f64::MAX`,
-//! infinities and NaN; sizes `0`, `1`, small, `2^40` and `usize::MAX`.
+//! infinities and NaN; sizes `0`, `1`, small, `2^40` and `usize::MAX`, and one and twice past
+//! the memory budget; tolerances below the rounding floor with `usize::MAX` iterations;
+//! parameters at the extremes the constructors accept; assemblies written to JSON and TOML
+//! and read back bit for bit.
 //!
 //! Each case runs under `catch_unwind` on a worker thread and is classified: `Ok`, typed
 //! error, panic (with its message), a non-finite number in an `Ok` result, a run without a
-//! consistent end reason, or a hang (no answer within
-//! [`HANG_SECONDS`](harness::HANG_SECONDS)). The tests fail on any panic, non-finite result,
-//! missing end reason or hang, and print each failure with its case index and the inputs
+//! consistent end reason, a result that contradicts its input (an error naming another index
+//! or size, memory held beyond what the budget counted, a file read back with other
+//! numbers), or a hang (no answer within [`HANG_SECONDS`](harness::HANG_SECONDS)). The tests
+//! fail on any but the first two, and print each failure with its case index and the inputs
 //! drawn, so that `STRESS_SEED`/`STRESS_ONLY` reproduce it.
+//!
+//! Overflowing arithmetic wraps silently in a release build: run the suite with overflow
+//! checks too (`CARGO_PROFILE_RELEASE_OVERFLOW_CHECKS=true`, in a target directory of its
+//! own), where it panics.
 //!
 //! - `stress_public_api`: [`QUICK_CASES`] cases (a minute in release);
 //! - `stress_public_api_long` (`#[ignore]`): `STRESS_CASES` cases, 20 000 by default:

@@ -77,7 +77,7 @@ pub enum AssemblyFileError {
     #[error("the assembly has no [[bar]]")]
     NoBars,
     /// Two bars have the same name.
-    #[error("bars {} and {} are both named `{name}`", .first + 1, .second + 1)]
+    #[error("bars {} and {} are both named `{name}`", one_based(.first), one_based(.second))]
     DuplicateBarName {
         /// The name.
         name: String,
@@ -87,7 +87,7 @@ pub enum AssemblyFileError {
         second: usize,
     },
     /// An end is not written `NAME.start` or `NAME.end`.
-    #[error("[[condition]] {}: end `{end}` is not of the form NAME.start or NAME.end", .condition + 1)]
+    #[error("[[condition]] {}: end `{end}` is not of the form NAME.start or NAME.end", one_based(.condition))]
     MalformedEnd {
         /// Index of the condition.
         condition: usize,
@@ -95,7 +95,7 @@ pub enum AssemblyFileError {
         end: String,
     },
     /// An end names a bar that the file does not have.
-    #[error("[[condition]] {}: end `{end}` names bar `{bar}`, which is not in the file", .condition + 1)]
+    #[error("[[condition]] {}: end `{end}` names bar `{bar}`, which is not in the file", one_based(.condition))]
     UnknownBarName {
         /// Index of the condition.
         condition: usize,
@@ -105,7 +105,7 @@ pub enum AssemblyFileError {
         bar: String,
     },
     /// A bar's values are rejected ([`Bar::new`](crate::bar::Bar::new)).
-    #[error("[[bar]] {} (`{name}`): {source}", .index + 1)]
+    #[error("[[bar]] {} (`{name}`): {source}", one_based(.index))]
     Bar {
         /// Index of the bar.
         index: usize,
@@ -124,7 +124,7 @@ pub enum AssemblyFileError {
     },
     /// A condition is rejected by the assembly builder (a gap or stiffness not positive and
     /// finite).
-    #[error("[[condition]] {} ({type_name}): {source}", .index + 1)]
+    #[error("[[condition]] {} ({type_name}): {source}", one_based(.index))]
     Condition {
         /// Index of the condition.
         index: usize,
@@ -146,7 +146,7 @@ pub enum AssemblyFileError {
     },
     /// A condition of the system is not one of the five built-in conditions, so the schema
     /// cannot describe it.
-    #[error("condition {} (`{condition}`) is not a built-in condition: the file schema cannot describe it", .index + 1)]
+    #[error("condition {} (`{condition}`) is not a built-in condition: the file schema cannot describe it", one_based(.index))]
     Unrepresentable {
         /// Its index in the system.
         index: usize,
@@ -161,6 +161,12 @@ pub enum AssemblyFileError {
         /// The serialiser's message.
         message: String,
     },
+}
+
+/// The 1-based number of the item at index `i`, as a reader counts (no overflow at
+/// `usize::MAX`: the fields of the error are public).
+fn one_based(i: &usize) -> u128 {
+    *i as u128 + 1
 }
 
 /// ` at line L, column C`, or nothing when the parser gave no position.
@@ -183,7 +189,7 @@ struct EndProblem<'a>(&'a [usize], &'a ModelError);
 
 impl fmt::Display for EndProblem<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let numbers: Vec<String> = self.0.iter().map(|i| (i + 1).to_string()).collect();
+        let numbers: Vec<String> = self.0.iter().map(|i| one_based(i).to_string()).collect();
         let list = match numbers.as_slice() {
             [] => String::new(),
             [one] => one.clone(),

@@ -87,7 +87,11 @@ pub fn harmonic_energies_by_bar<B: Basis>(
     x: &[f64],
     omega: f64,
 ) -> Result<Vec<Vec<f64>>, SettingsError> {
-    check_length(x, basis.len() * system.unknowns_per_harmonic())?;
+    // A product beyond `usize` is no length `x` can have.
+    check_length(
+        x,
+        basis.len().saturating_mul(system.unknowns_per_harmonic()),
+    )?;
     check_frequency(omega)?;
     check_unknowns_finite(x)?;
     let (len, m) = (basis.len(), basis.harmonics());

@@ -199,6 +199,9 @@ impl<B: Basis> NonsmoothSystem<B> {
 
     /// Index in `x` of coefficient `i`, bar `bar`, Helmholtz component `which` (0: `A`, 1: `B`),
     /// as in [`Layout`].
+    ///
+    /// # Panics
+    /// As [`Layout::index`]: for a bar or component out of range, or an index beyond `usize`.
     pub fn index(&self, i: usize, bar: usize, which: usize) -> usize {
         self.layout().index(i, bar, which)
     }

@@ -8,14 +8,16 @@ use super::solvers::solver;
 use super::{reference_system, settings, MAX_HARMONICS};
 use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
+use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::continuation::{EndReason, Rejection, SequentialOptions, Speculation};
 use nonsmooth_modes::modal::{
     arclength_backbone_observed, backbone, backbone_speculative_with, backbone_with,
-    grazing_energy, parameter_branch, ArclengthBackboneOptions, BackboneObserver, BackboneOptions,
-    BackbonePoint, ParameterSteps, PeriodGrid, SwitchAt,
+    parameter_branch, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint,
+    ParameterSteps, PeriodGrid, PointStatus, SwitchAt,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
-use nonsmooth_modes::system::HarmonicBalanceSettings;
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
+use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -146,9 +148,52 @@ pub(crate) fn arclength_backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResul
     Ok(())
 }
 
-/// `modal::parameter_branch` in the gap of the clamped bar, over values or by arclength.
+/// Values a constructor accepts at its extremes: a bar length or a gap from the least
+/// normal `f64` to `f64::MAX` (the independent run's `4.75e299` among them).
+const EXTREME_ACCEPTED: [f64; 8] = [
+    f64::MIN_POSITIVE,
+    1e-300,
+    1e-160,
+    1e10,
+    1e100,
+    1e200,
+    4.75e299,
+    f64::MAX,
+];
+
+/// The clamped bar of length `length` (wave speed and stiffness 1) facing its obstacle at
+/// `gap`.
+fn clamped_of_length(length: f64, gap: f64) -> Result<BarSystem, ModelError> {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::new(length, 1.0, 1.0)?);
+    b.dirichlet(bar.left())?.signorini(bar.right(), gap)?;
+    b.build()
+}
+
+/// A parameter value: in `valid`, or with probability `self.edge / 2` one of
+/// [`EXTREME_ACCEPTED`].
+fn parameter_value(d: &mut Draw, name: &str, valid: std::ops::RangeInclusive<f64>) -> f64 {
+    if d.flag(&format!("{name} extreme"), d.edge / 2.0) {
+        d.pick(name, &EXTREME_ACCEPTED)
+    } else {
+        d.real(name, valid)
+    }
+}
+
+/// `modal::parameter_branch` in the gap or the bar length of the clamped bar, over values or
+/// by arclength, up to the extremes of what `Bar::new` and the conditions accept.
 pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let gap = d.real("gap", 1e-4..=0.1);
+    let by_length = d.flag("bar length", 0.5);
+    // The family and its start value: the gap at `gap`, or the unit length.
+    let family = move |v: f64| {
+        if by_length {
+            clamped_of_length(v, gap)
+        } else {
+            clamped_bar_with_obstacle(v)
+        }
+    };
+    let start = if by_length { 1.0 } else { gap };
     let harmonics = d.size("harmonics", 1..=MAX_HARMONICS).min(1 << 20);
     let s = HarmonicBalanceSettings {
         harmonics,
@@ -164,8 +209,10 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let omega = 2.0 * PI / period;
     let steps = if d.flag("values", 0.5) {
         let count = d.size("count", 1..=6).min(8);
-        let mut values = vec![d.real("first value", gap..=gap)];
-        values.extend((1..count).map(|i| d.real(&format!("value{i}"), gap..=2.0 * gap)));
+        let mut values = vec![d.real("first value", start..=start)];
+        values.extend(
+            (1..count).map(|i| parameter_value(d, &format!("value{i}"), start..=2.0 * start)),
+        );
         let options = SequentialOptions {
             max_consecutive_failures: d.size("max_consecutive_failures", 0..=5),
             retry_depth: d.size("retry_depth", 0..=2),
@@ -175,8 +222,8 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     } else {
         let mut o = arclength_options(d);
         o.parameter_range = (
-            d.real("range lo", gap * 0.5..=gap),
-            d.real("range hi", gap..=gap * 3.0),
+            d.real("range lo", start * 0.5..=start),
+            parameter_value(d, "range hi", start..=start * 3.0),
         );
         o.max_steps = o.max_steps.min(8);
         o.max_rejections = o.max_rejections.min(20);
@@ -200,28 +247,16 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let branch = typed(
         c,
         "parameter_branch",
-        parameter_branch(
-            clamped_bar_with_obstacle,
-            s,
-            (x, omega),
-            gap,
-            steps,
-            solver,
-            observer,
-        ),
+        parameter_branch(family, s, (x, omega), start, steps, solver, observer),
     )?;
     c.branch("parameter branch", &branch, stopped);
-    // Converged points are finite; `E / E_g` is NaN, as documented, where the system at
-    // the point's parameter has no grazing energy (checked against `grazing_energy`).
-    for (value, p) in points.iter().filter(|(_, p)| p.converged) {
-        let defined = clamped_bar_with_obstacle(*value)
-            .ok()
-            .is_some_and(|s| grazing_energy(&s).is_ok());
-        let mut p = p.clone();
-        if !defined && p.energy_normalized.is_nan() {
-            p.energy_normalized = 0.0;
+    // Converged points are finite, energies included: a point whose energy or `E / E_g` is
+    // not finite (a system without grazing energy, a motion whose energy overflows) is
+    // `NonFiniteEnergy`, not converged. Failed points hold the solver's last iterate.
+    for (_, p) in &points {
+        if p.converged || p.status == PointStatus::NonFiniteEnergy {
+            c.backbone_point("parameter point", p);
         }
-        c.backbone_point("parameter point", &p);
     }
     Ok(())
 }

@@ -11,7 +11,9 @@ use nonsmooth_modes::modal::{
     ContactState, PeriodGrid,
 };
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
-use nonsmooth_modes::system::{AssemblyBuilder, HarmonicBalanceSettings, NonsmoothSystem};
+use nonsmooth_modes::system::{
+    AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
+};
 use std::f64::consts::PI;
 
 /// A downstream linear condition `k u + EA p = 0` (a spring of any stiffness, NaN and
@@ -127,6 +129,8 @@ pub(crate) fn assembly(d: &mut Draw, c: &mut Checks) -> CaseResult {
         }
     }
     let system = typed(c, "build", b.build())?;
+    #[cfg(feature = "serde")]
+    file_round_trip(c, &system);
     if let Ok(modes) = natural_frequencies(&system, ContactState::Open, d.real("upper", 1.0..=12.0))
     {
         for m in &modes {
@@ -165,6 +169,48 @@ pub(crate) fn assembly(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let points = typed(c, "backbone", backbone(&system, s, &options, fast))?;
     points.iter().for_each(|p| c.backbone_point("backbone", p));
     Ok(())
+}
+
+/// A system written as an assembly file, JSON and TOML, and read back is the same system bit
+/// for bit: its bars' numbers and its conditions (whose names carry their values). A system
+/// with a downstream condition cannot be written (`Unrepresentable`).
+#[cfg(feature = "serde")]
+fn file_round_trip(c: &mut Checks, system: &BarSystem) {
+    use nonsmooth_modes::io::assembly::{Assembly, AssemblyFile, FileFormat};
+    let Ok(file) = AssemblyFile::from_system(system) else {
+        return;
+    };
+    let bits = |s: &BarSystem| -> Vec<u64> {
+        s.bars()
+            .iter()
+            .flat_map(|b| [b.length(), b.wave_speed(), b.stiffness()])
+            .map(f64::to_bits)
+            .collect()
+    };
+    let names = |s: &BarSystem| -> Vec<String> { s.conditions().map(|c| c.name()).collect() };
+    for format in [FileFormat::Json, FileFormat::Toml] {
+        let text = match format {
+            FileFormat::Json => file.to_json(),
+            FileFormat::Toml => file.to_toml(),
+        };
+        let text = match text {
+            Ok(text) => text,
+            Err(e) => {
+                c.wrong
+                    .push(format!("{format}: a valid system not written: {e}"));
+                continue;
+            }
+        };
+        match Assembly::parse(&text, format) {
+            Ok(back) => c.expect(
+                bits(back.system()) == bits(system) && names(back.system()) == names(system),
+                || format!("{format}: read back with other numbers:\n{text}"),
+            ),
+            Err(e) => c.wrong.push(format!(
+                "{format}: the file written does not read back: {e}"
+            )),
+        }
+    }
 }
 
 /// Harmonic-balance settings of every size and value, a frequency of any value: the problem,

@@ -4,10 +4,11 @@ use super::model::foreign_bar;
 use super::{reference_system, MAX_HARMONICS};
 use crate::checks::{moderate_motion, typed, CaseResult, Checks};
 use crate::draw::Draw;
+use nonsmooth_modes::fourier::{Basis, MEMORY_BUDGET_BYTES};
 use nonsmooth_modes::modal::{branch_seed, diagnose, energy, grazing_energy, law_history};
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions, SpringUpdate};
-use nonsmooth_modes::Solution;
+use nonsmooth_modes::{SettingsError, Solution};
 use std::f64::consts::PI;
 
 /// Post-processing of a motion of a valid system at any frequency, with any sizes:
@@ -43,8 +44,12 @@ pub(crate) fn post_processing(d: &mut Draw, c: &mut Checks) -> CaseResult {
     if moderate_inputs {
         c.finite("energy", [&energy(&system, problem.basis(), &x, omega)]);
     }
-    let refinement = d.size("refinement", 1..=4);
-    if let Ok(diag) = diagnose(&problem, &x, omega, refinement) {
+    // Histories of `N refinement` samples, four doubles each.
+    let grid = problem.basis().samples() as f64;
+    let refinement = d.size_or_budget("refinement", 1..=4, 4.0 * grid);
+    let diagnosed = diagnose(&problem, &x, omega, refinement);
+    budget_consistent(c, "diagnose", 4.0 * grid * refinement as f64, &diagnosed);
+    if let Ok(diag) = diagnosed {
         c.finite("diagnose", &diag.residual_norm);
         c.finite(
             "diagnose",
@@ -56,10 +61,17 @@ pub(crate) fn post_processing(d: &mut Draw, c: &mut Checks) -> CaseResult {
         );
     }
     let law = d.size("law", 0..=1);
-    let samples = d.size("samples", 1..=64);
-    if let Ok(h) = law_history(&problem, &x, omega, law, samples) {
+    let samples = d.size_or_budget("samples", 1..=64, 4.0);
+    let laws = system.contact_count();
+    let history = law_history(&problem, &x, omega, law, samples);
+    index_consistent(c, "law_history", (law, laws), &history);
+    if law < laws {
+        budget_consistent(c, "law_history", 4.0 * samples as f64, &history);
+    }
+    if let Ok(h) = history {
         for v in [&h.time, &h.gap, &h.force, &h.residual] {
             c.finite("law history", v);
+            c.exact("law history", v);
         }
     }
     let solution = typed(c, "Solution::new", Solution::new(&problem, &x, omega))?;
@@ -69,19 +81,37 @@ pub(crate) fn post_processing(d: &mut Draw, c: &mut Checks) -> CaseResult {
     } else {
         system.bar_id(0).expect("a bar").right()
     };
-    if let Ok(h) = solution.end_history(end, d.size("end samples", 1..=32)) {
+    let bars = system.bars().len();
+    let samples = d.size_or_budget("end samples", 1..=32, 4.0);
+    let history = solution.end_history(end, samples);
+    index_consistent(c, "end_history", (end.bar.index(), bars), &history);
+    if end.bar.index() < bars {
+        budget_consistent(c, "end_history", 4.0 * samples as f64, &history);
+    }
+    if let Ok(h) = history {
         for v in [&h.time, &h.displacement, &h.strain, &h.contact_force] {
             c.finite("end history", v);
+            c.exact("end history", v);
         }
     }
-    let (bar, positions, instants) = (
-        d.size("grid bar", 0..=1),
-        d.size("positions", 1..=8),
-        d.size("instants", 1..=8),
-    );
-    if let Ok(g) = solution.displacement_grid(bar, positions, instants) {
+    let bar = d.size("grid bar", 0..=1);
+    let (positions, instants) = if d.flag("grid at the budget", d.edge / 4.0) {
+        // `(p + 1)(i + 1) - 1` values: `2^29` doubles (4 GiB), then one position more.
+        let extra = d.pick("extra positions", &[1usize, 2, 1 << 20]);
+        ((1 << 14) - 1 + extra, (1 << 15) - 1)
+    } else {
+        (d.size("positions", 1..=8), d.size("instants", 1..=8))
+    };
+    let g = solution.displacement_grid(bar, positions, instants);
+    index_consistent(c, "displacement_grid", (bar, bars), &g);
+    if bar < bars {
+        let (p, i) = (positions as f64, instants as f64);
+        budget_consistent(c, "displacement_grid", p * i + p + i, &g);
+    }
+    if let Ok(g) = g {
         for v in [&g.position, &g.time, &g.displacement] {
             c.finite("displacement grid", v);
+            c.exact("displacement grid", v);
         }
     }
     if let Ok(e) = solution.energy_normalized() {
@@ -160,4 +190,45 @@ pub(crate) fn post_processing(d: &mut Draw, c: &mut Checks) -> CaseResult {
         }
     }
     Ok(())
+}
+
+/// A request of `index` among `count` items: `IndexOutOfRange` exactly when it is out of
+/// range, naming that index and count (a wrapped `index + 1` named another).
+fn index_consistent<T>(
+    c: &mut Checks,
+    what: &str,
+    (index, count): (usize, usize),
+    result: &Result<T, SettingsError>,
+) {
+    let out = index >= count;
+    match result {
+        Err(SettingsError::IndexOutOfRange {
+            index: i, count: n, ..
+        }) => c.expect(out && (*i, *n) == (index, count), || {
+            format!("{what}: index {i} of {n} for index {index} of {count}")
+        }),
+        _ => c.expect(!out, || {
+            format!("{what}: index {index} of {count} not refused")
+        }),
+    }
+}
+
+/// A request of `doubles` values checked against the memory budget: refused when they
+/// exceed it (by `TooLarge` unless an earlier check refused it), and a `TooLarge` only then,
+/// carrying the bytes of the request.
+fn budget_consistent<T>(
+    c: &mut Checks,
+    what: &str,
+    doubles: f64,
+    result: &Result<T, SettingsError>,
+) {
+    let bytes = doubles * 8.0;
+    let over = bytes > MEMORY_BUDGET_BYTES as f64;
+    match result {
+        Err(SettingsError::TooLarge(e)) => c.expect(over && e.requested_bytes == bytes, || {
+            format!("{what}: {e} for {bytes:e} bytes")
+        }),
+        Ok(_) => c.expect(!over, || format!("{what}: {bytes:e} bytes not refused")),
+        Err(_) => {}
+    }
 }

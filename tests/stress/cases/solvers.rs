@@ -45,10 +45,20 @@ impl NonlinearSolver for AnySolver {
     }
 }
 
+/// An iteration budget: small, at the edges, or (with probability `unbounded`) `usize::MAX`,
+/// the budget a careless user gives a solver asked for a tolerance it cannot reach.
+fn iterations(d: &mut Draw, valid: std::ops::RangeInclusive<usize>, unbounded: f64) -> usize {
+    if d.flag("unbounded iterations", unbounded) {
+        usize::MAX
+    } else {
+        d.size("max_iterations", valid)
+    }
+}
+
 fn newton_options(d: &mut Draw) -> NewtonOptions {
     NewtonOptions {
-        tolerance: d.real("tolerance", 1e-12..=1e-3),
-        max_iterations: d.size("max_iterations", 0..=40),
+        tolerance: d.tolerance("tolerance", 1e-12..=1e-3),
+        max_iterations: iterations(d, 0..=40, 0.1),
         armijo: d.real("armijo", 1e-6..=0.5),
         min_step: d.real("min_step", 1e-10..=0.1),
         stall_window: d.size("stall_window", 0..=20),
@@ -76,8 +86,8 @@ pub(crate) fn solver(d: &mut Draw, c: &mut Checks) -> Result<AnySolver, String> 
         }
         "dogleg" => {
             let o = DoglegOptions {
-                tolerance: d.real("tolerance", 1e-12..=1e-3),
-                max_iterations: d.size("max_iterations", 0..=60),
+                tolerance: d.tolerance("tolerance", 1e-12..=1e-3),
+                max_iterations: iterations(d, 0..=60, 0.15),
                 initial_radius: d.real("initial_radius", 1e-3..=10.0),
                 min_radius: d.real("min_radius", 1e-14..=1e-2),
             };
