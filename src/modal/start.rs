@@ -351,7 +351,9 @@ pub fn backbone_start<S: NonlinearSolver>(
 /// its points from the far end back to the one before the start, in the run's direction and
 /// numbered from 0 ([`reversed`]), and the walk's rejected steps. The run then goes on from
 /// the start, so that the branch between `omega` and `from` is not lost. A start not beyond
-/// `omega`, or one the driver cannot start from, has no walk.
+/// `omega`, or one the driver cannot start from, has no walk. The walk keeps within the
+/// drivers' default step and rejection budgets ([`ArclengthOptions::default`]): the run's
+/// observer sees it only once it is over and so cannot stop it.
 pub(crate) fn walk_back<S: NonlinearSolver>(
     problem: &NonsmoothSystem,
     solver: &S,
@@ -365,6 +367,9 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
         return (Vec::new(), 0);
     }
     let (lo, hi) = options.parameter_range;
+    // The run's observer sees the walk only once it is over, so it cannot stop it: the walk
+    // keeps within the drivers' default budgets even where the run's are unbounded.
+    let defaults = ArclengthOptions::default();
     let walk = ArclengthOptions {
         direction: -direction,
         parameter_range: if direction > 0.0 {
@@ -373,6 +378,8 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
             (lo, omega.min(hi))
         },
         branch_points: false,
+        max_steps: options.max_steps.min(defaults.max_steps),
+        max_rejections: options.max_rejections.min(defaults.max_rejections),
         ..options
     };
     let (system, basis) = (problem.system().clone(), problem.basis().clone());
