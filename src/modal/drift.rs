@@ -12,7 +12,7 @@
 
 use crate::error::SettingsError;
 use crate::modal::linear::{rigid_body_modes, ContactState};
-use crate::system::rows::HarmonicRows;
+use crate::system::rows::{dot, HarmonicRows};
 use crate::system::BarSystem;
 
 /// Rows of `C` whose norm is below this fraction of the largest are gaps that no rigid-body
@@ -155,10 +155,6 @@ fn null_direction(m: &[Vec<f64>], r: usize) -> Option<Vec<f64>> {
     }
     let n = norm(&v);
     Some(v.into_iter().map(|x| x / n).collect())
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm(a: &[f64]) -> f64 {

@@ -197,7 +197,6 @@ pub(crate) fn usable_start<S: NonlinearSolver>(
     omega: f64,
     floor: f64,
 ) -> Result<(Vec<f64>, f64), SettingsError> {
-    let guesses = StartGuesses::new(problem.system());
     let (system, basis) = (problem.system().clone(), problem.basis().clone());
     let above_rest_at = |at: f64| {
         let (system, basis) = (&system, &basis);
@@ -216,6 +215,8 @@ pub(crate) fn usable_start<S: NonlinearSolver>(
     {
         return Ok((seed, omega));
     }
+    // The guesses need the rigid-body modes (an SVD): only a seed that slid to rest pays.
+    let guesses = StartGuesses::new(&system);
     let homotopy = SmoothingHomotopy::new(solver);
     let found = guesses.ratios().into_iter().find_map(|r| {
         let at = omega * r / START_RATIOS[0];
