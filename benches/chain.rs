@@ -17,9 +17,10 @@
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion};
+use nonsmooth_modes::branches::PeriodGrid;
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::Basis;
-use nonsmooth_modes::modal::{branch_seed, PeriodGrid};
+use nonsmooth_modes::modal::branch_seed;
 use nonsmooth_modes::reference::contact_chain;
 use nonsmooth_modes::solve::Problem;
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};

@@ -11,13 +11,12 @@
 //! ```
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use nonsmooth_modes::branches::backbone_speculative_with;
+use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
 use nonsmooth_modes::continuation::{ContinuationProblem, Speculation};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::backbone_speculative_with;
-use nonsmooth_modes::modal::{
-    backbone, energy, energy_at, BackboneOptions, BackbonePoint, PeriodGrid,
-};
+use nonsmooth_modes::modal::{energy, energy_at};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, Problem, SemismoothNewton};
 use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};

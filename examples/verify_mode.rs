@@ -16,8 +16,8 @@
 //! and penetration.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::backbone_with;
-use nonsmooth_modes::modal::{BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::backbone_with;
+use nonsmooth_modes::branches::{BackboneOptions, PeriodGrid};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };

@@ -247,7 +247,7 @@ pub enum SettingsError {
     TooLarge(#[from] OverBudget),
     /// A fundamental frequency is positive but so small that it is subnormal or that its
     /// period `2 pi / omega` overflows (see
-    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY)).
+    /// [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY)).
     #[error(
         "{what} {omega:e} is below {min:e}: it is subnormal or its period 2 pi / omega overflows"
     )]

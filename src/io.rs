@@ -4,8 +4,8 @@
 #[cfg(feature = "serde")]
 pub mod assembly;
 
+use crate::branches::BackbonePoint;
 use crate::continuation::Event;
-use crate::modal::BackbonePoint;
 use std::io::{self, Write};
 
 /// Serialises a value by its `Display` text (an error inside a serialised end reason).
@@ -165,7 +165,7 @@ mod tests {
             energy: 1e-6,
             energy_normalized: 2.25,
             converged: true,
-            status: crate::modal::PointStatus::Converged,
+            status: crate::branches::PointStatus::Converged,
             residual_norm: 1e-15,
             iterations: 2,
             x: vec![0.0, 1e-3],

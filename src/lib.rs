@@ -31,8 +31,8 @@
 //! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`], [`solve::SmoothingHomotopy`] |
 //! | [`solve::Problem`], [`solve::Structured`] | what a solver sees: residual, Jacobian, and optional capabilities (structured solve, line-search residual, smoothing, weights, active sets) |
 //! | [`continuation::ContinuationProblem`] | a problem with a parameter: [`continuation::Sequential`], [`continuation::Speculative`], [`continuation::Arclength`], all with one shape ([`continuation::Step`], iterator, `run` with an [`continuation::Observer`]) |
-//! | [`modal::backbone()`], [`modal::arclength_backbone`] (with [`modal::StallEscape`]), [`modal::parameter_branch`] | one call: a backbone with `E / E_g`; a point continued in any system parameter |
-//! | [`modal::energy_backbone`], [`modal::EnergyLevel`] | a backbone continued in `E / E_g`, the frequency an unknown (the state of rest excluded) |
+//! | [`branches::backbone()`], [`branches::arclength_backbone`] (with [`branches::StallEscape`]), [`branches::parameter_branch`] | one call: a backbone with `E / E_g`; a point continued in any system parameter |
+//! | [`branches::energy_backbone`], [`branches::EnergyLevel`] | a backbone continued in `E / E_g`, the frequency an unknown (the state of rest excluded) |
 //! | [`Solution`] | a computed motion (problem, unknowns, frequency): energy, `E/E_g`, fields, end and law histories, diagnostics, time-domain check |
 //! | [`modal::diagnose`], [`modal::FieldEvaluator`] | residual norm `R^(m)`, penetration, fields, histories of a point |
 //! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |
@@ -79,6 +79,7 @@ struct ReadmeDoctests;
 pub mod bar;
 pub mod bc;
 pub mod bem;
+pub mod branches;
 mod check;
 pub mod continuation;
 mod end;

@@ -27,11 +27,12 @@ use crate::bar::EndRef;
 use crate::error::SettingsError;
 use crate::fourier::{Basis, CosineBasis};
 use crate::modal::diagnostics::{
-    check_finite, check_motion, checked_displacement_grid, checked_end_history, diagnose,
-    law_history, EndHistory, FieldGrid, LawHistory, PointDiagnostics,
+    checked_displacement_grid, checked_end_history, diagnose, law_history, EndHistory, FieldGrid,
+    LawHistory, PointDiagnostics,
 };
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
+use crate::modal::inputs::{check_finite, check_motion};
 use crate::modal::linear::grazing_energy;
 use crate::modal::signature::{contact_intervals, subharmonic_share};
 use crate::system::{BarSystem, NonsmoothSystem};
@@ -53,7 +54,7 @@ impl<'a, B: Basis> Solution<'a, B> {
     /// [`SettingsError::Length`] if `x` does not have the problem's dimension,
     /// [`SettingsError::NotPositive`] for a non-positive or non-finite `omega` or unknowns
     /// that are not finite, and [`SettingsError::FrequencyTooSmall`] for an `omega` below
-    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY) (subnormal, or with an
+    /// [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY) (subnormal, or with an
     /// infinite period).
     pub fn new(
         problem: &'a NonsmoothSystem<B>,

@@ -1,7 +1,7 @@
 //! Sweeps: many backbones (modes, subharmonics, parameter values, harmonic counts) computed in
 //! one call, in parallel with the `parallel` feature.
 //!
-//! Each [`SweepJob`] is one call of [`modal::backbone`](fn@crate::modal::backbone): a system,
+//! Each [`SweepJob`] is one call of [`branches::backbone`](fn@crate::branches::backbone): a system,
 //! harmonic-balance settings, backbone options and a solver. The jobs are independent, so
 //! [`backbones`] runs them on rayon's thread pool when the crate is built with
 //! `--features parallel`, and one after the other otherwise. Every job is computed by the same
@@ -36,8 +36,8 @@
 //! # Ok::<(), nonsmooth_modes::Error>(())
 //! ```
 
+use crate::branches::{backbone, Backbone, BackboneOptions};
 use crate::error::{Error, SolveError};
-use crate::modal::{backbone, Backbone, BackboneOptions};
 use crate::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo, SolveMonitor};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 
@@ -77,7 +77,7 @@ impl NonlinearSolver for Solver {
     }
 }
 
-/// One backbone of a sweep: the arguments of [`modal::backbone`](fn@crate::modal::backbone).
+/// One backbone of a sweep: the arguments of [`branches::backbone`](fn@crate::branches::backbone).
 #[derive(Debug, Clone)]
 pub struct SweepJob<S = Solver> {
     /// The bar system.
@@ -94,7 +94,7 @@ impl<S: NonlinearSolver + Clone> SweepJob<S> {
     /// Computes this job's backbone (what [`backbones`] does for each job).
     ///
     /// # Errors
-    /// See [`modal::backbone`](fn@crate::modal::backbone).
+    /// See [`branches::backbone`](fn@crate::branches::backbone).
     pub fn run(&self) -> Result<Backbone, Error> {
         backbone(
             &self.system,
@@ -135,7 +135,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::modal::PeriodGrid;
+    use crate::branches::PeriodGrid;
     use crate::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
     use crate::solve::DoglegOptions;
 

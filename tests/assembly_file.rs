@@ -7,10 +7,10 @@
 #![cfg(feature = "serde")]
 
 use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
 use nonsmooth_modes::io::assembly::{
     Assembly, AssemblyFile, AssemblyFileError, ConditionEntry, FileFormat,
 };
-use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };
@@ -577,7 +577,7 @@ fn a_backbone_from_a_json_round_trip_equals_the_original_bit_for_bit() {
     let (a, b) = (run(&system), run(back.system()));
     assert!(a.iter().any(|p| p.converged));
     assert_eq!(a, b);
-    let bits = |p: &[nonsmooth_modes::modal::BackbonePoint]| -> Vec<u64> {
+    let bits = |p: &[nonsmooth_modes::branches::BackbonePoint]| -> Vec<u64> {
         p.iter()
             .flat_map(|p| p.x.iter().chain([&p.energy, &p.omega]))
             .map(|v| v.to_bits())

@@ -1,8 +1,8 @@
 //! A backbone run keeps everything it computed: a run that stalls returns its points, each
 //! with its status, and the reason it ended.
 
+use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid, PointStatus};
 use nonsmooth_modes::continuation::EndReason;
-use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid, PointStatus};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::HarmonicBalanceSettings;
@@ -114,7 +114,7 @@ fn a_completed_run_reports_each_step_status() {
 #[test]
 fn a_failed_start_search_is_bounded_and_says_why() {
     use nonsmooth_modes::bar::Bar;
-    use nonsmooth_modes::modal::{
+    use nonsmooth_modes::branches::{
         backbone_start, linear_period, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES,
         START_AMPLITUDES, START_RATIOS,
     };

@@ -4,12 +4,12 @@ use nonsmooth_modes::bar::{Bar, EndRef};
 use nonsmooth_modes::bc::{
     BoundaryCondition, Contact, LinearRows, Quantity, Robin, Signorini, Term,
 };
+use nonsmooth_modes::branches::{
+    arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, PeriodGrid,
+};
 use nonsmooth_modes::continuation::{linspace, ContinuationProblem, Sequential, SequentialOptions};
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, branch_seed, grazing_energy, natural_frequencies,
-    ArclengthBackboneOptions, BackboneOptions, ContactState, PeriodGrid,
-};
+use nonsmooth_modes::modal::{branch_seed, grazing_energy, natural_frequencies, ContactState};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{
     Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton,

@@ -1,13 +1,14 @@
 //! Continuation drivers on the paper's systems (issue: pseudo-arclength, parameters, loops).
 
+use nonsmooth_modes::branches::{
+    arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
+    PeriodGrid,
+};
 use nonsmooth_modes::continuation::{
     Arclength, ArclengthOptions, ContinuationProblem, EndReason, Event, PeriodParametrised, Point,
     Sequential, Speculative, Step,
 };
-use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, branch_seed, energy, ArclengthBackboneOptions, BackboneOptions,
-    BackbonePoint, PeriodGrid,
-};
+use nonsmooth_modes::modal::{branch_seed, energy};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
 };
@@ -400,7 +401,7 @@ fn clamped_backbone_m40(
     options: &BackboneOptions,
     speculation: Option<nonsmooth_modes::continuation::Speculation>,
 ) -> Vec<BackbonePoint> {
-    use nonsmooth_modes::modal::{backbone_speculative_with, backbone_with};
+    use nonsmooth_modes::branches::{backbone_speculative_with, backbone_with};
     use nonsmooth_modes::solve::NewtonOptions;
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
     let settings = HarmonicBalanceSettings {

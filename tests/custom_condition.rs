@@ -7,12 +7,12 @@ use nonsmooth_modes::bc::{
     complementarity, BoundaryCondition, LawValue, LinearRows, Observable, Quantity, Term,
     UnilateralLaw,
 };
+use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
 use nonsmooth_modes::continuation::{
     ContinuationProblem, PeriodParametrised, Sequential, SequentialOptions, Step,
 };
 use nonsmooth_modes::modal::{
-    backbone, branch_seed, energy, grazing_energy, natural_frequencies, BackboneOptions,
-    ContactState, PeriodGrid,
+    branch_seed, energy, grazing_energy, natural_frequencies, ContactState,
 };
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, clamped_free_frequency, robin_bar_with_obstacle,

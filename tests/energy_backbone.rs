@@ -3,13 +3,14 @@
 //! (whose exact first family is the clamped bar's at half length).
 
 use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::branches::{
+    arclength_backbone, backbone, backbone_start, energy_backbone, split_frequency,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
+    EnergyLevel, PeriodGrid, PointStatus, FLOATING_RETRY_DEPTH,
+};
 use nonsmooth_modes::continuation::{geomspace, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, backbone_start, branch_seed, energy, energy_backbone,
-    grazing_energy, split_frequency, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
-    EnergyBackboneOptions, EnergyGrid, EnergyLevel, PeriodGrid, PointStatus, FLOATING_RETRY_DEPTH,
-};
+use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
 use nonsmooth_modes::solve::{Problem, SemismoothNewton, Structured};
 use nonsmooth_modes::system::{
@@ -242,7 +243,7 @@ fn energy_backbone_of_the_clamped_bar_is_as_faithful_as_the_period_grid() {
     )
     .unwrap();
     let by_period = backbone(&system, settings(20), &BackboneOptions::default(), solver()).unwrap();
-    let points = |run: &nonsmooth_modes::modal::Backbone| {
+    let points = |run: &nonsmooth_modes::branches::Backbone| {
         run.converged()
             .map(|p| (p.period, p.energy_normalized))
             .collect::<Vec<_>>()

@@ -2,11 +2,9 @@
 //! and the linear frequencies (formulation §7–§8) as oracles.
 
 use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint};
 use nonsmooth_modes::continuation::ContinuationProblem;
-use nonsmooth_modes::modal::{
-    backbone, energy, grazing_energy, natural_frequencies, BackboneOptions, BackbonePoint,
-    ContactState,
-};
+use nonsmooth_modes::modal::{energy, grazing_energy, natural_frequencies, ContactState};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, clamped_clamped_frequency, clamped_free_frequency,
     clamped_grazing_energy, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,

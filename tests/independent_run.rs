@@ -15,13 +15,11 @@
 //! `tests/assembly_file.rs`; the stress suite `tests/stress/` draws all of these kinds.)
 
 use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::branches::{parameter_branch, BackbonePoint, ParameterSteps, PointStatus};
 use nonsmooth_modes::continuation::{ContinuationProblem, SequentialOptions};
 use nonsmooth_modes::fourier::{Basis, MEMORY_BUDGET_BYTES};
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::{
-    branch_seed, diagnose, law_history, parameter_branch, BackbonePoint, ParameterSteps,
-    PointStatus,
-};
+use nonsmooth_modes::modal::{branch_seed, diagnose, law_history};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::solve::{
     Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, SemismoothNewton,

@@ -288,7 +288,7 @@ proptest! {
 /// a short backbone of each system, each converged point perturbed by 1% of `g0`.
 #[test]
 fn jacobian_matches_finite_differences_near_converged_points() {
-    use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
+    use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
     use nonsmooth_modes::solve::SemismoothNewton;
     let mut checked = 0;
     let mut total = 0;

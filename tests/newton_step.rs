@@ -2,9 +2,10 @@
 //! right-hand side and for several at once.
 
 use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::branches::EnergyLevel;
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::{branch_seed, grazing_energy, EnergyLevel};
+use nonsmooth_modes::modal::{branch_seed, grazing_energy};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };

@@ -1,11 +1,11 @@
-//! A backbone point continued in a system parameter with `modal::parameter_branch`: the gap of
+//! A backbone point continued in a system parameter with `branches::parameter_branch`: the gap of
 //! the clamped bar, where the truncated problem is positively homogeneous
 //! (`x(s g0) = s x(g0)`, so `E / g0^2` and `E / E_g` stay constant along the branch).
 
-use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, SequentialOptions};
-use nonsmooth_modes::modal::{
+use nonsmooth_modes::branches::{
     backbone, parameter_branch, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
 };
+use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, SequentialOptions};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::HarmonicBalanceSettings;
@@ -130,7 +130,7 @@ fn bad_starts_are_typed_errors() {
 /// converged points of the branch, and every converged point is above the trivial-energy floor.
 #[test]
 fn a_gap_branch_that_slides_to_rest_reports_it() {
-    use nonsmooth_modes::modal::PointStatus;
+    use nonsmooth_modes::branches::PointStatus;
     let settings = HarmonicBalanceSettings::default();
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
     let options = BackboneOptions {

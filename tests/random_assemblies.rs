@@ -18,7 +18,8 @@
 //!   --nocapture`.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::{backbone, drifting_bars, BackboneOptions};
+use nonsmooth_modes::branches::{backbone, BackboneOptions};
+use nonsmooth_modes::modal::drifting_bars;
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};

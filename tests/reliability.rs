@@ -4,13 +4,12 @@
 //! all finite; none panics or aborts on an allocation. The errors carry the numbers that
 //! explain them.
 
+use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
 use nonsmooth_modes::continuation::linspace;
 use nonsmooth_modes::error::OverBudget;
 use nonsmooth_modes::fourier::{check_memory, Basis, CosineBasis, MEMORY_BUDGET_BYTES};
-use nonsmooth_modes::modal::diagnostics::MIN_FREQUENCY;
-use nonsmooth_modes::modal::{
-    backbone, branch_seed, diagnose, grazing_energy, law_history, BackboneOptions, PeriodGrid,
-};
+use nonsmooth_modes::modal::MIN_FREQUENCY;
+use nonsmooth_modes::modal::{branch_seed, diagnose, grazing_energy, law_history};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
@@ -736,8 +735,8 @@ fn overflowing_motions_are_typed_errors() {
 /// `tests/stress/`).
 #[test]
 fn overflowing_steps_and_missing_grazing_energy_are_typed_errors() {
+    use nonsmooth_modes::branches::{parameter_branch, ParameterSteps};
     use nonsmooth_modes::continuation::{Sequential, SequentialOptions};
-    use nonsmooth_modes::modal::{parameter_branch, ParameterSteps};
     let problem = NonsmoothSystem::new(&clamped(), settings()).unwrap();
     let start = motion();
     match Sequential::new(
@@ -777,7 +776,7 @@ fn overflowing_steps_and_missing_grazing_energy_are_typed_errors() {
 /// limit; at the limit a motion's numbers are finite.
 #[test]
 fn huge_frequencies_are_rejected_with_the_problem_limit() {
-    use nonsmooth_modes::modal::{arclength_backbone, ArclengthBackboneOptions};
+    use nonsmooth_modes::branches::{arclength_backbone, ArclengthBackboneOptions};
     use nonsmooth_modes::system::MAX_PHASE;
     let system = clamped();
     let mut problem = NonsmoothSystem::new(&system, settings()).unwrap();

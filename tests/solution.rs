@@ -2,9 +2,8 @@
 //! exact first mode where one is known, and bad requests are typed errors.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::{
-    backbone, energy, grazing_energy, BackboneOptions, BackbonePoint, PeriodGrid,
-};
+use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::modal::{energy, grazing_energy};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };

@@ -2,13 +2,14 @@
 //! point of it is block diagonal), and a point of the `K`-fold repeated branch can be left
 //! along the complement block's most singular direction.
 
+use nonsmooth_modes::branches::{
+    genuine_subharmonic_backbone, linear_period, symmetry_breaking_direction, BackboneOptions,
+    PeriodGrid, PointStatus, GENUINE_SHARE,
+};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::Basis;
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::modal::{
-    branch_seed, genuine_subharmonic_backbone, linear_period, subharmonic_share,
-    symmetry_breaking_direction, BackboneOptions, PeriodGrid, PointStatus, GENUINE_SHARE,
-};
+use nonsmooth_modes::modal::{branch_seed, subharmonic_share};
 use nonsmooth_modes::reference::robin_bar_with_obstacle;
 use nonsmooth_modes::solve::{Problem, SemismoothNewton};
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
@@ -101,7 +102,7 @@ fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
         genuine_subharmonic_backbone(&system, settings(30), &options, SemismoothNewton::default())
             .unwrap()
             .points;
-    let share = |p: &nonsmooth_modes::modal::BackbonePoint| {
+    let share = |p: &nonsmooth_modes::branches::BackbonePoint| {
         subharmonic_share(&system, problem.basis(), &p.x, p.omega, K).unwrap()
     };
     let genuine: Vec<_> = points
@@ -131,8 +132,8 @@ fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
 /// never reaches leaves the run as it is without a switch; a bad request is refused.
 #[test]
 fn switching_at_a_branch_point_of_the_repeated_branch_leaves_the_subspace() {
+    use nonsmooth_modes::branches::{arclength_backbone, ArclengthBackboneOptions, SwitchAt};
     use nonsmooth_modes::continuation::{EndReason, Event};
-    use nonsmooth_modes::modal::{arclength_backbone, ArclengthBackboneOptions, SwitchAt};
     use nonsmooth_modes::{ContinuationError, Error};
     let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
     let run = |switch| {
@@ -155,7 +156,7 @@ fn switching_at_a_branch_point_of_the_repeated_branch_leaves_the_subspace() {
     };
     let problem = NonsmoothSystem::new(&system, settings(40)).unwrap();
     let basis = problem.basis().clone();
-    let share = |p: &nonsmooth_modes::modal::BackbonePoint| {
+    let share = |p: &nonsmooth_modes::branches::BackbonePoint| {
         subharmonic_share(&system, &basis, &p.x, p.omega, K).unwrap()
     };
     let (points, branch) = run(Some(SwitchAt {

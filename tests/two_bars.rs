@@ -2,7 +2,7 @@
 //! degenerate harmonics of formulation §5.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
 use nonsmooth_modes::solve::SemismoothNewton;
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};

@@ -5,7 +5,7 @@
 //! commensurate grid the check gives the numbers it gave before.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::{backbone_with, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{backbone_with, BackboneOptions, PeriodGrid};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
@@ -338,7 +338,7 @@ fn harmonic_balance_point_with_incommensurate_bars_is_checked() {
             },
             ..Default::default()
         };
-        let points = nonsmooth_modes::modal::backbone(
+        let points = nonsmooth_modes::branches::backbone(
             &system,
             settings,
             &options,

@@ -2,7 +2,8 @@
 //! solution) and the paper's two-bar check (its Fig. 16).
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::{backbone, energy, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::modal::energy;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };

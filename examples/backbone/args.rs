@@ -2,8 +2,8 @@
 //! example's limits and the usage text.
 
 use crate::systems::{load_assembly, SystemKind};
+use nonsmooth_modes::branches::{BackboneOptions, SwitchAt};
 use nonsmooth_modes::continuation::{ArclengthOptions, Selection};
-use nonsmooth_modes::modal::{BackboneOptions, SwitchAt};
 use nonsmooth_modes::system::HarmonicBalanceSettings;
 
 pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]

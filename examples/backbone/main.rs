@@ -37,7 +37,7 @@
 //!
 //! Columns: `step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,
 //! status,residual_norm,iterations,step_size,event,parameter` (`status` is `converged`,
-//! `solver-failed` or `collapsed-to-rest`: `modal::PointStatus`; every step computed is
+//! `solver-failed` or `collapsed-to-rest`: `branches::PointStatus`; every step computed is
 //! written, also when the run then stalls and exits with code 1; `exact_energy_normalized` is the exact
 //! first mode of the clamped bar, formulation §9, when the system is the clamped bar —
 //! `--system ds` or a file with the same bars and conditions — with `--mode 1 --subharmonic 1`,
@@ -61,20 +61,20 @@
 //! mode of period `T/K` traced `K` times, a subspace Newton's method never leaves; the run
 //! follows it until a point can be left along the most singular direction off the multiples
 //! of `K`, then continues on that genuinely `T`-periodic branch
-//! (`modal::genuine_subharmonic_backbone_with`). `--repeated` keeps the repeated branch.
+//! (`branches::genuine_subharmonic_backbone_with`). `--repeated` keeps the repeated branch.
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
 //! escape from internal-resonance stalls, walking it back first where its start is found only
 //! above the first period's frequency. Without `--method` a run in the period is sequential,
 //! except for an assembly file whose branch cannot be entered at the first period
-//! (`modal::backbone_start`, `BackboneStart::moved_from`; the three-bar chain), which is
+//! (`branches::backbone_start`, `BackboneStart::moved_from`; the three-bar chain), which is
 //! followed by arclength, as stderr says; its `event` column marks folds, jumps, grazing and
 //! branch points (`branch-point`: the sign of the bordered Jacobian's determinant changed),
 //! and `--switch-at N[:SIDE]` leaves the branch at its `N`-th branch point for the branch
 //! crossing there, on side `SIDE` (`1`, the default, or `-1`) of its direction
 //! (`ArclengthBackboneOptions::switch`). `--parameter energy` continues the branch in the
-//! energy level `E/E_g` with the frequency an unknown (`modal::energy_backbone`; levels from
+//! energy level `E/E_g` with the frequency an unknown (`branches::energy_backbone`; levels from
 //! `--energy-range LO:HI`, default from mode `i`'s grazing energy to 300 times it, in `--steps`
 //! geometric levels; sequential only); the points where it walks an internal resonance in the
 //! period are rows too (`docs/assemblies.md`). `--parameter gap|robin-stiffness|stiffness-ratio`

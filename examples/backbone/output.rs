@@ -3,8 +3,9 @@
 //! place.
 
 use crate::args::MAX_VERIFY_STEPS;
+use nonsmooth_modes::branches::{BackbonePoint, PointStatus};
 use nonsmooth_modes::continuation::Event;
-use nonsmooth_modes::modal::{contact_intervals, subharmonic_share, BackbonePoint, PointStatus};
+use nonsmooth_modes::modal::{contact_intervals, subharmonic_share};
 use nonsmooth_modes::reference::ClampedFirstMode;
 use nonsmooth_modes::system::NonsmoothSystem;
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};

@@ -3,13 +3,13 @@
 use crate::args::{Args, Parameter};
 use crate::output::{header, Sink};
 use crate::systems::{build_system, clamped_gap, default_periods, parameter_value, SystemKind};
-use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
-use nonsmooth_modes::modal::{
+use nonsmooth_modes::branches::{
     arclength_backbone, backbone, backbone_from, backbone_speculative_with, backbone_start,
     backbone_with, energy_backbone_with, genuine_subharmonic_backbone_with, parameter_branch,
     ArclengthBackboneOptions, BackboneOptions, BackbonePoint, BackboneStart, EnergyBackboneOptions,
     EnergyGrid, ParameterSteps, PeriodGrid,
 };
+use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::NonsmoothSystem;
 // A plain enum of the crate's solvers: it can be cloned onto the thread of speculative retries.
@@ -139,7 +139,7 @@ fn solver_for(a: &Args, arclength: bool) -> Result<Solver, Box<dyn std::error::E
 
 /// The method of a backbone in the period when `--method` is not given: sequential, except
 /// for an assembly file whose branch cannot be entered at the grid's first period `t0`
-/// (`modal::backbone_start` gets back to a higher frequency only, as on the three-bar chain,
+/// (`branches::backbone_start` gets back to a higher frequency only, as on the three-bar chain,
 /// whose floating bar must be pushed hard enough to shuttle within a period). A period grid
 /// from `t0` would start off its branch; pseudo-arclength walks the branch back to `t0` and
 /// follows it through its folds. The shorthands (`--system`) have no floating bar and are

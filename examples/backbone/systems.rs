@@ -3,7 +3,7 @@
 
 use crate::args::{Args, Parameter};
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::modal::PeriodGrid;
+use nonsmooth_modes::branches::PeriodGrid;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
 };

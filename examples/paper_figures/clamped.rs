@@ -6,8 +6,9 @@ use crate::common::{
     omega_1, point_map, reference_line, series, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use crate::runs::{arclength_run, pick, run, Branch, Exact, Run};
+use nonsmooth_modes::branches::BackbonePoint;
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{harmonic_energies, BackbonePoint};
+use nonsmooth_modes::modal::harmonic_energies;
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::system::BarSystem;

@@ -4,11 +4,12 @@
 
 use crate::runs::Run;
 use crate::summary::Item;
+use nonsmooth_modes::branches::BackbonePoint;
 use nonsmooth_modes::continuation::Event;
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
 use nonsmooth_modes::modal::diagnostics::EndHistory;
-use nonsmooth_modes::modal::{displacement_grid, end_history, grazing_energy, BackbonePoint};
+use nonsmooth_modes::modal::{displacement_grid, end_history, grazing_energy};
 use nonsmooth_modes::plot::{
     render_svg, space_time_panel, Figure, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
     SpaceTimeField, PALETTE,

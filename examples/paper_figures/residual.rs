@@ -6,8 +6,9 @@ use crate::common::{
     over_gap, reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED,
 };
 use crate::runs::{run, solved_point, Branch, Run};
+use nonsmooth_modes::branches::{convergence_study, BackbonePoint, PeriodGrid};
 use nonsmooth_modes::continuation::ContinuationProblem;
-use nonsmooth_modes::modal::{convergence_study, diagnose, law_history, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::modal::{diagnose, law_history};
 use nonsmooth_modes::plot::{
     histories_panel, Figure, LegendPosition, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
 };

@@ -6,11 +6,9 @@ use crate::common::{
     settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use crate::runs::{arclength_run, pick, run, Branch, Run};
+use nonsmooth_modes::branches::{symmetry_breaking_direction, BackbonePoint, GENUINE_SHARE};
 use nonsmooth_modes::continuation::ContinuationProblem;
-use nonsmooth_modes::modal::{
-    energy, grazing_energy, law_history, subharmonic_share, symmetry_breaking_direction,
-    BackbonePoint, GENUINE_SHARE,
-};
+use nonsmooth_modes::modal::{energy, grazing_energy, law_history, subharmonic_share};
 use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
 use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
@@ -228,7 +226,7 @@ fn contacts_and_grazings(
 }
 
 /// Nudges along the symmetry-breaking direction, in units of the largest unknown:
-/// `modal::NUDGES` and a full step either way, which point g needs.
+/// `branches::NUDGES` and a full step either way, which point g needs.
 const WIDE_NUDGES: [f64; 6] = [0.1, -0.1, 0.5, -0.5, 1.0, -1.0];
 
 /// A motion with one contact and two grazings per period reached by leaving the repeated branch

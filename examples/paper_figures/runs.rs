@@ -3,13 +3,14 @@
 //! choice of points on a run.
 
 use crate::common::{settings, Ctx, Res, GAP};
+use nonsmooth_modes::branches::{
+    arclength_backbone, backbone, energy_backbone, genuine_subharmonic_backbone,
+    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
+    PeriodGrid, PointStatus, StallEscape,
+};
 use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{
-    arclength_backbone, backbone, energy, energy_backbone, genuine_subharmonic_backbone,
-    grazing_energy, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
-    EnergyBackboneOptions, EnergyGrid, PeriodGrid, PointStatus, StallEscape,
-};
+use nonsmooth_modes::modal::{energy, grazing_energy};
 use nonsmooth_modes::reference::ClampedFamily;
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, SolveInfo};
 use nonsmooth_modes::system::BarSystem;

@@ -8,9 +8,10 @@ use crate::common::{
     right_end, series, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use crate::runs::{arclength_run, energy_run, pick, run, solved_point, Branch, Run};
+use nonsmooth_modes::branches::BackbonePoint;
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{branch_seed, harmonic_energies_by_bar, law_history, BackbonePoint};
+use nonsmooth_modes::modal::{branch_seed, harmonic_energies_by_bar, law_history};
 use nonsmooth_modes::plot::{
     backbone_panel, snapshots_panel, Figure, LegendPosition, LinePanel, Marker, Panel, PlacedBar,
     Placement, Rgb, Series, SpaceTimeField, PALETTE,

@@ -108,7 +108,7 @@ pub enum EndReason {
     StoppedByObserver,
     /// The branch is lost: too many consecutive failed steps (natural-parameter runs), or
     /// every attempt to leave a stall failed (a strategy on top of a driver, such as the
-    /// backbone's [`StallEscape`](crate::modal::StallEscape)).
+    /// backbone's [`StallEscape`](crate::branches::StallEscape)).
     Stalled {
         /// Consecutive failures, or attempts.
         failures: usize,

@@ -172,7 +172,7 @@ pub enum Event {
     },
     /// The branch jumped: the corrected point is far from its prediction even at the
     /// smallest step, or a strategy on top of the driver moved it to a solution found at
-    /// fixed parameter (the backbone's [`StallEscape`](crate::modal::StallEscape)).
+    /// fixed parameter (the backbone's [`StallEscape`](crate::branches::StallEscape)).
     Jump {
         /// Distance to the prediction (or to the point jumped from) over the step size.
         ratio: f64,

@@ -40,7 +40,7 @@ pub enum Selection {
     /// point leads back to the backbone; with the energy as measure the start that reaches
     /// the lowest energy is the one still on the backbone. The cost: every step solves from
     /// all its starts, about `retry_depth` extra solves per step (see
-    /// [`BackboneOptions::selection`](crate::modal::BackboneOptions::selection) for the
+    /// [`BackboneOptions::selection`](crate::branches::BackboneOptions::selection) for the
     /// measured trade-off on the clamped bar). Without a measure it is
     /// [`Selection::FirstConverged`].
     LowestMeasure,

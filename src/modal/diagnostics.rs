@@ -6,111 +6,14 @@
 //! instants too.
 
 use crate::bar::{End, EndRef};
-use crate::error::{Error, SettingsError};
+use crate::error::SettingsError;
 use crate::fourier::{check_memory, Basis};
-use crate::modal::backbone::{backbone, BackboneOptions, PeriodGrid};
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
-use crate::modal::point::BackbonePoint;
-use crate::solve::NonlinearSolver;
+use crate::modal::inputs::{check_finite, check_motion};
 use crate::system::rows::{dot, HarmonicRows};
-use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
+use crate::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
-
-/// The smallest fundamental frequency `Omega` accepted by the post-processing (about
-/// `3.5e-308`): `2 pi / f64::MAX`, rounded up so that the period `2 pi / Omega` is finite.
-/// It is a normal `f64`, so every frequency at or above it is too (a subnormal one has lost
-/// precision).
-pub const MIN_FREQUENCY: f64 = 2.0 * PI / f64::MAX * (1.0 + 4.0 * f64::EPSILON);
-
-/// Checks a fundamental frequency: positive and finite ([`SettingsError::NotPositive`]) and
-/// at least [`MIN_FREQUENCY`] ([`SettingsError::FrequencyTooSmall`]).
-pub(crate) fn check_frequency(omega: f64) -> Result<f64, SettingsError> {
-    let what = "fundamental frequency";
-    if !(omega.is_finite() && omega > 0.0) {
-        Err(SettingsError::NotPositive { what, value: omega })
-    } else if omega < MIN_FREQUENCY {
-        Err(SettingsError::FrequencyTooSmall {
-            what,
-            omega,
-            min: MIN_FREQUENCY,
-        })
-    } else {
-        Ok(omega)
-    }
-}
-
-/// Checks a fundamental frequency of `problem`: [`check_frequency`], and at most
-/// [`Discretization::max_frequency`](crate::system::Discretization::max_frequency)
-/// ([`SettingsError::FrequencyTooLarge`]).
-pub(crate) fn check_frequency_of<B: Basis>(
-    problem: &NonsmoothSystem<B>,
-    omega: f64,
-) -> Result<f64, SettingsError> {
-    check_frequency(omega)?;
-    let max = problem.description().max_frequency();
-    if omega > max {
-        Err(SettingsError::FrequencyTooLarge {
-            what: "fundamental frequency",
-            omega,
-            max,
-        })
-    } else {
-        Ok(omega)
-    }
-}
-
-/// Checks a motion `x` of `problem` at `omega`: the length of `x`
-/// ([`SettingsError::Length`]), the frequency ([`check_frequency_of`]) and finite unknowns
-/// ([`SettingsError::NotPositive`] naming "unknowns (finite)").
-pub(crate) fn check_motion<B: Basis>(
-    problem: &NonsmoothSystem<B>,
-    x: &[f64],
-    omega: f64,
-) -> Result<(), SettingsError> {
-    check_length(x, problem.dimension())?;
-    check_frequency_of(problem, omega)?;
-    check_unknowns_finite(x)
-}
-
-/// Checks that the unknowns `x` have length `expected` ([`SettingsError::Length`]).
-pub(crate) fn check_length(x: &[f64], expected: usize) -> Result<(), SettingsError> {
-    if x.len() == expected {
-        Ok(())
-    } else {
-        Err(SettingsError::Length {
-            what: "unknowns",
-            got: x.len(),
-            expected,
-        })
-    }
-}
-
-/// Checks that the unknowns `x` are finite ([`SettingsError::NotPositive`] naming
-/// "unknowns (finite)").
-pub(crate) fn check_unknowns_finite(x: &[f64]) -> Result<(), SettingsError> {
-    match x.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(SettingsError::NotPositive {
-            what: "unknowns (finite)",
-            value: *v,
-        }),
-        None => Ok(()),
-    }
-}
-
-/// Checks that every value of `values` is finite: [`SettingsError::NonFiniteResult`]
-/// naming `what` otherwise.
-pub(crate) fn check_finite<'v>(
-    what: &'static str,
-    omega: f64,
-    values: impl IntoIterator<Item = &'v f64>,
-) -> Result<(), SettingsError> {
-    if values.into_iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(SettingsError::NonFiniteResult { what, omega })
-    }
-}
 
 /// Time histories of one end over a period.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -356,7 +259,7 @@ pub struct LawHistory {
 /// [`SettingsError::IndexOutOfRange`] if `law` is out of range; [`SettingsError::Length`] if
 /// `x` has the wrong length;
 /// [`SettingsError::NotPositive`] or [`SettingsError::FrequencyTooSmall`] for an `omega`
-/// that is not positive and finite or below [`MIN_FREQUENCY`], and `NotPositive` for
+/// that is not positive and finite or below [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY), and `NotPositive` for
 /// unknowns that are not finite; [`SettingsError::TooLarge`] if the `4 samples` values of
 /// the histories do not fit in the memory budget
 /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)), and
@@ -507,57 +410,4 @@ pub fn diagnose<B: Basis>(
         min_contact_force,
         energy_drift,
     })
-}
-
-/// One entry of a convergence study.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct ConvergenceEntry {
-    /// Number of harmonics.
-    pub harmonics: usize,
-    /// The last converged point of the run at this `m` (None if none converged).
-    pub point: Option<BackbonePoint>,
-    /// Its diagnostics.
-    pub diagnostics: Option<PointDiagnostics>,
-}
-
-/// The same point recomputed for each `m` in `harmonics`: a sequential backbone over `grid`
-/// (whose last period is the point of interest) for each `m`, keeping the last converged point
-/// and its diagnostics (refinement 8).
-///
-/// # Errors
-/// Invalid settings or options (the first `m` that fails to set up).
-pub fn convergence_study<S: NonlinearSolver + Clone>(
-    system: &BarSystem,
-    base: HarmonicBalanceSettings,
-    grid: PeriodGrid,
-    harmonics: &[usize],
-    solver: S,
-) -> Result<Vec<ConvergenceEntry>, Error> {
-    let mut out = Vec::new();
-    for &m in harmonics {
-        let settings = HarmonicBalanceSettings {
-            harmonics: m,
-            ..base
-        };
-        let options = BackboneOptions {
-            grid,
-            ..Default::default()
-        };
-        let points = backbone(system, settings, &options, solver.clone())?;
-        let point = points.into_iter().rev().find(|p| p.converged);
-        let diagnostics = match &point {
-            Some(p) => {
-                let problem = NonsmoothSystem::new(system, settings)?;
-                Some(diagnose(&problem, &p.x, p.omega, 8)?)
-            }
-            None => None,
-        };
-        out.push(ConvergenceEntry {
-            harmonics: m,
-            point,
-            diagnostics,
-        });
-    }
-    Ok(out)
 }

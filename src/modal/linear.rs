@@ -10,8 +10,8 @@
 use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
-use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::{energy_of, Conditions};
+use crate::modal::inputs::check_frequency_of;
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, NonsmoothSystem};
 

@@ -102,7 +102,7 @@ impl NewtonOptions {
     /// evaluations ([`NewtonOptions::max_evaluations`]); the default settings spend most of a
     /// backbone's time proving it (`docs/performance.md` compares the two on the clamped
     /// bar's backbone: about the same converged steps in much less time). Not for far starts
-    /// (a seed, the jumps of [`crate::modal::StallEscape`]): those can need a slow
+    /// (a seed, the jumps of [`crate::branches::StallEscape`]): those can need a slow
     /// first phase before converging.
     pub fn fail_fast() -> Self {
         Self {

@@ -17,7 +17,7 @@
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, ModelError};
 use crate::linalg::DenseMatrix;
-use crate::modal::diagnostics::check_frequency_of;
+use crate::modal::inputs::check_frequency_of;
 use crate::solve::{Problem, Structured};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
@@ -62,7 +62,7 @@ impl<F: SystemFamily> ParameterFamily<F> {
     ///
     /// # Errors
     /// An `omega` that is not positive and finite or is below
-    /// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY), invalid settings, or a
+    /// [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY), invalid settings, or a
     /// family that fails at the probe value.
     pub fn new(family: F, settings: HarmonicBalanceSettings, omega: f64) -> Result<Self, Error> {
         Self::at(family, settings, omega, 1.0)

@@ -232,7 +232,7 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
 /// Unsupported conditions, a time step longer than a bar's travel time
 /// ([`VerifyError::NonMatchingGrid`]), a solution vector of the wrong length or with NaN, an
 /// `omega` that is not positive and finite or is below
-/// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY) ([`VerifyError`]);
+/// [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY) ([`VerifyError`]);
 /// [`VerifyError::TooLarge`] if the cells of the grid or the histories of the
 /// `periods 2 pi / (omega dt)` steps do not fit in the memory budget
 /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)); [`VerifyError::TooCostly`]

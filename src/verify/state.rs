@@ -5,7 +5,7 @@ use super::wave::{distance_squared, Resolution, Wave};
 use super::{Condition, Grid, Model, VerifyError};
 use crate::bar::{End, EndRef};
 use crate::fourier::Basis;
-use crate::modal::diagnostics::check_frequency;
+use crate::modal::inputs::check_frequency;
 use crate::modal::FieldEvaluator;
 use crate::system::BarSystem;
 
@@ -203,7 +203,7 @@ impl State {
     /// # Errors
     /// [`VerifyError::Length`] if `x` does not match the basis and system,
     /// [`VerifyError::InvalidParameter`] for a bad `theta` or an `omega` that is not positive
-    /// and finite or is below [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY)
+    /// and finite or is below [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY)
     /// (subnormal, or with an infinite period), and the errors of
     /// [`Model::from_system`] and [`State::from_cells`].
     pub fn from_harmonic_balance<B: Basis>(

@@ -4,8 +4,8 @@
 //! than the budget counted, a file read back with other numbers than were written); and which
 //! inputs are moderate enough for the plain-number evaluators to be checked.
 
+use nonsmooth_modes::branches::{BackbonePoint, PointStatus};
 use nonsmooth_modes::continuation::{Branch, EndReason, Event, Point};
-use nonsmooth_modes::modal::{BackbonePoint, PointStatus};
 use nonsmooth_modes::solve::SolveInfo;
 use nonsmooth_modes::system::BarSystem;
 

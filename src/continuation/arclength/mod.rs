@@ -17,7 +17,7 @@
 //! points, when the step falls below `ds_min`, or after more than `max_rejections` rejected
 //! steps ([`EndReason`]). The driver follows the branch wherever it goes; strategies that
 //! leave it (a jump past a stall of a harmonic-balance backbone,
-//! [`StallEscape`](crate::modal::StallEscape)) are written on top of its public methods: a
+//! [`StallEscape`](crate::branches::StallEscape)) are written on top of its public methods: a
 //! fixed-parameter solve ([`Arclength::solve_at`]) and a restart from the solution found
 //! ([`Arclength::restart_from`]), which keeps the driver's scale, counters and acceptance test.
 //!

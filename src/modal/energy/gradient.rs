@@ -1,6 +1,6 @@
 //! Derivatives of the energy of [`super::energy`]: the gradient in the unknowns, in closed
 //! form, and the derivative in the frequency. They are the border row of the energy-level
-//! problem ([`crate::modal::EnergyLevel`]), which fixes `E(x; Omega)` and solves for
+//! problem ([`crate::branches::EnergyLevel`]), which fixes `E(x; Omega)` and solves for
 //! `(x, Omega)`.
 //!
 //! For one bar the strain part of the energy is `EA/2 sum_ij w_i w_j int u_i' u_j' dx`, a

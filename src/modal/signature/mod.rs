@@ -9,10 +9,10 @@
 use crate::bc::LawSamples;
 use crate::error::SettingsError;
 use crate::fourier::Basis;
-use crate::modal::diagnostics::{
+use crate::modal::energy::Diagonal;
+use crate::modal::inputs::{
     check_finite, check_frequency, check_length, check_motion, check_unknowns_finite,
 };
-use crate::modal::energy::Diagonal;
 use crate::system::{BarSystem, Layout, NonsmoothSystem};
 
 /// The time-averaged mechanical energy of the bars carried by each harmonic `n = 0..=m` of
@@ -59,7 +59,7 @@ use crate::system::{BarSystem, Layout, NonsmoothSystem};
 /// [`SettingsError::Length`] if `x` is not `basis.len()` times the system's unknowns per
 /// harmonic; [`SettingsError::NotPositive`] or [`SettingsError::FrequencyTooSmall`] for an
 /// `omega` that is not positive and finite or below
-/// [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY), and `NotPositive` for
+/// [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY), and `NotPositive` for
 /// unknowns that are not finite; [`SettingsError::NonFiniteResult`] if an energy overflows.
 pub fn harmonic_energies<B: Basis>(
     system: &BarSystem,

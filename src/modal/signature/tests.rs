@@ -1,9 +1,9 @@
 use super::*;
 use crate::bar::Bar;
+use crate::branches::{backbone, BackboneOptions, PeriodGrid};
 use crate::continuation::ContinuationProblem;
 use crate::fourier::CosineBasis;
 use crate::modal::energy::energy_at;
-use crate::modal::{backbone, BackboneOptions, PeriodGrid};
 use crate::reference::{clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode};
 use crate::solve::{SemismoothNewton, Structured};
 use crate::system::HarmonicBalanceSettings;

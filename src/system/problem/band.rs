@@ -23,56 +23,6 @@ use super::state::{Frequency, Samples};
 use crate::fourier::Basis;
 use crate::linalg::{Staircase, StaircaseLu};
 use crate::solve::{SingularStep, PIVOT_TOLERANCE};
-use crate::system::rows::HarmonicRows;
-
-/// The blocks (bars) whose unknowns `row` involves at some harmonic, `(first, last)`, given
-/// the row of each harmonic: `None` if it involves none.
-fn bar_span(
-    rows: &[HarmonicRows],
-    row: impl Fn(&HarmonicRows) -> &[f64],
-) -> Option<(usize, usize)> {
-    let mut span: Option<(usize, usize)> = None;
-    for r in rows {
-        let pairs = row(r).chunks_exact(2).enumerate();
-        for (bar, _) in pairs.filter(|(_, p)| p[0] != 0.0 || p[1] != 0.0) {
-            span = Some(span.map_or((bar, bar), |(f, l)| (f.min(bar), l.max(bar))));
-        }
-    }
-    span
-}
-
-/// The staircase shape of the Jacobian of `d` with the rows `rows` of one frequency, unknowns
-/// bar by bar, if the system has two contacts or more and every row involves some bar;
-/// `None` otherwise.
-pub(super) fn staircase_of<B: Basis>(
-    d: &Discretization<B>,
-    rows: &[HarmonicRows],
-) -> Option<Staircase> {
-    let (len, rpc, laws) = (d.basis().len(), d.linear_count, d.laws);
-    if laws < 2 {
-        return None;
-    }
-    let linear = (0..rpc)
-        .map(|r| bar_span(rows, |h| h.linear_row(r)))
-        .collect::<Option<Vec<_>>>()?;
-    let law = (0..laws)
-        .map(|l| {
-            let gap = bar_span(rows, |h| h.gap_row(l));
-            let force = bar_span(rows, |h| h.force_row(l));
-            match (gap, force) {
-                (Some((f, l)), Some((g, m))) => Some((f.min(g), l.max(m))),
-                (one, other) => one.or(other),
-            }
-        })
-        .collect::<Option<Vec<_>>>()?;
-    // Rows in the residual's order: linear rows coefficient by coefficient, then each law's
-    // projections.
-    let spans: Vec<_> = (0..len)
-        .flat_map(|_| linear.iter().copied())
-        .chain(law.iter().flat_map(|&s| std::iter::repeat_n(s, len)))
-        .collect();
-    Staircase::new(2 * len, d.unknowns / 2, &spans)
-}
 
 /// Whether the staircase LU of shape `shape` takes fewer multiply-adds than the condensed LU
 /// of `d`, `(len n_contacts)^3 / 3`. The staircase's windows are smaller matrices, on which
@@ -96,7 +46,8 @@ pub(super) struct Banded {
 impl Banded {
     /// Solves `J(x) z = r` in place for the `columns` right-hand sides stored one after the
     /// other in `rhs`, at the frequency of `at` and with the law samples of `samples` (those
-    /// of `x`). `None` where the Jacobian is not a staircase ([`staircase_of`]) or its LU
+    /// of `x`). `None` where the Jacobian is not a staircase
+    /// ([`staircase_of`](super::staircase::staircase_of)) or its LU
     /// costs more than the condensed one.
     pub(super) fn solve<B: Basis>(
         &mut self,
@@ -187,9 +138,10 @@ fn fill_row<B: Basis>(
 mod tests {
     use super::super::{HarmonicBalanceSettings, NonsmoothSystem};
     use super::*;
+    use crate::branches::PeriodGrid;
     use crate::continuation::ContinuationProblem;
     use crate::linalg::{DenseMatrix, Lu};
-    use crate::modal::{branch_seed, PeriodGrid};
+    use crate::modal::branch_seed;
     use crate::reference::contact_chain;
     use crate::solve::{Problem, Structured};
 

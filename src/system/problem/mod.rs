@@ -28,6 +28,7 @@
 
 mod band;
 mod discretization;
+mod staircase;
 mod state;
 mod step;
 

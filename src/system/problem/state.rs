@@ -29,8 +29,8 @@
 //! Newton iteration (about 8 % of the instructions of a backbone at 20 harmonics) and would
 //! move converged points near internal resonances, where the solution is barely isolated.
 
-use super::band::staircase_of;
 use super::discretization::Discretization;
+use super::staircase::staircase_of;
 use crate::bc::LawSamples;
 use crate::fourier::Basis;
 use crate::linalg::Staircase;

@@ -9,19 +9,19 @@ use super::{reference_system, settings, MAX_HARMONICS};
 use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::continuation::{EndReason, Rejection, SequentialOptions, Speculation};
-use nonsmooth_modes::modal::{
+use nonsmooth_modes::branches::{
     arclength_backbone_observed, backbone, backbone_speculative_with, backbone_with,
     parameter_branch, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint,
     ParameterSteps, PeriodGrid, PointStatus, SwitchAt,
 };
+use nonsmooth_modes::continuation::{EndReason, Rejection, SequentialOptions, Speculation};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
-/// `modal::backbone`, `backbone_with` (an observer that may stop it) and
+/// `branches::backbone`, `backbone_with` (an observer that may stop it) and
 /// `backbone_speculative_with`, with any grid, mode, options and solver.
 pub(crate) fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let system = reference_system(d, c)?;
@@ -99,7 +99,7 @@ impl BackboneObserver for &mut BackboneWatcher {
     }
 }
 
-/// `modal::arclength_backbone_observed` with any options, escape and observer.
+/// `branches::arclength_backbone_observed` with any options, escape and observer.
 pub(crate) fn arclength_backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let system = reference_system(d, c)?;
     let s = settings(d);
@@ -180,7 +180,7 @@ fn parameter_value(d: &mut Draw, name: &str, valid: std::ops::RangeInclusive<f64
     }
 }
 
-/// `modal::parameter_branch` in the gap or the bar length of the clamped bar, over values or
+/// `branches::parameter_branch` in the gap or the bar length of the clamped bar, over values or
 /// by arclength, up to the extremes of what `Bar::new` and the conditions accept.
 pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let gap = d.real("gap", 1e-4..=0.1);

@@ -5,12 +5,13 @@ use super::solvers::solver;
 use super::valid_problem;
 use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
+use nonsmooth_modes::branches::{EscapingArclength, StallEscape};
 use nonsmooth_modes::continuation::{
     linspace, Arclength, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem,
     PeriodParametrised, Point, Predictor, Selection, Sequential, SequentialOptions, Speculation,
     Speculative, Step, TangentPredictor,
 };
-use nonsmooth_modes::modal::{branch_seed, EscapingArclength, StallEscape};
+use nonsmooth_modes::modal::branch_seed;
 use nonsmooth_modes::solve::NonlinearSolver;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;

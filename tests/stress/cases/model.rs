@@ -6,9 +6,9 @@ use crate::checks::{moderate_motion, typed, CaseResult, Checks};
 use crate::draw::Draw;
 use nonsmooth_modes::bar::{Bar, BarId, EndRef};
 use nonsmooth_modes::bc::{BoundaryCondition, LinearRows, Quantity, Term};
+use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
 use nonsmooth_modes::modal::{
-    backbone, branch_seed, energy, grazing_energy, natural_frequencies, BackboneOptions,
-    ContactState, PeriodGrid,
+    branch_seed, energy, grazing_energy, natural_frequencies, ContactState,
 };
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
 use nonsmooth_modes::system::{

@@ -1,13 +1,13 @@
 //! What makes a motion a point of an energy backbone, and the solves at fixed frequency
 //! that start a branch and jump its internal resonances.
 
+use crate::branches::point::{BackbonePoint, PointStatus};
+use crate::branches::start::{first_solution, StartGuesses, Tally, RIGID_AMPLITUDES};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
-use crate::modal::point::{BackbonePoint, PointStatus};
 use crate::modal::signature::harmonic_energies;
-use crate::modal::start::{first_solution, StartGuesses, Tally, RIGID_AMPLITUDES};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::f64::consts::PI;

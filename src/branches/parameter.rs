@@ -6,14 +6,14 @@
 //! range. Every point reaches the observer as a [`BackbonePoint`] at the fixed frequency, its
 //! energy normalised by the grazing energy of the system at that parameter value.
 
+use crate::branches::point::{BackbonePoint, PointStatus};
+use crate::branches::BackboneOptions;
 use crate::continuation::{
     Arclength, ArclengthOptions, Branch, Point, Sequential, SequentialOptions, Step,
 };
 use crate::error::{ContinuationError, Error};
 use crate::modal::energy::energy;
 use crate::modal::linear::grazing_energy;
-use crate::modal::point::{BackbonePoint, PointStatus};
-use crate::modal::BackboneOptions;
 use crate::solve::NonlinearSolver;
 use crate::system::{HarmonicBalanceSettings, ParameterFamily, SystemFamily};
 use std::ops::ControlFlow;
@@ -44,7 +44,7 @@ pub enum ParameterSteps {
 /// [`SettingsError::GrazingEnergyOutOfRange`](crate::SettingsError::GrazingEnergyOutOfRange),
 /// gives `energy_normalized = NaN`), or one whose motion's energy leaves the range of `f64`
 /// (a bar length near `f64::MAX`). A converged point below the backbones' trivial-energy floor
-/// ([`BackboneOptions::trivial_energy`](crate::modal::BackboneOptions::trivial_energy) times
+/// ([`BackboneOptions::trivial_energy`](crate::branches::BackboneOptions::trivial_energy) times
 /// `E_g` at its parameter) is the state of rest, not a point of the branch: it reaches the
 /// observer as [`PointStatus::CollapsedToRest`] with `converged == false`.
 ///

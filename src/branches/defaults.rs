@@ -10,10 +10,10 @@
 //! 6 significant digits so that a linear period computed to `1e-13` lands on its decimal value
 //! (`4.000000000000001 -> 4`) and the clamped bar gets the paper's grid exactly.
 
+use crate::branches::backbone::{ArclengthBackboneOptions, BackboneOptions, PeriodGrid};
+use crate::branches::start::StartGuesses;
 use crate::error::SettingsError;
-use crate::modal::backbone::{ArclengthBackboneOptions, BackboneOptions, PeriodGrid};
 use crate::modal::linear::open_mode;
-use crate::modal::start::StartGuesses;
 use crate::system::BarSystem;
 use std::f64::consts::PI;
 

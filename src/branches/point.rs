@@ -105,7 +105,7 @@ pub enum PointStatus {
     /// The solver failed; the point holds its last iterate.
     SolverFailed(SolveError),
     /// The solver converged to a motion whose energy is below the backbone's trivial-energy
-    /// floor ([`BackboneOptions::trivial_energy`](crate::modal::BackboneOptions::trivial_energy)
+    /// floor ([`BackboneOptions::trivial_energy`](crate::branches::BackboneOptions::trivial_energy)
     /// times `E_g`): the state of rest, which is not a point of the branch.
     CollapsedToRest,
     /// The solver converged to a motion the backbone's acceptance test refuses (an
@@ -116,7 +116,7 @@ pub enum PointStatus {
     /// not finite (NaN or infinite, left in the point): the energy of the motion leaves the
     /// range of `f64` (a bar length or frequency near the limits of what the constructors
     /// accept), or the system at a parameter value of
-    /// [`parameter_branch`](crate::modal::parameter_branch) has no grazing energy `E_g`
+    /// [`parameter_branch`](crate::branches::parameter_branch) has no grazing energy `E_g`
     /// ([`SettingsError::GrazingEnergyOutOfRange`]). A point without a finite energy is not
     /// a point of the backbone.
     NonFiniteEnergy,

@@ -3,6 +3,7 @@
 //! floating bars added where the system has any), the start they lead to, and the walk back
 //! along the branch of an arclength backbone whose start lies beyond the asked frequency.
 
+use crate::branches::escape::{EscapingArclength, StallEscape};
 use crate::continuation::{
     Arclength, ArclengthOptions, Branch, ContinuationProblem, Event, Point, Step,
 };
@@ -10,7 +11,6 @@ use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
 use crate::modal::drift::check_held;
 use crate::modal::energy::energy;
-use crate::modal::escape::{EscapingArclength, StallEscape};
 use crate::modal::linear::{
     add_on_harmonic, branch_seed, grazing_energy, rigid_body_modes, seed_from_mode, ContactState,
 };
@@ -20,7 +20,7 @@ use std::ops::ControlFlow;
 
 /// Frequencies of the start, relative to the linear mode's: `80/79`, `40/39` and `20/19`
 /// (periods `79/80`, `39/40` and `19/20` of the mode's, the first of them the period
-/// grid's first, [`crate::modal::PeriodGrid::for_mode`]).
+/// grid's first, [`crate::branches::PeriodGrid::for_mode`]).
 pub const START_RATIOS: [f64; 3] = [80.0 / 79.0, 40.0 / 39.0, 20.0 / 19.0];
 
 /// Amplitudes of the start, relative to the grazing seed's: a seed that only grazes can
@@ -179,7 +179,7 @@ pub(crate) fn first_solution(
 /// The guess of a period backbone's first step at `omega`: the grazing seed where `solver`
 /// takes it to a motion of energy above `floor` (the paper's three systems), else the first
 /// such solution from the guesses of [`StartGuesses`] around the seed, at `omega` and then at
-/// the higher frequencies of [`START_RATIOS`](crate::modal::START_RATIOS) (relative to the
+/// the higher frequencies of [`START_RATIOS`](crate::branches::START_RATIOS) (relative to the
 /// first), walked back to `omega` in a few steps (as far as they converge). A seed that only
 /// grazes can slide to rest (a floating bar resting against an obstacle, or an obstacle
 /// whose grazing the rounding leaves just open), a slightly larger one cannot. At each
@@ -317,7 +317,7 @@ impl BackboneStart {
 /// motions of [`RIGID_AMPLITUDES`] added), walked back towards `omega` as far as it
 /// converges. [`BackboneStart::moved_from`] tells whether it got back to `omega`: where it
 /// did not, a period grid from `omega` starts off its branch, and pseudo-arclength
-/// ([`crate::modal::arclength_backbone`], which walks the branch back to `omega`) is the
+/// ([`crate::branches::arclength_backbone`], which walks the branch back to `omega`) is the
 /// backbone to use.
 ///
 /// # Errors
@@ -333,7 +333,7 @@ pub fn backbone_start<S: NonlinearSolver>(
 ) -> Result<BackboneStart, Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
     check_trivial_energy(trivial_energy)?;
-    crate::modal::diagnostics::check_frequency_of(&problem, omega)?;
+    crate::modal::inputs::check_frequency_of(&problem, omega)?;
     let (e_g, seed) = grazing_and_seed(&mut problem, mode, subharmonic, omega)?;
     let (x, omega) = usable_start(
         &mut problem,

@@ -15,15 +15,15 @@
 //! repeated branch along it and solves, keeping a solution only if its share of the energy
 //! off the multiples of `K` ([`subharmonic_share`]) is at least [`GENUINE_SHARE`].
 
+use crate::branches::backbone::{backbone_with, BackboneOptions};
+use crate::branches::point::{Backbone, BackbonePoint, PointStatus};
 use crate::continuation::{
     linspace, ContinuationProblem, EndReason, PeriodParametrised, Sequential, Step,
 };
 use crate::error::{ContinuationError, Error};
 use crate::fourier::Basis;
 use crate::linalg::{DenseMatrix, Lu};
-use crate::modal::backbone::{backbone_with, BackboneOptions};
 use crate::modal::energy::energy;
-use crate::modal::point::{Backbone, BackbonePoint, PointStatus};
 use crate::modal::signature::subharmonic_share;
 use crate::solve::{NonlinearSolver, Problem};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
@@ -156,7 +156,7 @@ pub fn leave_subspace<B: Basis>(
 /// [`genuine_subharmonic_backbone_with`] collecting every point, as [`backbone`] does for
 /// [`backbone_with`]: a run that stalls returns what it computed, with its end reason.
 ///
-/// [`backbone`]: crate::modal::backbone
+/// [`backbone`]: crate::branches::backbone
 ///
 /// # Errors
 /// See [`genuine_subharmonic_backbone_with`].

@@ -1,10 +1,10 @@
 //! Switching an arclength backbone onto the branch that crosses it at a branch point.
 
+use crate::branches::EscapingArclength;
 use crate::continuation::{
     Arclength, Branch, ContinuationProblem, EndReason, Event, Observer, Point, Step,
 };
 use crate::error::ContinuationError;
-use crate::modal::EscapingArclength;
 use crate::solve::NonlinearSolver;
 use std::ops::ControlFlow;
 

@@ -6,12 +6,12 @@ pub(crate) mod judge;
 use judge::{Judge, Walk};
 pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY};
 
+use crate::branches::level::{split_frequency, EnergyLevel};
+use crate::branches::point::{Backbone, BackbonePoint, PointStatus};
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
 use crate::error::Error;
 use crate::modal::energy::energy;
-use crate::modal::level::{split_frequency, EnergyLevel};
 use crate::modal::linear::{grazing_energy, grazing_energy_of, open_mode};
-use crate::modal::point::{Backbone, BackbonePoint, PointStatus};
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::ops::ControlFlow;
@@ -103,7 +103,7 @@ impl Default for EnergyBackboneOptions {
 /// # The run
 /// - **Start.** A nonsmooth mode at a fixed frequency just above linear mode `mode`'s,
 ///   solved from its grazing seed (placed on harmonic `subharmonic`; see
-///   [`START_RATIOS`](crate::modal::START_RATIOS)). Its level is the branch's first; the grid's levels above it follow.
+///   [`START_RATIOS`](crate::branches::START_RATIOS)). Its level is the branch's first; the grid's levels above it follow.
 /// - **Levels.** Each level is solved in `(x, Omega)` from the predictor. The state of
 ///   rest is no solution at any level, so no point collapses to it.
 /// - **Acceptance.** A converged point joins the branch if its frequency is positive (and

@@ -1,19 +1,19 @@
 //! Backbone curves: a nonsmooth-mode branch computed by sequential continuation in the
 //! period, with energies normalised by the first grazing energy.
 
+use crate::branches::escape::{EscapingArclength, StallEscape};
+use crate::branches::point::{Backbone, BackbonePoint};
+use crate::branches::start::{
+    check_trivial_energy, grazing_and_seed, usable_start, walk_back, BackboneStart,
+};
+use crate::branches::switch::{Runner, SwitchAt};
 use crate::continuation::{
     linspace, Arclength, ArclengthOptions, Branch, EndReason, Observer, PeriodParametrised, Point,
     Predictor, Rejection, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
 };
 use crate::error::{ContinuationError, Error};
-use crate::modal::diagnostics::check_frequency_of;
 use crate::modal::energy::energy;
-use crate::modal::escape::{EscapingArclength, StallEscape};
-use crate::modal::point::{Backbone, BackbonePoint};
-use crate::modal::start::{
-    check_trivial_energy, grazing_and_seed, usable_start, walk_back, BackboneStart,
-};
-use crate::modal::switch::{Runner, SwitchAt};
+use crate::modal::inputs::check_frequency_of;
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
@@ -154,7 +154,7 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
 }
 
 /// [`backbone_with`] (`speculation = None`) or [`backbone_speculative_with`] from a start
-/// found beforehand by [`backbone_start`](crate::modal::backbone_start) at the grid's first
+/// found beforehand by [`backbone_start`](crate::branches::backbone_start) at the grid's first
 /// frequency, instead of searching it again: a caller who looked at the start (for instance
 /// to choose between this and [`arclength_backbone`] by
 /// [`BackboneStart::moved_from`]) does not pay for the search twice. The start's unknowns are

@@ -1,0 +1,103 @@
+//! Checks of the inputs of the post-processing and of the branch methods: a motion's length,
+//! its frequency against the discretization's range, finite unknowns and finite results.
+//! One module, so that every entry point refuses the same inputs with the same errors.
+
+use crate::error::SettingsError;
+use crate::fourier::Basis;
+use crate::system::NonsmoothSystem;
+use std::f64::consts::PI;
+
+/// The smallest fundamental frequency `Omega` accepted by the post-processing (about
+/// `3.5e-308`): `2 pi / f64::MAX`, rounded up so that the period `2 pi / Omega` is finite.
+/// It is a normal `f64`, so every frequency at or above it is too (a subnormal one has lost
+/// precision).
+pub const MIN_FREQUENCY: f64 = 2.0 * PI / f64::MAX * (1.0 + 4.0 * f64::EPSILON);
+
+/// Checks a fundamental frequency: positive and finite ([`SettingsError::NotPositive`]) and
+/// at least [`MIN_FREQUENCY`] ([`SettingsError::FrequencyTooSmall`]).
+pub(crate) fn check_frequency(omega: f64) -> Result<f64, SettingsError> {
+    let what = "fundamental frequency";
+    if !(omega.is_finite() && omega > 0.0) {
+        Err(SettingsError::NotPositive { what, value: omega })
+    } else if omega < MIN_FREQUENCY {
+        Err(SettingsError::FrequencyTooSmall {
+            what,
+            omega,
+            min: MIN_FREQUENCY,
+        })
+    } else {
+        Ok(omega)
+    }
+}
+
+/// Checks a fundamental frequency of `problem`: [`check_frequency`], and at most
+/// [`Discretization::max_frequency`](crate::system::Discretization::max_frequency)
+/// ([`SettingsError::FrequencyTooLarge`]).
+pub(crate) fn check_frequency_of<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    omega: f64,
+) -> Result<f64, SettingsError> {
+    check_frequency(omega)?;
+    let max = problem.description().max_frequency();
+    if omega > max {
+        Err(SettingsError::FrequencyTooLarge {
+            what: "fundamental frequency",
+            omega,
+            max,
+        })
+    } else {
+        Ok(omega)
+    }
+}
+
+/// Checks a motion `x` of `problem` at `omega`: the length of `x`
+/// ([`SettingsError::Length`]), the frequency ([`check_frequency_of`]) and finite unknowns
+/// ([`SettingsError::NotPositive`] naming "unknowns (finite)").
+pub(crate) fn check_motion<B: Basis>(
+    problem: &NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+) -> Result<(), SettingsError> {
+    check_length(x, problem.dimension())?;
+    check_frequency_of(problem, omega)?;
+    check_unknowns_finite(x)
+}
+
+/// Checks that the unknowns `x` have length `expected` ([`SettingsError::Length`]).
+pub(crate) fn check_length(x: &[f64], expected: usize) -> Result<(), SettingsError> {
+    if x.len() == expected {
+        Ok(())
+    } else {
+        Err(SettingsError::Length {
+            what: "unknowns",
+            got: x.len(),
+            expected,
+        })
+    }
+}
+
+/// Checks that the unknowns `x` are finite ([`SettingsError::NotPositive`] naming
+/// "unknowns (finite)").
+pub(crate) fn check_unknowns_finite(x: &[f64]) -> Result<(), SettingsError> {
+    match x.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(SettingsError::NotPositive {
+            what: "unknowns (finite)",
+            value: *v,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks that every value of `values` is finite: [`SettingsError::NonFiniteResult`]
+/// naming `what` otherwise.
+pub(crate) fn check_finite<'v>(
+    what: &'static str,
+    omega: f64,
+    values: impl IntoIterator<Item = &'v f64>,
+) -> Result<(), SettingsError> {
+    if values.into_iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(SettingsError::NonFiniteResult { what, omega })
+    }
+}
