@@ -171,6 +171,8 @@ mod tests {
             x: vec![0.0, 1e-3],
             step_size: -0.005,
             events: vec![Event::Fold { parameter: 1.8 }],
+            branch: 0,
+            displacement_defect: None,
         }
     }
 

@@ -1,117 +1,63 @@
-//! Sweeps: many backbones (modes, subharmonics, parameter values, harmonic counts) computed in
+//! Sweeps: many branches (modes, subharmonics, parameter values, harmonic counts) computed in
 //! one call, in parallel with the `parallel` feature.
 //!
-//! Each [`SweepJob`] is one call of [`branches::backbone`](fn@crate::branches::backbone): a system,
-//! harmonic-balance settings, backbone options and a solver. The jobs are independent, so
-//! [`backbones`] runs them on rayon's thread pool when the crate is built with
-//! `--features parallel`, and one after the other otherwise. Every job is computed by the same
-//! sequential code either way (faer runs single-threaded, FFT plans and scratch buffers are
-//! per basis and per thread), so the results are identical bit for bit, in the order of the
-//! jobs.
+//! Each [`SweepJob`] is one call of [`branches::compute`](crate::branches::compute): a system
+//! and a request. The jobs are independent, so [`backbones`] runs them on rayon's thread pool
+//! when the crate is built with `--features parallel`, and one after the other otherwise.
+//! Every job is computed by the same sequential code either way (faer runs single-threaded,
+//! FFT plans and scratch buffers are per basis and per thread), so the results are identical
+//! bit for bit, in the order of the jobs.
 //!
 //! ```
-//! use nonsmooth_modes::modal::{BackboneOptions, PeriodGrid};
+//! use nonsmooth_modes::branches::{BackboneOptions, Method, PeriodGrid, Request};
 //! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-//! use nonsmooth_modes::sweep::{backbones, Solver, SweepJob};
-//! use nonsmooth_modes::system::HarmonicBalanceSettings;
+//! use nonsmooth_modes::sweep::{backbones, SweepJob};
 //!
 //! let system = clamped_bar_with_obstacle(1e-3)?;
-//! let options = BackboneOptions {
-//!     grid: PeriodGrid { start: 3.9, end: 3.8, steps: 3 },
-//!     ..Default::default()
-//! };
+//! let grid = PeriodGrid { start: 3.9, end: 3.8, steps: 3 };
+//! let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
 //! // the same backbone at m = 8 and m = 16
 //! let jobs: Vec<SweepJob> = [8, 16]
 //!     .into_iter()
 //!     .map(|m| SweepJob {
 //!         system: system.clone(),
-//!         settings: HarmonicBalanceSettings { harmonics: m, ..Default::default() },
-//!         options,
-//!         solver: Solver::default(),
+//!         request: Request::new(1).harmonics(m).method(method),
 //!     })
 //!     .collect();
 //! let results = backbones(&jobs);
 //! assert_eq!(results.len(), 2);
-//! assert!(results.iter().all(|r| r.as_ref().is_ok_and(|points| points.len() == 3)));
+//! assert!(results.iter().all(|r| r.as_ref().is_ok_and(|run| run.points.len() == 3)));
 //! # Ok::<(), nonsmooth_modes::Error>(())
 //! ```
 
-use crate::branches::{backbone, Backbone, BackboneOptions};
-use crate::error::{Error, SolveError};
-use crate::solve::{Dogleg, NonlinearSolver, Problem, SemismoothNewton, SolveInfo, SolveMonitor};
-use crate::system::{BarSystem, HarmonicBalanceSettings};
+use crate::branches::{compute, ModeBranches, Request};
+use crate::error::Error;
+pub use crate::solve::Solver;
+use crate::system::BarSystem;
 
-/// A solver chosen per job (so that one sweep can mix solvers).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Solver {
-    /// [`SemismoothNewton`] (the default).
-    Newton(SemismoothNewton),
-    /// Powell's [`Dogleg`].
-    Dogleg(Dogleg),
-}
-
-impl Default for Solver {
-    fn default() -> Self {
-        Self::Newton(SemismoothNewton::default())
-    }
-}
-
-impl NonlinearSolver for Solver {
-    fn solve_monitored(
-        &self,
-        problem: &mut dyn Problem,
-        x: &mut [f64],
-        monitor: &mut dyn SolveMonitor,
-    ) -> Result<SolveInfo, SolveError> {
-        match self {
-            Self::Newton(s) => s.solve_monitored(problem, x, monitor),
-            Self::Dogleg(s) => s.solve_monitored(problem, x, monitor),
-        }
-    }
-
-    fn tolerance(&self, problem: &mut dyn Problem) -> f64 {
-        match self {
-            Self::Newton(s) => s.tolerance(problem),
-            Self::Dogleg(s) => s.tolerance(problem),
-        }
-    }
-}
-
-/// One backbone of a sweep: the arguments of [`branches::backbone`](fn@crate::branches::backbone).
+/// One branch of a sweep: the arguments of [`compute`].
 #[derive(Debug, Clone)]
-pub struct SweepJob<S = Solver> {
+pub struct SweepJob {
     /// The bar system.
     pub system: BarSystem,
-    /// Harmonic-balance settings (harmonics, samples, complementarity parameter).
-    pub settings: HarmonicBalanceSettings,
-    /// Period grid, mode, subharmonic, predictor, failure budget.
-    pub options: BackboneOptions,
-    /// The nonlinear solver (cloned for the run).
-    pub solver: S,
+    /// What to compute.
+    pub request: Request,
 }
 
-impl<S: NonlinearSolver + Clone> SweepJob<S> {
-    /// Computes this job's backbone (what [`backbones`] does for each job).
+impl SweepJob {
+    /// Computes this job's branch (what [`backbones`] does for each job).
     ///
     /// # Errors
-    /// See [`branches::backbone`](fn@crate::branches::backbone).
-    pub fn run(&self) -> Result<Backbone, Error> {
-        backbone(
-            &self.system,
-            self.settings,
-            &self.options,
-            self.solver.clone(),
-        )
+    /// See [`compute`].
+    pub fn run(&self) -> Result<ModeBranches, Error> {
+        compute(&self.system, &self.request)
     }
 }
 
-/// Computes every job's backbone, in the order of `jobs`: in parallel on rayon's global
+/// Computes every job's branch, in the order of `jobs`: in parallel on rayon's global
 /// thread pool with the `parallel` feature, sequentially without it. Results do not depend on
 /// the number of threads.
-pub fn backbones<S>(jobs: &[SweepJob<S>]) -> Vec<Result<Backbone, Error>>
-where
-    S: NonlinearSolver + Clone + Send + Sync,
-{
+pub fn backbones(jobs: &[SweepJob]) -> Vec<Result<ModeBranches, Error>> {
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
@@ -125,78 +71,42 @@ where
 
 /// [`backbones`] one job after the other on the calling thread, whatever the features (the
 /// reference the parallel sweep is checked against).
-pub fn backbones_serial<S>(jobs: &[SweepJob<S>]) -> Vec<Result<Backbone, Error>>
-where
-    S: NonlinearSolver + Clone,
-{
+pub fn backbones_serial(jobs: &[SweepJob]) -> Vec<Result<ModeBranches, Error>> {
     jobs.iter().map(SweepJob::run).collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::branches::PeriodGrid;
+    use crate::branches::{BackboneOptions, Method, PeriodGrid};
     use crate::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
-    use crate::solve::DoglegOptions;
+    use crate::solve::{Dogleg, DoglegOptions};
+
+    fn grid(start: f64, end: f64, steps: usize) -> Method {
+        let grid = PeriodGrid { start, end, steps };
+        Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1))
+    }
 
     fn jobs() -> Vec<SweepJob> {
         let clamped = clamped_bar_with_obstacle(1e-3).unwrap();
         let robin = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
-        let grid = PeriodGrid {
-            start: 3.95,
-            end: 3.75,
-            steps: 21,
+        let on_grid = grid(3.95, 3.75, 21);
+        let job = |system: &BarSystem, m: usize, method: Method| SweepJob {
+            system: system.clone(),
+            request: Request::new(1).harmonics(m).method(method),
         };
-        let mut jobs = Vec::new();
-        for m in [10, 20, 31] {
-            jobs.push(SweepJob {
-                system: clamped.clone(),
-                settings: HarmonicBalanceSettings {
-                    harmonics: m,
-                    ..Default::default()
-                },
-                options: BackboneOptions {
-                    grid,
-                    ..Default::default()
-                },
-                solver: Solver::default(),
-            });
-        }
-        jobs.push(SweepJob {
-            system: clamped.clone(),
-            settings: HarmonicBalanceSettings::default(),
-            options: BackboneOptions {
-                grid,
-                ..Default::default()
-            },
-            solver: Solver::Dogleg(Dogleg::new(DoglegOptions::default()).unwrap()),
-        });
-        jobs.push(SweepJob {
-            system: robin,
-            settings: HarmonicBalanceSettings {
-                harmonics: 12,
-                ..Default::default()
-            },
-            options: BackboneOptions {
-                grid: PeriodGrid {
-                    start: 9.5,
-                    end: 8.5,
-                    steps: 11,
-                },
-                ..Default::default()
-            },
-            solver: Solver::default(),
-        });
+        let mut jobs: Vec<SweepJob> = [10, 20, 31]
+            .into_iter()
+            .map(|m| job(&clamped, m, on_grid))
+            .collect();
+        let mut dogleg = job(&clamped, 20, on_grid);
+        dogleg.request.solver = Some(Solver::Dogleg(
+            Dogleg::new(DoglegOptions::default()).unwrap(),
+        ));
+        jobs.push(dogleg);
+        jobs.push(job(&robin, 12, grid(9.5, 8.5, 11)));
         // an invalid job: its error comes back in its slot
-        jobs.push(SweepJob {
-            system: clamped,
-            settings: HarmonicBalanceSettings {
-                harmonics: 0,
-                ..Default::default()
-            },
-            options: BackboneOptions::default(),
-            solver: Solver::default(),
-        });
+        jobs.push(job(&clamped, 0, on_grid));
         jobs
     }
 
@@ -209,8 +119,8 @@ mod tests {
         for (k, (a, b)) in swept.iter().zip(&serial).enumerate() {
             match (a, b) {
                 (Ok(a), Ok(b)) => {
-                    assert_eq!(a.len(), b.len(), "job {k}");
-                    for (p, q) in a.iter().zip(b) {
+                    assert_eq!(a.points.len(), b.points.len(), "job {k}");
+                    for (p, q) in a.points.iter().zip(&b.points) {
                         assert_eq!(p.converged, q.converged, "job {k} step {}", p.step);
                         assert_eq!(p.energy.to_bits(), q.energy.to_bits(), "job {k}");
                         assert_eq!(p.residual_norm.to_bits(), q.residual_norm.to_bits());
@@ -229,25 +139,18 @@ mod tests {
         assert!(swept[..5].iter().all(Result::is_ok));
         assert!(swept[5].is_err());
         // the jobs did real work: most steps of the clamped backbones converge
-        let converged = swept[1]
-            .as_ref()
-            .unwrap()
-            .iter()
-            .filter(|p| p.converged)
-            .count();
+        let converged = swept[1].as_ref().unwrap().converged().count();
         assert!(converged >= 15, "{converged} of 21 converged");
     }
 
+    /// The job's solver is the one that runs: the Dogleg job differs from the Newton job of
+    /// the same grid in its iterations, and a request without a solver takes the method's.
     #[test]
     fn solver_choice_forwards() {
-        let job = &jobs()[3];
-        let direct = backbone(
-            &job.system,
-            job.settings,
-            &job.options,
-            Dogleg::new(DoglegOptions::default()).unwrap(),
-        )
-        .unwrap();
-        assert_eq!(job.run().unwrap(), direct);
+        let jobs = jobs();
+        let (newton, dogleg) = (jobs[1].run().unwrap(), jobs[3].run().unwrap());
+        let iterations =
+            |run: &ModeBranches| run.points.iter().map(|p| p.iterations).sum::<usize>();
+        assert_ne!(iterations(&newton), iterations(&dogleg));
     }
 }

@@ -33,19 +33,6 @@ pub struct PeriodGrid {
     pub steps: usize,
 }
 
-impl Default for PeriodGrid {
-    /// The paper's grid for the first mode of the clamped bar: `T` from 3.95 to 3.05 in 181
-    /// steps. Other systems: [`PeriodGrid::for_mode`], the same rule on their own linear
-    /// period.
-    fn default() -> Self {
-        Self {
-            start: 3.95,
-            end: 3.05,
-            steps: 181,
-        }
-    }
-}
-
 /// Options of [`backbone`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BackboneOptions {
@@ -93,17 +80,24 @@ impl BackboneOptions {
     }
 }
 
-impl Default for BackboneOptions {
-    fn default() -> Self {
+/// The energy below which a converged point counts as the state of rest, as a fraction of
+/// `E_g` (the default [`BackboneOptions::trivial_energy`]).
+pub const TRIVIAL_ENERGY: f64 = 1e-6;
+
+impl BackboneOptions {
+    /// The library's settings of a period grid `grid` for NSM `mode` sub `subharmonic`:
+    /// constant predictor, 40 consecutive failures, one retry, the first converged solution,
+    /// [`TRIVIAL_ENERGY`]. [`BackboneOptions::for_mode`] derives the grid from the system.
+    pub fn on_grid(grid: PeriodGrid, mode: usize, subharmonic: usize) -> Self {
         Self {
-            grid: PeriodGrid::default(),
-            mode: 1,
-            subharmonic: 1,
+            grid,
+            mode,
+            subharmonic,
             predictor: Predictor::Constant,
             max_consecutive_failures: 40,
             retry_depth: 1,
             selection: Selection::FirstConverged,
-            trivial_energy: 1e-6,
+            trivial_energy: TRIVIAL_ENERGY,
         }
     }
 }
@@ -120,7 +114,7 @@ impl Default for BackboneOptions {
 /// [`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound) if the start search
 /// found no motion in contact near the first period and no step of the grid converged
 /// either (the steps were handed to `observer`, each with its status).
-pub fn backbone_with<S: NonlinearSolver>(
+pub(crate) fn backbone_with<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
@@ -139,7 +133,7 @@ pub fn backbone_with<S: NonlinearSolver>(
 ///
 /// # Errors
 /// See [`backbone_with`].
-pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
+pub(crate) fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
@@ -163,7 +157,7 @@ pub fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'static>(
 /// # Errors
 /// See [`backbone_with`]; a start of the wrong size is
 /// [`ContinuationError::Dimension`].
-pub fn backbone_from<S: NonlinearSolver + Clone + Send + 'static>(
+pub(crate) fn backbone_from<S: NonlinearSolver + Clone + Send + 'static>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
@@ -291,7 +285,7 @@ fn drive_backbone<S: NonlinearSolver>(
 ///
 /// # Errors
 /// See [`backbone_with`].
-pub fn backbone<S: NonlinearSolver>(
+pub(crate) fn backbone<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
@@ -327,16 +321,24 @@ pub struct ArclengthBackboneOptions {
     pub switch: Option<SwitchAt>,
 }
 
-impl Default for ArclengthBackboneOptions {
-    fn default() -> Self {
+impl ArclengthBackboneOptions {
+    /// The library's settings of an arclength backbone of NSM `mode` sub `subharmonic` seeded
+    /// at `start_period` inside `omega_range`: the driver's default options, the default
+    /// stall escape, [`TRIVIAL_ENERGY`], no switch. [`ArclengthBackboneOptions::for_mode`]
+    /// derives the period and range from the system.
+    pub fn seeded_at(
+        start_period: f64,
+        omega_range: (f64, f64),
+        (mode, subharmonic): (usize, usize),
+    ) -> Self {
         Self {
-            start_period: 3.95,
-            omega_range: (2.0 * PI / 3.96, 2.0 * PI / 3.05),
-            mode: 1,
-            subharmonic: 1,
+            start_period,
+            omega_range,
+            mode,
+            subharmonic,
             arclength: ArclengthOptions::default(),
             escape: Some(StallEscape::default()),
-            trivial_energy: 1e-6,
+            trivial_energy: TRIVIAL_ENERGY,
             switch: None,
         }
     }
@@ -365,32 +367,13 @@ impl<F: FnMut(&BackbonePoint) -> ControlFlow<()>> BackboneObserver for F {
     }
 }
 
-/// Computes a backbone by pseudo-arclength continuation in `Omega` (see
-/// [`Arclength`]): seeds the branch from the linear mode at `start_period`, follows it inside
-/// `omega_range`, jumping past stalls when `options.escape` is set ([`EscapingArclength`]),
-/// and hands every accepted point to `observer`, which may stop the run
-/// ([`arclength_backbone_observed`] also shows the rejected steps).
-/// Returns `E_g` and the branch summary (points, rejections, end reason).
-///
-/// # Errors
-/// Invalid settings or options, a failed seed or a failed start.
-pub fn arclength_backbone<S: NonlinearSolver>(
-    system: &BarSystem,
-    settings: HarmonicBalanceSettings,
-    options: &ArclengthBackboneOptions,
-    solver: S,
-    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
-) -> Result<(f64, Branch), Error> {
-    arclength_backbone_observed(system, settings, options, solver, observer)
-}
-
 /// [`arclength_backbone`] whose observer sees every accepted point and every rejected step,
 /// and may stop the run on either
 /// ([`EndReason::StoppedByObserver`](crate::continuation::EndReason::StoppedByObserver)).
 ///
 /// # Errors
 /// Invalid settings or options, a failed seed or a failed start.
-pub fn arclength_backbone_observed<S: NonlinearSolver>(
+pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &ArclengthBackboneOptions,

@@ -38,10 +38,7 @@ pub fn convergence_study<S: NonlinearSolver + Clone>(
             harmonics: m,
             ..base
         };
-        let options = BackboneOptions {
-            grid,
-            ..Default::default()
-        };
+        let options = BackboneOptions::on_grid(grid, 1, 1);
         let points = backbone(system, settings, &options, solver.clone())?;
         let point = points.into_iter().rev().find(|p| p.converged);
         let diagnostics = match &point {

@@ -91,16 +91,15 @@ impl BackboneOptions {
         subharmonic: usize,
     ) -> Result<Self, SettingsError> {
         let floating = StartGuesses::new(system).floating();
+        let grid = PeriodGrid::for_mode(system, mode, subharmonic)?;
+        let options = Self::on_grid(grid, mode, subharmonic);
         Ok(Self {
-            grid: PeriodGrid::for_mode(system, mode, subharmonic)?,
-            mode,
-            subharmonic,
             retry_depth: if floating {
                 FLOATING_RETRY_DEPTH
             } else {
-                Self::default().retry_depth
+                options.retry_depth
             },
-            ..Self::default()
+            ..options
         })
     }
 }
@@ -119,16 +118,12 @@ impl ArclengthBackboneOptions {
         subharmonic: usize,
     ) -> Result<Self, SettingsError> {
         let period = linear_period(system, mode, subharmonic)?;
-        Ok(Self {
-            start_period: fraction(period, START),
-            omega_range: (
-                2.0 * PI / fraction(period, ARCLENGTH_START),
-                2.0 * PI / fraction(period, END),
-            ),
-            mode,
-            subharmonic,
-            ..Self::default()
-        })
+        let range = (
+            2.0 * PI / fraction(period, ARCLENGTH_START),
+            2.0 * PI / fraction(period, END),
+        );
+        let start = fraction(period, START);
+        Ok(Self::seeded_at(start, range, (mode, subharmonic)))
     }
 }
 
@@ -167,14 +162,15 @@ mod tests {
     fn clamped_bar_gets_the_paper_grid() {
         let system = clamped_bar_with_obstacle(1e-3).unwrap();
         assert_eq!(linear_period(&system, 1, 1).unwrap(), 4.0);
-        assert_eq!(
-            PeriodGrid::for_mode(&system, 1, 1).unwrap(),
-            PeriodGrid::default()
-        );
-        assert_eq!(
-            ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap(),
-            ArclengthBackboneOptions::default()
-        );
+        let paper = PeriodGrid {
+            start: 3.95,
+            end: 3.05,
+            steps: 181,
+        };
+        assert_eq!(PeriodGrid::for_mode(&system, 1, 1).unwrap(), paper);
+        let arclength = ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap();
+        assert_eq!(arclength.start_period, 3.95);
+        assert_eq!(arclength.omega_range, (2.0 * PI / 3.96, 2.0 * PI / 3.05));
     }
 
     /// Another system gets its own period: the Robin bar's first open mode,

@@ -4,6 +4,7 @@
 //! what a run returns.
 
 mod backbone;
+mod compute;
 mod convergence;
 mod defaults;
 mod energy_backbone;
@@ -11,31 +12,31 @@ mod escape;
 mod level;
 mod parameter;
 mod point;
+mod request;
+mod result;
 mod start;
 mod subharmonic;
 mod switch;
 
 pub use backbone::{
-    arclength_backbone, arclength_backbone_observed, backbone, backbone_from,
-    backbone_speculative_with, backbone_with, ArclengthBackboneOptions, BackboneObserver,
-    BackboneOptions, PeriodGrid,
+    ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PeriodGrid, TRIVIAL_ENERGY,
 };
+pub use compute::{compute, compute_observed};
 pub use convergence::{convergence_study, ConvergenceEntry};
 pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use energy_backbone::{
-    energy_backbone, energy_backbone_with, EnergyBackboneOptions, EnergyGrid, CALM_STEPS,
-    ESCAPE_AFTER, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY,
+    EnergyBackboneOptions, EnergyGrid, CALM_STEPS, ESCAPE_AFTER, ESCAPE_PERIODS, MARGINAL_SHARE,
+    SLOPE_COLLAPSE, SLOPE_MEMORY,
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use level::{split_frequency, EnergyLevel};
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
+pub use request::{AutoChoice, Method, Request, TimeDomainCheck};
+pub use result::ModeBranches;
 pub use start::{
-    backbone_start, BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES,
-    START_AMPLITUDES, START_RATIOS,
+    BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES,
+    START_RATIOS,
 };
-pub use subharmonic::{
-    genuine_subharmonic_backbone, genuine_subharmonic_backbone_with, leave_subspace,
-    symmetry_breaking_direction, GENUINE_SHARE, NUDGES,
-};
+pub use subharmonic::{leave_subspace, symmetry_breaking_direction, GENUINE_SHARE, NUDGES};
 pub use switch::SwitchAt;

@@ -6,8 +6,8 @@
 //! range. Every point reaches the observer as a [`BackbonePoint`] at the fixed frequency, its
 //! energy normalised by the grazing energy of the system at that parameter value.
 
+use crate::branches::backbone::TRIVIAL_ENERGY;
 use crate::branches::point::{BackbonePoint, PointStatus};
-use crate::branches::BackboneOptions;
 use crate::continuation::{
     Arclength, ArclengthOptions, Branch, Point, Sequential, SequentialOptions, Step,
 };
@@ -66,7 +66,7 @@ where
     S: NonlinearSolver,
 {
     let basis = settings.cosine_basis()?;
-    let floor = BackboneOptions::default().trivial_energy;
+    let floor = TRIVIAL_ENERGY;
     let problem = ParameterFamily::at(family.clone(), settings, omega, value)?;
     // Energies are normalised by `E_g`: a start without one is refused, as by `backbone`.
     grazing_energy(&family.build(value)?)?;

@@ -39,6 +39,13 @@ pub struct BackbonePoint {
     pub step_size: f64,
     /// Events detected there (folds, jumps, grazing).
     pub events: Vec<Event>,
+    /// Index of the branch the point lies on within its run: 0 for the branch the run
+    /// started on, one more after each jump (a stall escape, a switch at a branch point).
+    pub branch: usize,
+    /// Displacement defect of the time-domain check after one period, relative to the
+    /// motion's displacement, where a check was asked
+    /// ([`Request::check`](crate::branches::Request::check)) and could run.
+    pub displacement_defect: Option<f64>,
 }
 
 impl BackbonePoint {
@@ -91,6 +98,8 @@ impl BackbonePoint {
             x: x.to_vec(),
             step_size: p.step_size,
             events: p.events.clone(),
+            branch: 0,
+            displacement_defect: None,
         }
     }
 }

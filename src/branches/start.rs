@@ -307,6 +307,19 @@ impl BackboneStart {
     pub fn moved_from(&self, omega: f64) -> bool {
         (self.omega - omega).abs() > 1e-9 * omega.abs()
     }
+
+    /// The unsolved grazing seed of NSM `mode` sub `subharmonic` at `omega`: where a start
+    /// search failed, a period grid may still enter its branch further on from it.
+    pub(crate) fn seed(
+        system: &BarSystem,
+        settings: HarmonicBalanceSettings,
+        (mode, subharmonic): (usize, usize),
+        omega: f64,
+    ) -> Result<Self, Error> {
+        let mut problem = NonsmoothSystem::new(system, settings)?;
+        let (_, x) = grazing_and_seed(&mut problem, mode, subharmonic, omega)?;
+        Ok(Self { x, omega })
+    }
 }
 
 /// The start of the backbone of NSM `mode` sub `subharmonic` at frequency `omega`, as the
@@ -323,7 +336,7 @@ impl BackboneStart {
 /// # Errors
 /// Invalid settings, no linear mode `mode`, a `trivial_energy` that is negative or not
 /// finite, a non-positive or non-finite `omega`.
-pub fn backbone_start<S: NonlinearSolver>(
+pub(crate) fn backbone_start<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     (mode, subharmonic): (usize, usize),

@@ -16,7 +16,7 @@
 //! off the multiples of `K` ([`subharmonic_share`]) is at least [`GENUINE_SHARE`].
 
 use crate::branches::backbone::{backbone_with, BackboneOptions};
-use crate::branches::point::{Backbone, BackbonePoint, PointStatus};
+use crate::branches::point::{BackbonePoint, PointStatus};
 use crate::continuation::{
     linspace, ContinuationProblem, EndReason, PeriodParametrised, Sequential, Step,
 };
@@ -153,24 +153,6 @@ pub fn leave_subspace<B: Basis>(
     None
 }
 
-/// [`genuine_subharmonic_backbone_with`] collecting every point, as [`backbone`] does for
-/// [`backbone_with`]: a run that stalls returns what it computed, with its end reason.
-///
-/// [`backbone`]: crate::branches::backbone
-///
-/// # Errors
-/// See [`genuine_subharmonic_backbone_with`].
-pub fn genuine_subharmonic_backbone<S: NonlinearSolver>(
-    system: &BarSystem,
-    settings: HarmonicBalanceSettings,
-    options: &BackboneOptions,
-    solver: S,
-) -> Result<Backbone, Error> {
-    Backbone::collect(|see| {
-        genuine_subharmonic_backbone_with(system, settings, options, solver, see)
-    })
-}
-
 /// A genuinely subharmonic backbone: the `K`-fold repeated branch of `options` (`K =
 /// options.subharmonic >= 2`) by [`backbone_with`], each converged point of which is tried
 /// with [`leave_subspace`] until one leaves the subspace of the multiples of `K`; from there,
@@ -183,7 +165,7 @@ pub fn genuine_subharmonic_backbone<S: NonlinearSolver>(
 ///
 /// # Errors
 /// As [`backbone_with`]; [`ContinuationError::InvalidOption`] for `K < 2`.
-pub fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
+pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,

@@ -16,10 +16,12 @@
 //! [`Problem::structure`]: an adapter that wraps a problem forwards that one accessor and so
 //! keeps every capability of the problem it wraps.
 
+mod choice;
 mod dogleg;
 mod homotopy;
 mod newton;
 
+pub use choice::Solver;
 pub use dogleg::{Dogleg, DoglegOptions};
 pub use homotopy::SmoothingHomotopy;
 pub use newton::{NewtonOptions, SemismoothNewton};

@@ -260,6 +260,8 @@ impl Judge {
                 x: y.clone(),
                 step_size: -period / 800.0,
                 events: Vec::new(),
+                branch: 0,
+                displacement_defect: None,
             };
             if see(point).is_break() {
                 return Walk::Stopped;

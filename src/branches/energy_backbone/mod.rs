@@ -7,7 +7,7 @@ use judge::{Judge, Walk};
 pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY};
 
 use crate::branches::level::{split_frequency, EnergyLevel};
-use crate::branches::point::{Backbone, BackbonePoint, PointStatus};
+use crate::branches::point::{BackbonePoint, PointStatus};
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
 use crate::error::Error;
 use crate::modal::energy::energy;
@@ -29,27 +29,23 @@ pub struct EnergyGrid {
     pub steps: usize,
 }
 
-impl Default for EnergyGrid {
+impl EnergyGrid {
     /// The first mode's grid: `E / E_g` from 1, its grazing point, to 300, in 181 levels.
     /// For the clamped bar this spans the paper's periods, `T = 3.90` to `3.02`.
-    fn default() -> Self {
-        Self {
-            start: 1.0,
-            end: 300.0,
-            steps: 181,
-        }
-    }
-}
+    const FIRST_MODE: Self = Self {
+        start: 1.0,
+        end: 300.0,
+        steps: 181,
+    };
 
-impl EnergyGrid {
     /// The grid of NSM `mode` of `system`: from the grazing energy of linear mode `mode`
     /// (where its nonsmooth mode leaves the linear family) to 300 times it, in 181 levels;
-    /// [`EnergyGrid::default`] for `mode = 1`.
+    /// `1` to `300` in 181 levels for `mode = 1`.
     ///
     /// # Errors
     /// A failed mode search or grazing energy ([`grazing_energy_of`]).
     pub fn for_mode(system: &BarSystem, mode: usize) -> Result<Self, Error> {
-        let default = Self::default();
+        let default = Self::FIRST_MODE;
         if mode == 1 {
             return Ok(default);
         }
@@ -83,16 +79,21 @@ pub struct EnergyBackboneOptions {
     pub retry_depth: usize,
 }
 
-impl Default for EnergyBackboneOptions {
-    fn default() -> Self {
-        Self {
-            levels: EnergyGrid::default(),
-            mode: 1,
-            subharmonic: 1,
+impl EnergyBackboneOptions {
+    /// The options of NSM `mode` sub `subharmonic` of `system`: the levels
+    /// [`EnergyGrid::for_mode`], a secant predictor, 40 consecutive failures, one retry.
+    ///
+    /// # Errors
+    /// See [`EnergyGrid::for_mode`].
+    pub fn for_mode(system: &BarSystem, mode: usize, subharmonic: usize) -> Result<Self, Error> {
+        Ok(Self {
+            levels: EnergyGrid::for_mode(system, mode)?,
+            mode,
+            subharmonic,
             predictor: Predictor::Secant,
             max_consecutive_failures: 40,
             retry_depth: 1,
-        }
+        })
     }
 }
 
@@ -131,7 +132,7 @@ impl Default for EnergyBackboneOptions {
 /// Invalid settings or options, or no start
 /// ([`SettingsError::NoStart`](crate::SettingsError::NoStart)): nothing was
 /// computed.
-pub fn energy_backbone_with<S: NonlinearSolver>(
+pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
     options: &EnergyBackboneOptions,
@@ -263,18 +264,4 @@ impl Segment {
             ControlFlow::Continue(())
         }
     }
-}
-
-/// [`energy_backbone_with`] collecting every point: a run that stalls returns what it
-/// computed, with its end reason ([`Backbone::error`]).
-///
-/// # Errors
-/// See [`energy_backbone_with`].
-pub fn energy_backbone<S: NonlinearSolver>(
-    system: &BarSystem,
-    settings: HarmonicBalanceSettings,
-    options: &EnergyBackboneOptions,
-    solver: S,
-) -> Result<Backbone, Error> {
-    Backbone::collect(|see| energy_backbone_with(system, settings, options, solver, see))
 }

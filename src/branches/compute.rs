@@ -1,0 +1,245 @@
+//! The one call: a branch of a system's nonsmooth mode from a [`Request`], whatever the method.
+
+use crate::branches::backbone::{
+    arclength_backbone_observed, backbone_from, backbone_speculative_with, backbone_with,
+    ArclengthBackboneOptions, BackboneObserver, BackboneOptions,
+};
+use crate::branches::energy_backbone::{energy_backbone_with, EnergyBackboneOptions};
+use crate::branches::point::BackbonePoint;
+use crate::branches::request::{AutoChoice, Method, Request};
+use crate::branches::result::{Annotator, ModeBranches};
+use crate::branches::start::{backbone_start, BackboneStart};
+use crate::branches::subharmonic::genuine_subharmonic_backbone_with;
+use crate::continuation::Rejection;
+use crate::error::{Error, SettingsError};
+use crate::system::{BarSystem, NonsmoothSystem};
+use std::f64::consts::PI;
+use std::ops::ControlFlow;
+
+/// Computes the branch of NSM `request.mode` sub `request.subharmonic` of `system` by
+/// `request.method`, and returns every point computed, each with its status, branch index,
+/// character and label ([`ModeBranches`]).
+///
+/// # Method::Auto
+/// - Order `K >= 2`: a genuine subharmonic over the system's period grid
+///   ([`BackboneOptions::for_mode`]).
+/// - Otherwise the start of the branch is searched at the first period of the system's grid
+///   (the grazing seed of linear mode `i`, solved; where it slides to rest, a search over
+///   amplitudes, frequencies and rigid-body motions). Where the branch is entered there, the
+///   period grid runs from that start; where it is entered only at a higher frequency (a
+///   floating bar that must be pushed hard enough to shuttle within a period),
+///   pseudo-arclength from the grid's first period walks the branch back and follows it
+///   through its folds ([`ArclengthBackboneOptions::for_mode`]).
+///
+/// The choice is [`ModeBranches::auto`].
+///
+/// # Errors
+/// Only when no point was computed: invalid settings or options, no linear mode `i`, an
+/// assembly with a bar nothing holds
+/// ([`SettingsError::Unconfined`](crate::SettingsError::Unconfined)), or no start and no
+/// converged step ([`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound),
+/// which says what was tried). A run that stalls or fails part-way returns its points with
+/// its end reason ([`ModeBranches::end`]).
+///
+/// # Example
+/// ```
+/// use nonsmooth_modes::branches::{compute, Request};
+/// use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+///
+/// let system = clamped_bar_with_obstacle(1e-3)?;
+/// let run = compute(&system, &Request::new(1).harmonics(10))?;
+/// assert!(run.converged().count() > 100);
+/// println!("{} by {}", run.end.label(), run.method.name());
+/// # Ok::<(), nonsmooth_modes::Error>(())
+/// ```
+pub fn compute(system: &BarSystem, request: &Request) -> Result<ModeBranches, Error> {
+    compute_observed(system, request, |_: &BackbonePoint| {
+        ControlFlow::Continue(())
+    })
+}
+
+/// [`compute`], handing each point (annotated as in the result) and each rejected
+/// arclength step to `observer` as it comes; the observer may stop the run
+/// ([`EndReason::StoppedByObserver`]), which keeps its points.
+///
+/// # Errors
+/// See [`compute`].
+pub fn compute_observed(
+    system: &BarSystem,
+    request: &Request,
+    observer: impl BackboneObserver,
+) -> Result<ModeBranches, Error> {
+    let problem = NonsmoothSystem::new(system, request.settings)?;
+    let (plan, method, auto) = resolve(system, request)?;
+    let solver = request.solver_for(&method)?;
+    let mut annotator = Annotator::new(&problem, request, observer)?;
+    let settings = request.settings;
+    let see = |p: &BackbonePoint| annotator.point(p);
+    let (grazing_energy, end, rejected) = match plan {
+        Plan::Grid(options, Some(start)) => {
+            let spec = request.speculation;
+            let (e_g, end) = backbone_from(system, settings, &options, start, spec, solver, see)?;
+            (e_g, end, 0)
+        }
+        Plan::Grid(options, None) => {
+            let (e_g, end) = match request.speculation {
+                Some(spec) => {
+                    backbone_speculative_with(system, settings, &options, spec, solver, see)?
+                }
+                None => backbone_with(system, settings, &options, solver, see)?,
+            };
+            (e_g, end, 0)
+        }
+        Plan::Genuine(options) => {
+            let (e_g, end) =
+                genuine_subharmonic_backbone_with(system, settings, &options, solver, see)?;
+            (e_g, end, 0)
+        }
+        Plan::Energy(options) => {
+            let (e_g, end) = energy_backbone_with(system, settings, &options, solver, see)?;
+            (e_g, end, 0)
+        }
+        Plan::Arclength(options) => {
+            let seen = Forward(&mut annotator);
+            let (e_g, branch) =
+                arclength_backbone_observed(system, settings, &options, solver, seen)?;
+            (e_g, branch.end, branch.rejections)
+        }
+        Plan::FromSeed(options, start, not_found) => {
+            let spec = request.speculation;
+            let (e_g, end) = backbone_from(system, settings, &options, start, spec, solver, see)?;
+            if annotator.converged() == 0 {
+                return Err(not_found);
+            }
+            (e_g, end, 0)
+        }
+    };
+    Ok(annotator.finish((method, auto), grazing_energy, end, rejected))
+}
+
+/// An observer that hands what it sees to the annotator (the arclength backbone takes its
+/// observer by value).
+struct Forward<'a, O>(&'a mut Annotator<O>);
+
+impl<O: BackboneObserver> BackboneObserver for Forward<'_, O> {
+    fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()> {
+        self.0.point(point)
+    }
+    fn rejected(&mut self, rejection: &Rejection) -> ControlFlow<()> {
+        self.0.rejected(rejection)
+    }
+}
+
+/// What [`compute`] runs: the driver, with its options built from the system and the
+/// request's mode and order in them.
+enum Plan {
+    /// A period grid, from a start found beforehand or searching its own.
+    Grid(BackboneOptions, Option<BackboneStart>),
+    /// A period grid from the unsolved seed, after a start search that failed with the
+    /// error kept: the grid may still enter its branch further on.
+    FromSeed(BackboneOptions, BackboneStart, Error),
+    Genuine(BackboneOptions),
+    Energy(EnergyBackboneOptions),
+    Arclength(ArclengthBackboneOptions),
+}
+
+/// The plan of `request`, the method it stands for (as the result records it) and, for
+/// [`Method::Auto`], why.
+///
+/// # Errors
+/// No linear mode `i` (or an order 0), invalid settings, and the errors of the start search
+/// of `Auto` but its failure to find a start.
+fn resolve(
+    system: &BarSystem,
+    request: &Request,
+) -> Result<(Plan, Method, Option<AutoChoice>), Error> {
+    let (mode, subharmonic) = (request.mode, request.subharmonic);
+    let grid = |o: &BackboneOptions| BackboneOptions {
+        mode,
+        subharmonic,
+        ..*o
+    };
+    let arclength = |o: &ArclengthBackboneOptions| ArclengthBackboneOptions {
+        mode,
+        subharmonic,
+        ..*o
+    };
+    Ok(match &request.method {
+        Method::Auto => return auto(system, request),
+        Method::PeriodGrid(o) => (Plan::Grid(grid(o), None), Method::PeriodGrid(grid(o)), None),
+        Method::GenuineSubharmonic(o) => (
+            Plan::Genuine(grid(o)),
+            Method::GenuineSubharmonic(grid(o)),
+            None,
+        ),
+        Method::Arclength(o) => (
+            Plan::Arclength(arclength(o)),
+            Method::Arclength(arclength(o)),
+            None,
+        ),
+        Method::Switch(o, at) => {
+            let options = ArclengthBackboneOptions {
+                switch: Some(*at),
+                ..arclength(o)
+            };
+            (Plan::Arclength(options), Method::Switch(options, *at), None)
+        }
+        Method::Energy(o) => {
+            let options = EnergyBackboneOptions {
+                mode,
+                subharmonic,
+                ..*o
+            };
+            (Plan::Energy(options), Method::Energy(options), None)
+        }
+    })
+}
+
+/// What [`Method::Auto`] runs on `system` ([`compute`]).
+fn auto(
+    system: &BarSystem,
+    request: &Request,
+) -> Result<(Plan, Method, Option<AutoChoice>), Error> {
+    let (mode, order) = (request.mode, request.subharmonic);
+    let grid = BackboneOptions::for_mode(system, mode, order)?;
+    if order >= 2 {
+        let choice = Some(AutoChoice::Subharmonic);
+        return Ok((
+            Plan::Genuine(grid),
+            Method::GenuineSubharmonic(grid),
+            choice,
+        ));
+    }
+    let first = 2.0 * PI / grid.grid.start;
+    let solver = request.solver_for(&Method::PeriodGrid(grid))?;
+    let settings = request.settings;
+    let floor = grid.trivial_energy;
+    let start = match backbone_start(system, settings, (mode, order), first, floor, &solver) {
+        Ok(start) => start,
+        Err(not_found @ Error::Settings(SettingsError::StartNotFound { .. })) => {
+            let seed = BackboneStart::seed(system, settings, (mode, order), first)?;
+            let choice = Some(AutoChoice::NoStartFound);
+            return Ok((
+                Plan::FromSeed(grid, seed, not_found),
+                Method::PeriodGrid(grid),
+                choice,
+            ));
+        }
+        Err(e) => return Err(e),
+    };
+    if !start.moved_from(first) {
+        let choice = Some(AutoChoice::EnteredAtGridStart);
+        return Ok((
+            Plan::Grid(grid, Some(start)),
+            Method::PeriodGrid(grid),
+            choice,
+        ));
+    }
+    let options = ArclengthBackboneOptions::for_mode(system, mode, order)?;
+    let entered_at = 2.0 * PI / start.omega;
+    Ok((
+        Plan::Arclength(options),
+        Method::Arclength(options),
+        Some(AutoChoice::EnteredAtShorterPeriod { entered_at }),
+    ))
+}

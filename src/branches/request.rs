@@ -1,0 +1,196 @@
+//! What a user asks of [`compute`](crate::branches::compute): which nonsmooth mode, with how
+//! many harmonics, by which method, with which solver, and whether every point is checked in
+//! the time domain.
+
+use crate::branches::backbone::{ArclengthBackboneOptions, BackboneOptions};
+use crate::branches::energy_backbone::EnergyBackboneOptions;
+use crate::branches::switch::SwitchAt;
+use crate::continuation::Speculation;
+use crate::error::SolveError;
+use crate::solve::{NewtonOptions, SemismoothNewton, Solver};
+use crate::system::{BarSystem, HarmonicBalanceSettings};
+use crate::verify::PeriodicityOptions;
+
+/// How a branch is followed. Each variant but [`Method::Auto`] carries its options, built
+/// from the system by their `for_mode` constructors (no option set carries another
+/// system's numbers); the request's [`Request::mode`] and [`Request::subharmonic`] replace
+/// the options' own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Method {
+    /// Let the system decide, as [`compute`](crate::branches::compute) documents: a genuine
+    /// subharmonic for an order `K >= 2`, otherwise the period grid where the branch can be
+    /// entered at the grid's first period, and pseudo-arclength (which walks the branch
+    /// back to it) where it can be entered only at a higher frequency. The result records
+    /// the choice ([`AutoChoice`]).
+    Auto,
+    /// Sequential continuation over a grid of periods ([`BackboneOptions::for_mode`]).
+    PeriodGrid(BackboneOptions),
+    /// Pseudo-arclength continuation in `Omega` with the stall escape
+    /// ([`ArclengthBackboneOptions::for_mode`]).
+    Arclength(ArclengthBackboneOptions),
+    /// Pseudo-arclength that leaves its branch at a branch point for the branch crossing
+    /// there.
+    Switch(ArclengthBackboneOptions, SwitchAt),
+    /// Sequential continuation in the energy level `E / E_g`, the frequency an unknown
+    /// ([`EnergyBackboneOptions::for_mode`]).
+    Energy(EnergyBackboneOptions),
+    /// A genuinely subharmonic branch (NSM `i` sub `K`, `K >= 2`), left from the `K`-fold
+    /// repeated branch over a period grid ([`BackboneOptions::for_mode`] with the order).
+    GenuineSubharmonic(BackboneOptions),
+}
+
+impl Method {
+    /// A short name for tables and messages: `auto`, `period-grid`, `arclength`, `switch`,
+    /// `energy` or `genuine-subharmonic`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::PeriodGrid(_) => "period-grid",
+            Self::Arclength(_) => "arclength",
+            Self::Switch(..) => "switch",
+            Self::Energy(_) => "energy",
+            Self::GenuineSubharmonic(_) => "genuine-subharmonic",
+        }
+    }
+}
+
+/// Why [`Method::Auto`] chose the method it ran.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum AutoChoice {
+    /// The requested order is `K >= 2`: a genuine subharmonic.
+    Subharmonic,
+    /// The branch can be entered at the grid's first period: the period grid.
+    EnteredAtGridStart,
+    /// No start was found near the grid's first period: the period grid runs from the
+    /// unsolved seed, and may enter its branch further on (a run that never does ends with
+    /// [`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound)).
+    NoStartFound,
+    /// The branch could be entered only at period `entered_at`, shorter than the grid's
+    /// first: pseudo-arclength from the grid's first period, which walks the branch back.
+    EnteredAtShorterPeriod {
+        /// Period of the start found.
+        entered_at: f64,
+    },
+}
+
+/// The time-domain check of every converged point ([`crate::verify::periodicity_check`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeDomainCheck {
+    /// Options of the march; its time step is replaced by [`TimeDomainCheck::for_system`]'s
+    /// where built by it.
+    pub options: PeriodicityOptions,
+    /// A point whose displacement defect after one period exceeds this is labelled
+    /// [`Label::Unverified`](crate::modal::Label::Unverified).
+    pub max_displacement_defect: f64,
+}
+
+impl TimeDomainCheck {
+    /// Largest displacement defect of a verified point by default: 5 % of the motion's
+    /// displacement, the tolerance of the crate's acceptance figures.
+    pub const MAX_DISPLACEMENT_DEFECT: f64 = 0.05;
+    /// Cells per shortest travel time by default (the paper's clamped bar: `dt = 1/400`).
+    pub const CELLS_PER_TRAVEL: f64 = 400.0;
+
+    /// The check of `system`: a time step of `1/400` of the shortest travel time `l_b / c_b`
+    /// of its bars (so that the cell count per bar does not depend on the units), on a
+    /// grid adjusted to commensurate cells where one is near, one period, and
+    /// [`Self::MAX_DISPLACEMENT_DEFECT`].
+    pub fn for_system(system: &BarSystem) -> Self {
+        let travel = system
+            .bars()
+            .iter()
+            .map(|b| b.length() / b.wave_speed())
+            .fold(f64::INFINITY, f64::min);
+        Self {
+            options: PeriodicityOptions {
+                dt: travel / Self::CELLS_PER_TRAVEL,
+                adjust_grid: true,
+                ..PeriodicityOptions::default()
+            },
+            max_displacement_defect: Self::MAX_DISPLACEMENT_DEFECT,
+        }
+    }
+}
+
+/// A request of [`compute`](crate::branches::compute): NSM `mode` sub `subharmonic` of a
+/// system, with `settings`, by `method`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    /// Linear mode the branch leaves (1-based, among the modes of nonzero frequency).
+    pub mode: usize,
+    /// Period multiple `K` (NSM `mode` sub `K`; 1 for the main branch).
+    pub subharmonic: usize,
+    /// Harmonics and contact-law settings.
+    pub settings: HarmonicBalanceSettings,
+    /// How the branch is followed.
+    pub method: Method,
+    /// The nonlinear solver; `None`: the method's own ([`Request::solver_for`]).
+    pub solver: Option<Solver>,
+    /// Period grids only: run the first retry of each failing step on a second thread
+    /// ([`Speculation`]); the points are the same bit for bit.
+    pub speculation: Option<Speculation>,
+    /// Check every converged point in the time domain and label those that fail it
+    /// (`None`: no check; points are labelled by their harmonic content alone).
+    pub check: Option<TimeDomainCheck>,
+}
+
+impl Request {
+    /// The main branch of NSM `mode` with the default settings, [`Method::Auto`], the
+    /// method's solver, no speculation and no time-domain check.
+    pub fn new(mode: usize) -> Self {
+        Self {
+            mode,
+            subharmonic: 1,
+            settings: HarmonicBalanceSettings::default(),
+            method: Method::Auto,
+            solver: None,
+            speculation: None,
+            check: None,
+        }
+    }
+
+    /// The same request with `harmonics` harmonics.
+    pub fn harmonics(mut self, harmonics: usize) -> Self {
+        self.settings.harmonics = harmonics;
+        self
+    }
+
+    /// The same request for NSM `mode` sub `order`.
+    pub fn subharmonic(mut self, order: usize) -> Self {
+        self.subharmonic = order;
+        self
+    }
+
+    /// The same request by `method`.
+    pub fn method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// The same request with every converged point checked by `check`.
+    pub fn checked(mut self, check: TimeDomainCheck) -> Self {
+        self.check = Some(check);
+        self
+    }
+
+    /// The solver of a run by `method`: [`Request::solver`] if given; otherwise
+    /// semismooth Newton that gives up early on a period grid (each step starts from a
+    /// converged neighbour, and a failing step is retried from another), and with its full
+    /// budget for the other methods (their escapes and starts solve from far guesses).
+    ///
+    /// # Errors
+    /// None in practice: the fail-fast options are valid ([`SolveError::InvalidOption`]
+    /// otherwise).
+    pub fn solver_for(&self, method: &Method) -> Result<Solver, SolveError> {
+        Ok(match (self.solver, method) {
+            (Some(solver), _) => solver,
+            (None, Method::PeriodGrid(_) | Method::GenuineSubharmonic(_)) => {
+                Solver::Newton(SemismoothNewton::new(NewtonOptions::fail_fast())?)
+            }
+            (None, _) => Solver::default(),
+        })
+    }
+}

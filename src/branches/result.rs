@@ -1,0 +1,168 @@
+//! What [`compute`](crate::branches::compute) returns, and how each point gets its branch
+//! index, its time-domain defect and its label on the way.
+
+use crate::branches::backbone::BackboneObserver;
+use crate::branches::point::BackbonePoint;
+use crate::branches::request::{AutoChoice, Method, Request, TimeDomainCheck};
+use crate::continuation::{EndReason, Event, Rejection};
+use crate::error::{ContinuationError, SettingsError};
+use crate::solution::Solution;
+use crate::system::NonsmoothSystem;
+use crate::verify::periodicity_check;
+use std::ops::ControlFlow;
+
+/// The branches of a nonsmooth mode that one request computed: every point (converged or
+/// not, in the run's order) with its status, branch index and label, the rejected
+/// arclength steps, why the run ended and which method ran. It keeps the discretization its
+/// points solve, so that a point's [`Solution`] needs no rebuilt problem.
+#[derive(Debug, Clone)]
+pub struct ModeBranches {
+    problem: NonsmoothSystem,
+    /// The method that ran, with the options it used (for [`Method::Auto`], the one chosen).
+    pub method: Method,
+    /// Why [`Method::Auto`] chose [`ModeBranches::method`] (`None` for a method asked).
+    pub auto: Option<AutoChoice>,
+    /// The first grazing energy `E_g` the energies are normalised by.
+    pub grazing_energy: f64,
+    /// Every point computed.
+    pub points: Vec<BackbonePoint>,
+    /// Rejected corrector steps of an arclength run (a period or energy grid reports its
+    /// failed steps as points, with their status).
+    pub rejected_steps: usize,
+    /// Why the run ended.
+    pub end: EndReason,
+}
+
+impl ModeBranches {
+    /// The discretization the points solve.
+    pub fn problem(&self) -> &NonsmoothSystem {
+        &self.problem
+    }
+
+    /// The converged points.
+    pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
+        self.points.iter().filter(|p| p.converged)
+    }
+
+    /// The points of branch `index` ([`BackbonePoint::branch`]).
+    pub fn branch(&self, index: usize) -> impl Iterator<Item = &BackbonePoint> {
+        self.points.iter().filter(move |p| p.branch == index)
+    }
+
+    /// The number of branches (one more than the largest branch index; 0 without points).
+    pub fn branch_count(&self) -> usize {
+        self.points.iter().map(|p| p.branch + 1).max().unwrap_or(0)
+    }
+
+    /// Point `index` as a [`Solution`], to ask it for fields, histories, diagnostics and
+    /// the time-domain check.
+    ///
+    /// # Errors
+    /// [`SettingsError::IndexOutOfRange`] for an index past the points, and the errors of
+    /// [`Solution::new`] for a point whose unknowns are not a motion (a failed step's last
+    /// iterate that is not finite).
+    pub fn solution(&self, index: usize) -> Result<Solution<'_>, SettingsError> {
+        let point = self
+            .points
+            .get(index)
+            .ok_or(SettingsError::IndexOutOfRange {
+                what: "point",
+                index,
+                count: self.points.len(),
+            })?;
+        Solution::new(&self.problem, &point.x, point.omega)
+    }
+
+    /// The error of a run that ended on one (a stall, too many failures or rejections),
+    /// `None` for a run that completed or was stopped by its observer.
+    pub fn error(&self) -> Option<ContinuationError> {
+        self.end.error()
+    }
+}
+
+/// Annotates each point a driver hands over (branch index, time-domain defect) before the
+/// user's observer sees it, and keeps it.
+pub(crate) struct Annotator<O> {
+    problem: NonsmoothSystem,
+    check: Option<TimeDomainCheck>,
+    observer: O,
+    points: Vec<BackbonePoint>,
+    branch: usize,
+    converged: usize,
+}
+
+impl<O: BackboneObserver> Annotator<O> {
+    /// The annotator of the points of `problem` asked by `request`.
+    pub(crate) fn new(
+        problem: &NonsmoothSystem,
+        request: &Request,
+        observer: O,
+    ) -> Result<Self, SettingsError> {
+        Ok(Self {
+            problem: problem.clone(),
+            check: request.check,
+            observer,
+            points: Vec::new(),
+            branch: 0,
+            converged: 0,
+        })
+    }
+
+    /// Annotates `point`, keeps it and shows it to the observer.
+    pub(crate) fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()> {
+        let mut point = point.clone();
+        // A jump (the stall escape, a corrector that lands far from its prediction, a switch
+        // onto a crossing branch) leaves the branch followed so far.
+        let jumped = point.events.iter().any(|e| matches!(e, Event::Jump { .. }));
+        if jumped && !self.points.is_empty() {
+            self.branch += 1;
+        }
+        point.branch = self.branch;
+        if point.converged {
+            self.converged += 1;
+            point.displacement_defect = self.defect(&point);
+        }
+        let flow = self.observer.point(&point);
+        self.points.push(point);
+        flow
+    }
+
+    /// Shows a rejected step to the observer.
+    pub(crate) fn rejected(&mut self, rejection: &Rejection) -> ControlFlow<()> {
+        self.observer.rejected(rejection)
+    }
+
+    /// The converged points so far.
+    pub(crate) fn converged(&self) -> usize {
+        self.converged
+    }
+
+    /// The displacement defect of `point` after one period, if a check was asked and the
+    /// march could run.
+    fn defect(&self, point: &BackbonePoint) -> Option<f64> {
+        let check = self.check?;
+        let (system, basis) = (self.problem.system(), self.problem.basis());
+        periodicity_check(system, basis, &point.x, point.omega, &check.options)
+            .ok()
+            .map(|r| r.displacement_defect)
+    }
+
+    /// The result of the run.
+    pub(crate) fn finish(
+        self,
+        (method, auto): (Method, Option<AutoChoice>),
+        grazing_energy: f64,
+        end: EndReason,
+        rejected_steps: usize,
+    ) -> ModeBranches {
+        ModeBranches {
+            problem: self.problem,
+            method,
+            auto,
+            grazing_energy,
+            points: self.points,
+            rejected_steps,
+            end,
+        }
+    }
+}
