@@ -3,6 +3,7 @@
 //! point for reports (subharmonic share, contact intervals per period).
 
 mod backbone;
+mod character;
 mod defaults;
 pub mod diagnostics;
 mod drift;
@@ -24,6 +25,7 @@ pub use backbone::{
     backbone_speculative_with, backbone_with, ArclengthBackboneOptions, BackboneObserver,
     BackboneOptions, PeriodGrid,
 };
+pub use character::{character, label, nearest_mode, Character, Label, GRAZING_TOLERANCE};
 pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use diagnostics::{
     convergence_study, diagnose, displacement_grid, end_history, law_history, PointDiagnostics,

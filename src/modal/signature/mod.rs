@@ -233,7 +233,7 @@ pub fn contact_intervals<B: Basis>(
 
 /// For each law, whether each of the `N` instants of the full grid is in contact (the
 /// criterion of [`contact_intervals`]).
-fn contact_samples<B: Basis>(
+pub(crate) fn contact_samples<B: Basis>(
     problem: &mut NonsmoothSystem<B>,
     x: &[f64],
     omega: f64,
@@ -270,7 +270,7 @@ fn contact_samples<B: Basis>(
 
 /// The number of maximal runs of `true` in the periodic sequence `values` (the last value
 /// precedes the first): the rises from `false` to `true`, or 1 if every value is `true`.
-fn periodic_runs(values: &[bool]) -> usize {
+pub(crate) fn periodic_runs(values: &[bool]) -> usize {
     let Some(&last) = values.last() else {
         return 0;
     };
