@@ -172,7 +172,9 @@ mod tests {
             step_size: -0.005,
             events: vec![Event::Fold { parameter: 1.8 }],
             branch: 0,
-            displacement_defect: None,
+            time_domain: None,
+            character: None,
+            label: None,
         }
     }
 

@@ -2,7 +2,7 @@
 //! example's limits and the usage text.
 
 use crate::systems::{load_assembly, SystemKind};
-use nonsmooth_modes::branches::{BackboneOptions, SwitchAt};
+use nonsmooth_modes::branches::{SwitchAt, MAX_CONSECUTIVE_FAILURES};
 use nonsmooth_modes::continuation::{ArclengthOptions, Selection};
 use nonsmooth_modes::system::HarmonicBalanceSettings;
 
@@ -23,8 +23,6 @@ pub const MAX_POINTS: usize = 1_000_000;
 pub const MAX_HARMONICS: usize = 1_000;
 /// Largest `--samples-per-harmonic`.
 pub const MAX_SAMPLES_PER_HARMONIC: usize = 10_000;
-/// Most time steps `--verify` marches for one point.
-pub const MAX_VERIFY_STEPS: f64 = 1e6;
 
 /// The flags that set a value of a `--system` shorthand, refused with `--assembly`.
 const SHORTHAND_VALUES: [&str; 5] = [
@@ -141,7 +139,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         dogleg: false,
         fail_fast: None,
         retry_depth: None,
-        max_failures: BackboneOptions::default().max_consecutive_failures,
+        max_failures: MAX_CONSECUTIVE_FAILURES,
         selection: Selection::FirstConverged,
         serial: false,
         out: None,

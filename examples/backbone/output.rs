@@ -1,22 +1,20 @@
-//! The CSV output: its header, one row per point, the `--verify` columns and the signature
-//! columns (contact intervals, subharmonic share), last so that every other column keeps its
-//! place.
+//! The CSV output: its header, one row per point, the `--verify` columns, the signature
+//! columns (contact intervals, subharmonic share) and the label columns, last so that every
+//! other column keeps its place.
 
-use crate::args::MAX_VERIFY_STEPS;
 use nonsmooth_modes::branches::{BackbonePoint, PointStatus};
 use nonsmooth_modes::continuation::Event;
 use nonsmooth_modes::modal::{contact_intervals, subharmonic_share};
 use nonsmooth_modes::reference::ClampedFirstMode;
 use nonsmooth_modes::system::NonsmoothSystem;
-use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
-use std::f64::consts::PI;
 use std::io::Write;
 use std::ops::ControlFlow;
 
 pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energy_normalized,converged,status,residual_norm,iterations,step_size,event,parameter";
 
 /// The whole header: [`HEADER`], the `--verify` columns if `verify`, then
-/// `contacts_per_period`, and `subharmonic_share` for a subharmonic order `K > 1`.
+/// `contacts_per_period`, `subharmonic_share` for a subharmonic order `K > 1`, and
+/// `label,branch,dominant_harmonic`.
 pub fn header(verify: bool, subharmonic: usize) -> String {
     let mut header = HEADER.to_string();
     if verify {
@@ -26,6 +24,7 @@ pub fn header(verify: bool, subharmonic: usize) -> String {
     if subharmonic > 1 {
         header.push_str(",subharmonic_share");
     }
+    header.push_str(",label,branch,dominant_harmonic");
     header
 }
 
@@ -62,7 +61,11 @@ impl Sink<'_> {
                 String::new()
             })
         };
-        let contacts = contact_intervals(problem, &p.x, p.omega).map(|c| c.iter().sum::<usize>());
+        // A converged point carries its contact count; the others are counted here.
+        let contacts = match &p.character {
+            Some(c) => Ok(c.contacts.iter().sum::<usize>()),
+            None => contact_intervals(problem, &p.x, p.omega).map(|c| c.iter().sum::<usize>()),
+        };
         let mut cells = format!(
             ",{}",
             cell(contacts.map(|c| c.to_string()), "contacts_per_period")
@@ -82,36 +85,43 @@ impl Sink<'_> {
         cells
     }
 
-    /// `periodicity_defect,displacement_defect,max_penetration` of a point, or empty cells.
-    fn verification(&self, problem: &NonsmoothSystem, p: &BackbonePoint) -> String {
+    /// `periodicity_defect,displacement_defect,max_penetration` of a point (the library's
+    /// time-domain check of the run), or empty cells where it was not checked.
+    fn verification(&self, p: &BackbonePoint) -> String {
         if !self.verify {
             return String::new();
         }
-        let options = PeriodicityOptions {
-            adjust_grid: true,
-            ..Default::default()
-        };
-        let steps = 2.0 * PI / p.omega / options.dt;
-        if steps > MAX_VERIFY_STEPS {
-            eprintln!(
-                "backbone: verification of step {} skipped: its march of {steps:.3e} time steps \
-                 is over the example's limit of {MAX_VERIFY_STEPS:.0e}",
-                p.step
-            );
-            return ",,,".to_string();
-        }
-        let (system, basis) = (problem.system(), problem.basis());
-        let report = periodicity_check(system, basis, &p.x, p.omega, &options);
-        match report {
-            Ok(r) => format!(
+        match (p.time_domain, p.converged) {
+            (Some(r), _) => format!(
                 ",{:.6e},{:.6e},{:.6e}",
                 r.defect, r.displacement_defect, r.max_penetration
             ),
-            Err(e) => {
-                eprintln!("backbone: verification of step {} failed: {e}", p.step);
+            (None, true) => {
+                eprintln!(
+                    "backbone: step {} not checked in the time domain (its march is over the \
+                     check's budget, or failed): unverified",
+                    p.step
+                );
                 ",,,".to_string()
             }
+            (None, false) => ",,,".to_string(),
         }
+    }
+
+    /// `,label,branch,dominant_harmonic` of a point (label and harmonic empty for a point
+    /// that did not converge).
+    fn label(p: &BackbonePoint) -> String {
+        let label = p
+            .label
+            .as_ref()
+            .map(ToString::to_string)
+            .unwrap_or_default();
+        let harmonic = p
+            .character
+            .as_ref()
+            .map(|c| c.dominant_harmonic.to_string())
+            .unwrap_or_default();
+        format!(",{label},{},{harmonic}", p.branch)
     }
 
     /// Writes the row of `p`, a point of `problem` (whose system is the one at the point's
@@ -133,10 +143,10 @@ impl Sink<'_> {
                 p.step, p.period, p.energy_normalized, p.step_size
             );
         }
-        let verification = self.verification(problem, p);
+        let verification = self.verification(p);
         let signature = self.signature(problem, p);
         let line = format!(
-            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}{}",
+            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}{}{}",
             p.step,
             p.period,
             p.omega,
@@ -156,6 +166,7 @@ impl Sink<'_> {
             },
             verification,
             signature,
+            Self::label(p),
         );
         match writeln!(self.out, "{line}") {
             Ok(()) => ControlFlow::Continue(()),

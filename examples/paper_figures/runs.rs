@@ -4,18 +4,32 @@
 
 use crate::common::{settings, Ctx, Res, GAP};
 use nonsmooth_modes::branches::{
-    arclength_backbone, backbone, energy_backbone, genuine_subharmonic_backbone,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
-    PeriodGrid, PointStatus, StallEscape,
+    compute, ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions,
+    Method, PeriodGrid, PointStatus, Request,
 };
 use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{energy, grazing_energy};
 use nonsmooth_modes::reference::ClampedFamily;
-use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, SolveInfo};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, SolveInfo, Solver};
 use nonsmooth_modes::system::BarSystem;
 use std::f64::consts::PI;
-use std::ops::ControlFlow;
+
+/// The request of `method` for NSM `mode` sub `subharmonic` with `m` harmonics, solved by
+/// `solver`.
+fn request(
+    m: usize,
+    (mode, subharmonic): (usize, usize),
+    method: Method,
+    solver: Solver,
+) -> Request {
+    Request {
+        settings: settings(m),
+        method,
+        solver: Some(solver),
+        ..Request::new(mode).subharmonic(subharmonic)
+    }
+}
 
 /// Exact `E/E_g` of a clamped-bar branch: an exact family, on its `subharmonic`-th branch.
 #[derive(Clone, Copy)]
@@ -104,7 +118,7 @@ pub struct Branch<'a> {
     /// Steps of the period grid.
     pub steps: usize,
     /// For a subharmonic: follow the genuinely `T`-periodic branch that leaves the repeated
-    /// one ([`genuine_subharmonic_backbone`]) instead of the repeated branch.
+    /// one ([`Method::GenuineSubharmonic`]) instead of the repeated branch.
     pub genuine: bool,
 }
 
@@ -141,18 +155,15 @@ impl<'a> Branch<'a> {
 /// NSM `mode` of `system` with `m` harmonics, continued in the energy level from the mode's
 /// own grazing energy to 300 times it ([`EnergyGrid::for_mode`]).
 pub fn energy_run(system: &BarSystem, m: usize, label: &str, mode: usize) -> Res<Run> {
-    let options = EnergyBackboneOptions {
-        levels: EnergyGrid::for_mode(system, mode)?,
-        mode,
-        ..Default::default()
-    };
-    let points = energy_backbone(system, settings(m), &options, SemismoothNewton::default())?;
-    let ok = points.iter().filter(|p| p.converged).count();
+    let options = EnergyBackboneOptions::for_mode(system, mode, 1)?;
+    let method = Method::Energy(options);
+    let points = compute(system, &request(m, (mode, 1), method, Solver::default()))?;
+    let ok = points.converged().count();
     println!(
         "    {label:<28} m = {m:<3} E/E_g {:.3} -> {:.3}: {ok}/{} converged",
         options.levels.start,
         options.levels.end,
-        points.len()
+        points.points.len()
     );
     Ok(Run {
         label: label.to_string(),
@@ -165,30 +176,30 @@ pub fn energy_run(system: &BarSystem, m: usize, label: &str, mode: usize) -> Res
 /// Follows `branch` of `system` with `m` harmonics, visiting the whole grid.
 pub fn run(system: &BarSystem, m: usize, branch: &Branch<'_>) -> Res<Run> {
     let (start, end) = branch.periods;
+    let grid = PeriodGrid {
+        start,
+        end,
+        steps: branch.steps,
+    };
     let options = BackboneOptions {
-        grid: PeriodGrid {
-            start,
-            end,
-            steps: branch.steps,
-        },
-        mode: branch.mode,
-        subharmonic: branch.subharmonic,
         // Visit the whole grid: failed stretches (near resonances) are reported, not fatal.
         max_consecutive_failures: usize::MAX,
-        ..Default::default()
+        ..BackboneOptions::on_grid(grid, branch.mode, branch.subharmonic)
     };
-    let points = if branch.genuine {
+    let (method, solver) = if branch.genuine {
         // As the `backbone` example: each step starts from a converged neighbour.
         let solver = SemismoothNewton::new(NewtonOptions::fail_fast())?;
-        genuine_subharmonic_backbone(system, settings(m), &options, solver)?
+        (Method::GenuineSubharmonic(options), Solver::Newton(solver))
     } else {
-        backbone(system, settings(m), &options, SemismoothNewton::default())?
+        (Method::PeriodGrid(options), Solver::default())
     };
-    let ok = points.iter().filter(|p| p.converged).count();
+    let order = (branch.mode, branch.subharmonic);
+    let points = compute(system, &request(m, order, method, solver))?;
+    let ok = points.converged().count();
     println!(
         "    {:<28} m = {m:<3} T {start:.4} -> {end:.4}: {ok}/{} converged",
         branch.label,
-        points.len()
+        points.points.len()
     );
     Ok(Run {
         label: branch.label.to_string(),
@@ -209,30 +220,19 @@ pub fn arclength_run(
     w1: f64,
 ) -> Res<Run> {
     let (start, end) = branch.periods;
-    let mut points = Vec::new();
+    let range = (2.0 * PI / (start + 0.01), 2.0 * PI / end);
+    let order = (branch.mode, branch.subharmonic);
     let options = ArclengthBackboneOptions {
-        start_period: start,
-        omega_range: (2.0 * PI / (start + 0.01), 2.0 * PI / end),
         arclength: ArclengthOptions {
             max_steps: if ctx.quick { 150 } else { 2000 },
             ..Default::default()
         },
-        escape: Some(StallEscape::default()),
-        mode: branch.mode,
-        subharmonic: branch.subharmonic,
-        ..Default::default()
+        ..ArclengthBackboneOptions::seeded_at(start, range, order)
     };
     let label = branch.label;
-    let (_, branch) = arclength_backbone(
-        system,
-        settings(m),
-        &options,
-        SemismoothNewton::default(),
-        |p| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        },
-    )?;
+    let method = Method::Arclength(options);
+    let run = compute(system, &request(m, order, method, Solver::default()))?;
+    let points = run.points;
     let reached = points
         .iter()
         .map(|p| p.omega / w1)
@@ -240,8 +240,8 @@ pub fn arclength_run(
     println!(
         "    {label} (m = {m}): {} points, {} rejections, end {:?}, max Omega/omega_1 = {reached:.3}",
         points.len(),
-        branch.rejections,
-        match &branch.end {
+        run.rejected_steps,
+        match &run.end {
             EndReason::ParameterOutOfRange { .. } => "range".to_string(),
             other => format!("{other:?}"),
         }
@@ -296,5 +296,9 @@ pub fn solved_point(
         x,
         step_size: 0.0,
         events: Vec::new(),
+        branch: 0,
+        time_domain: None,
+        character: None,
+        label: None,
     })
 }

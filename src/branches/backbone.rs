@@ -84,6 +84,10 @@ impl BackboneOptions {
 /// `E_g` (the default [`BackboneOptions::trivial_energy`]).
 pub const TRIVIAL_ENERGY: f64 = 1e-6;
 
+/// Consecutive failed steps after which a period grid stops, stalled (the default
+/// [`BackboneOptions::max_consecutive_failures`]).
+pub const MAX_CONSECUTIVE_FAILURES: usize = 40;
+
 impl BackboneOptions {
     /// The library's settings of a period grid `grid` for NSM `mode` sub `subharmonic`:
     /// constant predictor, 40 consecutive failures, one retry, the first converged solution,
@@ -94,7 +98,7 @@ impl BackboneOptions {
             mode,
             subharmonic,
             predictor: Predictor::Constant,
-            max_consecutive_failures: 40,
+            max_consecutive_failures: MAX_CONSECUTIVE_FAILURES,
             retry_depth: 1,
             selection: Selection::FirstConverged,
             trivial_energy: TRIVIAL_ENERGY,
@@ -322,6 +326,23 @@ pub struct ArclengthBackboneOptions {
 }
 
 impl ArclengthBackboneOptions {
+    /// The arclength backbone over the range of a period grid: seeded at its first period,
+    /// towards its last, inside the frequencies of its periods widened by `0.1 %` at the
+    /// first period's end (so that the walk back to the first period ends beyond it).
+    pub fn over_grid(options: &BackboneOptions) -> Self {
+        let PeriodGrid { start, end, .. } = options.grid;
+        let (first, last) = (2.0 * PI / start, 2.0 * PI / end);
+        let range = if first <= last {
+            (first * 0.999, last)
+        } else {
+            (last, first * 1.001)
+        };
+        let mut arclength = Self::seeded_at(start, range, (options.mode, options.subharmonic));
+        arclength.arclength.direction = if end < start { 1.0 } else { -1.0 };
+        arclength.trivial_energy = options.trivial_energy;
+        arclength
+    }
+
     /// The library's settings of an arclength backbone of NSM `mode` sub `subharmonic` seeded
     /// at `start_period` inside `omega_range`: the driver's default options, the default
     /// stall escape, [`TRIVIAL_ENERGY`], no switch. [`ArclengthBackboneOptions::for_mode`]

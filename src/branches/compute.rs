@@ -72,7 +72,7 @@ pub fn compute_observed(
     let problem = NonsmoothSystem::new(system, request.settings)?;
     let (plan, method, auto) = resolve(system, request)?;
     let solver = request.solver_for(&method)?;
-    let mut annotator = Annotator::new(&problem, request, observer)?;
+    let mut annotator = Annotator::new(&problem, request, observer);
     let settings = request.settings;
     let see = |p: &BackbonePoint| annotator.point(p);
     let (grazing_energy, end, rejected) = match plan {
@@ -165,7 +165,7 @@ fn resolve(
         ..*o
     };
     Ok(match &request.method {
-        Method::Auto => return auto(system, request),
+        Method::Auto(grid) => return auto(system, request, *grid),
         Method::PeriodGrid(o) => (Plan::Grid(grid(o), None), Method::PeriodGrid(grid(o)), None),
         Method::GenuineSubharmonic(o) => (
             Plan::Genuine(grid(o)),
@@ -195,13 +195,18 @@ fn resolve(
     })
 }
 
-/// What [`Method::Auto`] runs on `system` ([`compute`]).
+/// What [`Method::Auto`] runs on `system` from the period grid `given` ([`compute`]).
 fn auto(
     system: &BarSystem,
     request: &Request,
+    given: Option<BackboneOptions>,
 ) -> Result<(Plan, Method, Option<AutoChoice>), Error> {
     let (mode, order) = (request.mode, request.subharmonic);
-    let grid = BackboneOptions::for_mode(system, mode, order)?;
+    let grid = BackboneOptions {
+        mode,
+        subharmonic: order,
+        ..given.map_or_else(|| BackboneOptions::for_mode(system, mode, order), Ok)?
+    };
     if order >= 2 {
         let choice = Some(AutoChoice::Subharmonic);
         return Ok((
@@ -235,7 +240,7 @@ fn auto(
             choice,
         ));
     }
-    let options = ArclengthBackboneOptions::for_mode(system, mode, order)?;
+    let options = ArclengthBackboneOptions::over_grid(&grid);
     let entered_at = 2.0 * PI / start.omega;
     Ok((
         Plan::Arclength(options),

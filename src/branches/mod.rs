@@ -19,7 +19,8 @@ mod subharmonic;
 mod switch;
 
 pub use backbone::{
-    ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PeriodGrid, TRIVIAL_ENERGY,
+    ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PeriodGrid,
+    MAX_CONSECUTIVE_FAILURES, TRIVIAL_ENERGY,
 };
 pub use compute::{compute, compute_observed};
 pub use convergence::{convergence_study, ConvergenceEntry};

@@ -4,8 +4,10 @@
 use crate::continuation::{EndReason, Event, Point};
 use crate::error::{ContinuationError, SettingsError, SolveError};
 use crate::fourier::Basis;
+use crate::modal::{Character, Label};
 use crate::solution::Solution;
 use crate::system::NonsmoothSystem;
+use crate::verify::PeriodicityReport;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -42,10 +44,15 @@ pub struct BackbonePoint {
     /// Index of the branch the point lies on within its run: 0 for the branch the run
     /// started on, one more after each jump (a stall escape, a switch at a branch point).
     pub branch: usize,
-    /// Displacement defect of the time-domain check after one period, relative to the
-    /// motion's displacement, where a check was asked
+    /// The time-domain check of a converged point, where one was asked
     /// ([`Request::check`](crate::branches::Request::check)) and could run.
-    pub displacement_defect: Option<f64>,
+    pub time_domain: Option<PeriodicityReport>,
+    /// What a converged point's motion is like: contacts and grazings per period, energy
+    /// shares by bar and harmonic, dominant harmonic and linear modes.
+    pub character: Option<Character>,
+    /// Which branch of the mode a converged point lies on: skeleton, internal resonance,
+    /// subharmonic, or unverified ([`Label`]).
+    pub label: Option<Label>,
 }
 
 impl BackbonePoint {
@@ -99,7 +106,9 @@ impl BackbonePoint {
             step_size: p.step_size,
             events: p.events.clone(),
             branch: 0,
-            displacement_defect: None,
+            time_domain: None,
+            character: None,
+            label: None,
         }
     }
 }

@@ -18,12 +18,13 @@ use crate::verify::PeriodicityOptions;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Method {
-    /// Let the system decide, as [`compute`](crate::branches::compute) documents: a genuine
-    /// subharmonic for an order `K >= 2`, otherwise the period grid where the branch can be
-    /// entered at the grid's first period, and pseudo-arclength (which walks the branch
-    /// back to it) where it can be entered only at a higher frequency. The result records
-    /// the choice ([`AutoChoice`]).
-    Auto,
+    /// Let the system decide, from the period grid given (`None`: the system's own,
+    /// [`BackboneOptions::for_mode`]), as [`compute`](crate::branches::compute) documents: a
+    /// genuine subharmonic for an order `K >= 2`, otherwise the period grid where the branch
+    /// can be entered at the grid's first period, and pseudo-arclength over the grid's range
+    /// (walking the branch back to its first period) where it can be entered only at a higher
+    /// frequency. The result records the choice ([`AutoChoice`]).
+    Auto(Option<BackboneOptions>),
     /// Sequential continuation over a grid of periods ([`BackboneOptions::for_mode`]).
     PeriodGrid(BackboneOptions),
     /// Pseudo-arclength continuation in `Omega` with the stall escape
@@ -45,7 +46,7 @@ impl Method {
     /// `energy` or `genuine-subharmonic`.
     pub fn name(&self) -> &'static str {
         match self {
-            Self::Auto => "auto",
+            Self::Auto(_) => "auto",
             Self::PeriodGrid(_) => "period-grid",
             Self::Arclength(_) => "arclength",
             Self::Switch(..) => "switch",
@@ -85,6 +86,10 @@ pub struct TimeDomainCheck {
     /// A point whose displacement defect after one period exceeds this is labelled
     /// [`Label::Unverified`](crate::modal::Label::Unverified).
     pub max_displacement_defect: f64,
+    /// Most time steps one point's march may take: a point whose march would take more is
+    /// not checked, and so is unverified (a budget of time per point; the march itself
+    /// refuses what would exceed its memory).
+    pub max_steps: f64,
 }
 
 impl TimeDomainCheck {
@@ -93,11 +98,13 @@ impl TimeDomainCheck {
     pub const MAX_DISPLACEMENT_DEFECT: f64 = 0.05;
     /// Cells per shortest travel time by default (the paper's clamped bar: `dt = 1/400`).
     pub const CELLS_PER_TRAVEL: f64 = 400.0;
+    /// Most time steps of one point's march by default: a second or so.
+    pub const MAX_STEPS: f64 = 1e6;
 
     /// The check of `system`: a time step of `1/400` of the shortest travel time `l_b / c_b`
     /// of its bars (so that the cell count per bar does not depend on the units), on a
-    /// grid adjusted to commensurate cells where one is near, one period, and
-    /// [`Self::MAX_DISPLACEMENT_DEFECT`].
+    /// grid adjusted to commensurate cells where one is near, one period,
+    /// [`Self::MAX_DISPLACEMENT_DEFECT`] and [`Self::MAX_STEPS`].
     pub fn for_system(system: &BarSystem) -> Self {
         let travel = system
             .bars()
@@ -111,6 +118,7 @@ impl TimeDomainCheck {
                 ..PeriodicityOptions::default()
             },
             max_displacement_defect: Self::MAX_DISPLACEMENT_DEFECT,
+            max_steps: Self::MAX_STEPS,
         }
     }
 }
@@ -138,14 +146,15 @@ pub struct Request {
 }
 
 impl Request {
-    /// The main branch of NSM `mode` with the default settings, [`Method::Auto`], the
+    /// The main branch of NSM `mode` with the default settings, [`Method::Auto`] on the
+    /// system's grid, the
     /// method's solver, no speculation and no time-domain check.
     pub fn new(mode: usize) -> Self {
         Self {
             mode,
             subharmonic: 1,
             settings: HarmonicBalanceSettings::default(),
-            method: Method::Auto,
+            method: Method::Auto(None),
             solver: None,
             speculation: None,
             check: None,

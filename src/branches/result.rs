@@ -6,9 +6,11 @@ use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
+use crate::modal::{character, label, natural_frequencies, nearest_mode, ContactState};
 use crate::solution::Solution;
 use crate::system::NonsmoothSystem;
 use crate::verify::periodicity_check;
+use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// The branches of a nonsmooth mode that one request computed: every point (converged or
@@ -80,32 +82,35 @@ impl ModeBranches {
     }
 }
 
-/// Annotates each point a driver hands over (branch index, time-domain defect) before the
-/// user's observer sees it, and keeps it.
+/// Annotates each point a driver hands over (branch index, character, time-domain check,
+/// label) before the user's observer sees it, and keeps it.
 pub(crate) struct Annotator<O> {
     problem: NonsmoothSystem,
     check: Option<TimeDomainCheck>,
+    order: usize,
     observer: O,
     points: Vec<BackbonePoint>,
     branch: usize,
     converged: usize,
+    /// Open-contact natural frequencies up to `natural_up_to` (computed as points need).
+    natural: Vec<f64>,
+    natural_up_to: f64,
 }
 
 impl<O: BackboneObserver> Annotator<O> {
     /// The annotator of the points of `problem` asked by `request`.
-    pub(crate) fn new(
-        problem: &NonsmoothSystem,
-        request: &Request,
-        observer: O,
-    ) -> Result<Self, SettingsError> {
-        Ok(Self {
+    pub(crate) fn new(problem: &NonsmoothSystem, request: &Request, observer: O) -> Self {
+        Self {
             problem: problem.clone(),
             check: request.check,
+            order: request.subharmonic,
             observer,
             points: Vec::new(),
             branch: 0,
             converged: 0,
-        })
+            natural: Vec::new(),
+            natural_up_to: 0.0,
+        }
     }
 
     /// Annotates `point`, keeps it and shows it to the observer.
@@ -120,7 +125,7 @@ impl<O: BackboneObserver> Annotator<O> {
         point.branch = self.branch;
         if point.converged {
             self.converged += 1;
-            point.displacement_defect = self.defect(&point);
+            self.describe(&mut point);
         }
         let flow = self.observer.point(&point);
         self.points.push(point);
@@ -137,14 +142,64 @@ impl<O: BackboneObserver> Annotator<O> {
         self.converged
     }
 
-    /// The displacement defect of `point` after one period, if a check was asked and the
-    /// march could run.
-    fn defect(&self, point: &BackbonePoint) -> Option<f64> {
-        let check = self.check?;
-        let (system, basis) = (self.problem.system(), self.problem.basis());
-        periodicity_check(system, basis, &point.x, point.omega, &check.options)
-            .ok()
-            .map(|r| r.displacement_defect)
+    /// The character, time-domain check and label of a converged point. A point whose
+    /// character cannot be computed (its motion overflows) keeps none and no label; a check
+    /// that was asked but could not run (a march beyond the cost bound) leaves the point
+    /// unverified.
+    fn describe(&mut self, point: &mut BackbonePoint) {
+        let (x, omega) = (&point.x, point.omega);
+        let Ok(mut described) = character(&mut self.problem, x, omega, &self.natural) else {
+            return;
+        };
+        // The natural frequencies are computed only as far as the points name modes: a
+        // skeleton point needs them just beyond its fundamental, a resonance further.
+        if self.extend_natural_frequencies(described.named_frequencies(omega)) {
+            described.name_modes(omega, &self.natural);
+        }
+        let verified = self.check.map(|check| {
+            let (system, basis) = (self.problem.system(), self.problem.basis());
+            let options = &check.options;
+            let steps = 2.0 * PI / omega / options.dt * options.periods as f64;
+            point.time_domain = (steps <= check.max_steps)
+                .then(|| periodicity_check(system, basis, x, omega, options).ok())
+                .flatten();
+            point
+                .time_domain
+                .is_some_and(|r| r.displacement_defect <= check.max_displacement_defect)
+        });
+        let natural = &self.natural;
+        point.label = label(&described, self.order, omega, natural, verified).ok();
+        point.character = Some(described);
+    }
+
+    /// Extends the open-contact natural frequencies until the nearest of each frequency `f`
+    /// of `named` is known to be right: the list is complete up to `U` and `f + d <= U`, `d`
+    /// the distance from `f` to the nearest listed mode (a mode beyond `U` is farther).
+    /// Returns whether the list changed. The first extension reaches a mode spacing `pi c / l`
+    /// of the shortest-period bar beyond `f`; each further one at least a quarter more, so a
+    /// run scans a few times at most. A scan that fails (too long) keeps the list it had:
+    /// labels then name the nearest mode found, and the scan is not repeated.
+    fn extend_natural_frequencies(&mut self, named: impl Iterator<Item = f64> + Clone) -> bool {
+        let system = self.problem.system();
+        let spacing = (system.bars().iter())
+            .map(|b| PI * b.wave_speed() / b.length())
+            .fold(f64::INFINITY, f64::min);
+        let mut changed = false;
+        for _ in 0..8 {
+            let need = (named.clone())
+                .map(|f| f + nearest_mode(f, &self.natural).map_or(spacing, |(_, w)| (w - f).abs()))
+                .fold(0.0, f64::max);
+            if need <= self.natural_up_to {
+                break;
+            }
+            let up_to = need.max(1.25 * self.natural_up_to);
+            if let Ok(modes) = natural_frequencies(system, ContactState::Open, up_to) {
+                self.natural = modes.iter().map(|m| m.omega).collect();
+                changed = true;
+            }
+            self.natural_up_to = up_to;
+        }
+        changed
     }
 
     /// The result of the run.

@@ -12,7 +12,7 @@ use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
 use crate::modal::energy::{energy_of, Conditions};
 use crate::modal::inputs::check_frequency_of;
-use crate::system::rows::{dot, HarmonicRows};
+use crate::system::rows::{dot, HarmonicRows, RowsScratch};
 use crate::system::{BarSystem, NonsmoothSystem};
 
 /// Which linear state the unilateral conditions take.
@@ -34,36 +34,75 @@ pub struct LinearMode {
     pub shapes: Vec<Vec<f64>>,
 }
 
-/// Row-major square matrix of the linear system in `state` at `omega`.
-fn state_matrix(system: &BarSystem, omega: f64, state: ContactState) -> (Vec<f64>, usize) {
-    let rows = HarmonicRows::new(system, omega);
-    let n = rows.unknowns();
-    let mut m = Vec::with_capacity(n * n);
-    for r in 0..rows.linear_count() {
-        m.extend_from_slice(rows.linear_row(r));
-    }
-    for l in 0..system.contact_count() {
-        m.extend_from_slice(match state {
-            ContactState::Open => rows.force_row(l),
-            ContactState::Closed => rows.gap_row(l),
-        });
-    }
-    // Scale each row to unit norm so that the singular-value ratio measures degeneracy,
-    // not the growth of `k sin(kl)` entries with frequency.
-    for row in m.chunks_mut(n) {
-        let s = dot(row, row).sqrt();
-        if s > 0.0 {
-            row.iter_mut().for_each(|v| *v /= s);
-        }
-    }
-    (m, n)
+/// The linear system of one harmonic in `state`, rebuilt at each frequency in the same
+/// storage: a scan evaluates it at thousands of frequencies.
+struct StateMatrix<'a> {
+    system: &'a BarSystem,
+    state: ContactState,
+    rows: HarmonicRows,
+    scratch: RowsScratch,
+    /// Row-major, `n x n`.
+    matrix: Vec<f64>,
+    singular: Vec<f64>,
 }
 
+impl<'a> StateMatrix<'a> {
+    fn new(system: &'a BarSystem, state: ContactState) -> Self {
+        Self {
+            system,
+            state,
+            rows: HarmonicRows::new(system, 0.0),
+            scratch: RowsScratch::default(),
+            matrix: Vec::new(),
+            singular: Vec::new(),
+        }
+    }
+
+    /// The row-major square matrix at `omega` and its size.
+    fn at(&mut self, omega: f64) -> (&[f64], usize) {
+        let (system, rows) = (self.system, &mut self.rows);
+        rows.rebuild(system, omega, &mut self.scratch);
+        let n = rows.unknowns();
+        self.matrix.clear();
+        for r in 0..rows.linear_count() {
+            self.matrix.extend_from_slice(rows.linear_row(r));
+        }
+        for l in 0..system.contact_count() {
+            self.matrix.extend_from_slice(match self.state {
+                ContactState::Open => rows.force_row(l),
+                ContactState::Closed => rows.gap_row(l),
+            });
+        }
+        // Scale each row to unit norm so that the singular-value ratio measures degeneracy,
+        // not the growth of `k sin(kl)` entries with frequency.
+        for row in self.matrix.chunks_mut(n) {
+            let s = dot(row, row).sqrt();
+            if s > 0.0 {
+                row.iter_mut().for_each(|v| *v /= s);
+            }
+        }
+        (&self.matrix, n)
+    }
+
+    /// `sigma_min / sigma_max` of the matrix at `omega`: zero where it is singular.
+    fn singularity(&mut self, omega: f64) -> f64 {
+        let n = self.at(omega).1;
+        self.singular.resize(n, 0.0);
+        singular_values_small(&self.matrix, n, n, &mut self.singular);
+        self.singular[n - 1] / self.singular[0]
+    }
+}
+
+/// Row-major square matrix of the linear system in `state` at `omega`.
+fn state_matrix(system: &BarSystem, omega: f64, state: ContactState) -> (Vec<f64>, usize) {
+    let mut matrix = StateMatrix::new(system, state);
+    let (m, n) = matrix.at(omega);
+    (m.to_vec(), n)
+}
+
+/// `sigma_min / sigma_max` of `D(omega)`: zero where it is singular.
 fn singularity(system: &BarSystem, omega: f64, state: ContactState) -> f64 {
-    let (m, n) = state_matrix(system, omega, state);
-    let mut s = vec![0.0; n];
-    singular_values_small(&m, n, n, &mut s);
-    s[n - 1] / s[0]
+    StateMatrix::new(system, state).singularity(omega)
 }
 
 /// Largest number of scan samples of [`natural_frequencies`] (about 1000 modes of one bar).
@@ -103,15 +142,16 @@ pub fn natural_frequencies(
         });
     }
     let steps = samples.ceil() as usize + 1;
+    let mut matrix = StateMatrix::new(system, state);
     let values: Vec<f64> = (0..=steps)
-        .map(|i| singularity(system, (i as f64 + 0.5) * h, state))
+        .map(|i| matrix.singularity((i as f64 + 0.5) * h))
         .collect();
     let mut modes = Vec::new();
     for i in 1..values.len() - 1 {
         if values[i] <= values[i - 1] && values[i] < values[i + 1] {
             let (lo, hi) = ((i as f64 - 0.5) * h, (i as f64 + 1.5) * h);
-            let omega = golden_minimum(|w| singularity(system, w, state), lo, hi);
-            if omega > omega_max || singularity(system, omega, state) > 1e-8 {
+            let omega = golden_minimum(|w| matrix.singularity(w), lo, hi);
+            if omega > omega_max || matrix.singularity(omega) > 1e-8 {
                 continue;
             }
             modes.push(LinearMode {
@@ -137,7 +177,7 @@ pub fn rigid_body_modes(system: &BarSystem, state: ContactState) -> Option<Linea
     })
 }
 
-fn golden_minimum(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+fn golden_minimum(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
     let (mut fc, mut fd) = (f(c), f(d));

@@ -3,6 +3,7 @@
 //! signature (harmonic content, contact intervals per period) and diagnostics, and whether an
 //! assembly holds every bar. How branches of modes are found is [`crate::branches`].
 
+mod character;
 pub mod diagnostics;
 pub(crate) mod drift;
 pub mod energy;
@@ -11,6 +12,7 @@ pub(crate) mod inputs;
 pub mod linear;
 pub mod signature;
 
+pub use character::{character, label, nearest_mode, Character, Label, GRAZING_TOLERANCE};
 pub use diagnostics::{diagnose, displacement_grid, end_history, law_history, PointDiagnostics};
 pub use drift::{check_held, drifting_bars};
 pub use energy::{energy, energy_at, energy_gradient};

@@ -35,6 +35,7 @@ impl Default for PeriodicityOptions {
 
 /// Outcome of a periodicity check.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PeriodicityReport {
     /// Period `T` of the orbit.
     pub period: f64,

@@ -261,7 +261,9 @@ impl Judge {
                 step_size: -period / 800.0,
                 events: Vec::new(),
                 branch: 0,
-                displacement_defect: None,
+                time_domain: None,
+                character: None,
+                label: None,
             };
             if see(point).is_break() {
                 return Walk::Stopped;

@@ -233,11 +233,21 @@ pub fn contact_intervals<B: Basis>(
 
 /// For each law, whether each of the `N` instants of the full grid is in contact (the
 /// criterion of [`contact_intervals`]).
-fn contact_samples<B: Basis>(
+pub(crate) fn contact_samples<B: Basis>(
     problem: &mut NonsmoothSystem<B>,
     x: &[f64],
     omega: f64,
 ) -> Result<Vec<Vec<bool>>, SettingsError> {
+    let laws = contact_and_gap_samples(problem, x, omega)?;
+    Ok(laws.into_iter().map(|(contact, _)| contact).collect())
+}
+
+/// For each law, [`contact_samples`] and the gap history it was computed from.
+pub(crate) fn contact_and_gap_samples<B: Basis>(
+    problem: &mut NonsmoothSystem<B>,
+    x: &[f64],
+    omega: f64,
+) -> Result<Vec<(Vec<bool>, Vec<f64>)>, SettingsError> {
     check_motion(problem, x, omega)?;
     // The histories first: they move the problem to `omega`, the laws then borrow it.
     let histories: Vec<(Vec<f64>, Vec<f64>)> = (0..problem.system().contact_count())
@@ -254,7 +264,7 @@ fn contact_samples<B: Basis>(
     let (mut values, mut d_gap, mut d_force) =
         (vec![0.0; samples], vec![0.0; samples], vec![0.0; samples]);
     let a_c = problem.complementarity();
-    let laws = problem.system().laws().zip(&histories);
+    let laws = problem.system().laws().zip(histories);
     Ok(laws
         .map(|(law, (gap, force))| {
             let out = LawSamples {
@@ -262,15 +272,15 @@ fn contact_samples<B: Basis>(
                 d_gap: &mut d_gap,
                 d_force: &mut d_force,
             };
-            law.sample(gap, force, a_c, 0.0, out);
-            d_gap.iter().map(|w| *w != 0.0).collect()
+            law.sample(&gap, &force, a_c, 0.0, out);
+            (d_gap.iter().map(|w| *w != 0.0).collect(), gap)
         })
         .collect())
 }
 
 /// The number of maximal runs of `true` in the periodic sequence `values` (the last value
 /// precedes the first): the rises from `false` to `true`, or 1 if every value is `true`.
-fn periodic_runs(values: &[bool]) -> usize {
+pub(crate) fn periodic_runs(values: &[bool]) -> usize {
     let Some(&last) = values.last() else {
         return 0;
     };

@@ -1,11 +1,11 @@
 use super::*;
 use crate::bar::Bar;
-use crate::branches::{backbone, BackboneOptions, PeriodGrid};
+use crate::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
 use crate::continuation::ContinuationProblem;
 use crate::fourier::CosineBasis;
 use crate::modal::energy::energy_at;
 use crate::reference::{clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode};
-use crate::solve::{SemismoothNewton, Structured};
+use crate::solve::Structured;
 use crate::system::HarmonicBalanceSettings;
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -195,15 +195,17 @@ fn the_clamped_bar_touches_once_per_period() {
         harmonics: 10,
         ..Default::default()
     };
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.9,
-            end: 3.7,
-            steps: 5,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.9,
+        end: 3.7,
+        steps: 5,
     };
-    let run = backbone(&system, settings, &options, SemismoothNewton::default()).unwrap();
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        ..Request::new(1)
+    };
+    let run = compute(&system, &request).unwrap();
     let p = run.points.iter().rev().find(|p| p.converged).unwrap();
     let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
     assert_eq!(
