@@ -122,9 +122,6 @@ fn omegas(system: &BarSystem, max: f64) -> Vec<f64> {
         .collect()
 }
 
-/// A clamped bar with a mass `m` at its free end vibrates at `omega tan(omega) = 1/m`: for
-/// `m = 2` the Robin-free frequencies of formulation §8; as `m -> 0`, the clamped-free ones.
-
 /// The points of the period grid `grid` of NSM 1 of `system`, with the full semismooth
 /// Newton.
 fn grid_points(
@@ -141,6 +138,8 @@ fn grid_points(
     compute(system, &request).unwrap().points
 }
 
+/// A clamped bar with a mass `m` at its free end vibrates at `omega tan(omega) = 1/m`: for
+/// `m = 2` the Robin-free frequencies of formulation §8; as `m -> 0`, the clamped-free ones.
 #[test]
 fn end_mass_frequencies() {
     let got = omegas(&clamped_with(mass_on_spring(2.0, 0.0)), 10.0);
