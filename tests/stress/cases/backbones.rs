@@ -16,7 +16,7 @@ use nonsmooth_modes::branches::{
     PeriodGrid, PointStatus, Request, SwitchAt, TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::{Rejection, SequentialOptions, Speculation};
-use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, contact_chain, ClampedFirstMode};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
@@ -174,10 +174,17 @@ pub(crate) fn arclength_backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResul
 
 /// `branches::compute_observed` with a random request: any method (`Auto` and the options
 /// derived from the system among them, or options drawn at random), mode, order, solver,
-/// speculation and time-domain check, on one of the paper's systems. Every run is stopped
-/// by its observer after a few steps, so that the system-derived grids stay cheap.
+/// speculation and time-domain check, on one of the paper's systems or the three-bar chain
+/// (whose floating bar makes `Auto` enter its branch at a shorter period). Every run is
+/// stopped by its observer after a few steps, so that the system-derived grids stay cheap.
 pub(crate) fn request_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
-    let system = reference_system(d, c)?;
+    let system = if d.flag("three-bar chain", 0.2) {
+        let gap = d.real("chain gap", 1e-4..=0.1);
+        let spring = d.real("chain spring", 0.05..=5.0);
+        typed(c, "contact_chain", contact_chain(3, gap, spring))?
+    } else {
+        reference_system(d, c)?
+    };
     let s = settings(d);
     let mode = d.size("mode", 1..=2);
     let subharmonic = d.size("subharmonic", 1..=3);
