@@ -11,18 +11,19 @@
 //! ```
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use nonsmooth_modes::branches::backbone_speculative_with;
-use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, ModeBranches, PeriodGrid, Request,
+};
 use nonsmooth_modes::continuation::{ContinuationProblem, Speculation};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{energy, energy_at};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::solve::Solver;
 use nonsmooth_modes::solve::{NewtonOptions, NonlinearSolver, Problem, SemismoothNewton};
-use nonsmooth_modes::sweep::{backbones, backbones_serial, Solver, SweepJob};
+use nonsmooth_modes::sweep::{backbones, backbones_serial, SweepJob};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::hint::black_box;
-use std::ops::ControlFlow;
 use std::time::Duration;
 
 const GAP: f64 = 1e-3;
@@ -36,31 +37,46 @@ fn settings(m: usize) -> HarmonicBalanceSettings {
 
 /// The backbone example's grid: 181 periods from 3.95 down to 3.05.
 fn full_grid() -> BackboneOptions {
-    BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.95,
-            end: 3.05,
-            steps: 181,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.05,
+        steps: 181,
+    };
+    BackboneOptions::on_grid(grid, 1, 1)
+}
+
+/// The period-grid request of `options` at `m` harmonics with `solver`.
+fn grid_request(m: usize, options: BackboneOptions, solver: Solver) -> Request {
+    Request {
+        settings: settings(m),
+        method: Method::PeriodGrid(options),
+        solver: Some(solver),
+        ..Request::new(options.mode)
     }
+}
+
+/// The period-grid run of `options` on `system` at `m` harmonics with `solver`.
+fn grid_run(
+    system: &BarSystem,
+    m: usize,
+    options: BackboneOptions,
+    solver: Solver,
+) -> ModeBranches {
+    compute(system, &grid_request(m, options, solver)).expect("a backbone")
 }
 
 /// The last two points of the backbone from `T = 3.95` to `3.9` at `m` harmonics (a state
 /// near the branch for the residual and Jacobian benches; consecutive converged points for
 /// the solve bench, at the `m` where there are two).
 fn two_points(system: &BarSystem, m: usize) -> (BackbonePoint, BackbonePoint) {
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.95,
-            end: 3.9,
-            steps: 11,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.9,
+        steps: 11,
     };
-    let points = backbone(system, settings(m), &options, SemismoothNewton::default())
-        .expect("short backbone");
-    let converged: Vec<_> = points.iter().filter(|p| p.converged).cloned().collect();
+    let options = BackboneOptions::on_grid(grid, 1, 1);
+    let points = grid_run(system, m, options, Solver::default());
+    let converged: Vec<_> = points.converged().cloned().collect();
     let pick = if converged.len() >= 2 {
         &converged
     } else {
@@ -130,19 +146,18 @@ fn whole_backbone(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(5));
     // The `backbone` example's solver: the fail-fast budget of sequential runs.
-    let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
+    let solver = Solver::Newton(SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap());
     for m in [20, 40, 80] {
         group.bench_with_input(BenchmarkId::new("serial", m), &m, |b, &m| {
-            b.iter(|| backbone(&system, settings(m), &options, solver).unwrap());
+            b.iter(|| grid_run(&system, m, options, solver));
         });
         // The same points with the first retry of failing steps on a worker thread.
-        group.bench_with_input(BenchmarkId::new("speculative", m), &m, |b, &m| {
-            b.iter(|| {
-                let see = |_: &BackbonePoint| ControlFlow::Continue(());
-                let spec = Speculation::default();
-                backbone_speculative_with(&system, settings(m), &options, spec, solver, see)
-                    .unwrap()
-            });
+        let speculative = Request {
+            speculation: Some(Speculation::default()),
+            ..grid_request(m, options, solver)
+        };
+        group.bench_with_input(BenchmarkId::new("speculative", m), &m, |b, _| {
+            b.iter(|| compute(&system, &speculative).unwrap());
         });
     }
     group.finish();
@@ -161,9 +176,7 @@ fn sweep(c: &mut Criterion) {
         ] {
             jobs.push(SweepJob {
                 system: system.clone(),
-                settings: settings(m),
-                options,
-                solver,
+                request: grid_request(m, options, solver),
             });
         }
     }

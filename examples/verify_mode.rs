@@ -16,12 +16,13 @@
 //! and penetration.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::backbone_with;
-use nonsmooth_modes::branches::{BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute_observed, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::Solver;
 use nonsmooth_modes::system::HarmonicBalanceSettings;
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use std::ops::ControlFlow;
@@ -64,9 +65,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     };
     let basis = settings.cosine_basis()?;
-    let options = BackboneOptions {
-        grid: PeriodGrid { start, end, steps },
-        ..Default::default()
+    let options = BackboneOptions::on_grid(PeriodGrid { start, end, steps }, 1, 1);
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(options),
+        solver: Some(Solver::default()),
+        ..Request::new(1)
     };
     let check = PeriodicityOptions {
         dt,
@@ -75,48 +79,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("period,energy_normalized,exact_energy_normalized,converged,residual_norm,defect,displacement_defect,initial_penetration,max_penetration,min_contact_force,energy_drift");
     let mut defects = Vec::new();
     let mut failure = None;
-    backbone_with(
-        &system,
-        settings,
-        &options,
-        SemismoothNewton::default(),
-        |p| {
-            let exact = if system_kind == "ds" {
-                format!(
-                    "{:.6}",
-                    ClampedFirstMode::new(gap, p.period).energy_normalized()
-                )
-            } else {
-                String::new()
-            };
-            match periodicity_check(&system, &basis, &p.x, p.omega, &check) {
-                Ok(r) => {
-                    if p.converged {
-                        defects.push((r.defect, r.displacement_defect));
-                    }
-                    println!(
-                        "{:.4},{:.6},{},{},{:.3e},{:.4e},{:.4e},{:.3e},{:.3e},{:.4e},{:.3e}",
-                        p.period,
-                        p.energy_normalized,
-                        exact,
-                        p.converged,
-                        p.residual_norm,
-                        r.defect,
-                        r.displacement_defect,
-                        r.initial_penetration / gap,
-                        r.max_penetration / gap,
-                        r.min_contact_force,
-                        r.energy_drift
-                    );
-                    ControlFlow::Continue(())
+    compute_observed(&system, &request, |p: &BackbonePoint| {
+        let exact = if system_kind == "ds" {
+            format!(
+                "{:.6}",
+                ClampedFirstMode::new(gap, p.period).energy_normalized()
+            )
+        } else {
+            String::new()
+        };
+        match periodicity_check(&system, &basis, &p.x, p.omega, &check) {
+            Ok(r) => {
+                if p.converged {
+                    defects.push((r.defect, r.displacement_defect));
                 }
-                Err(e) => {
-                    failure = Some(e);
-                    ControlFlow::Break(())
-                }
+                println!(
+                    "{:.4},{:.6},{},{},{:.3e},{:.4e},{:.4e},{:.3e},{:.3e},{:.4e},{:.3e}",
+                    p.period,
+                    p.energy_normalized,
+                    exact,
+                    p.converged,
+                    p.residual_norm,
+                    r.defect,
+                    r.displacement_defect,
+                    r.initial_penetration / gap,
+                    r.max_penetration / gap,
+                    r.min_contact_force,
+                    r.energy_drift
+                );
+                ControlFlow::Continue(())
             }
-        },
-    )?;
+            Err(e) => {
+                failure = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    })?;
     if let Some(e) = failure {
         return Err(e.into());
     }

@@ -52,22 +52,15 @@
 //! ## Quick start
 //!
 //! ```
-//! use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
+//! use nonsmooth_modes::branches::{compute, Request};
 //! use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
-//! use nonsmooth_modes::solve::SemismoothNewton;
-//! use nonsmooth_modes::system::HarmonicBalanceSettings;
 //!
 //! let system = clamped_bar_with_obstacle(1e-3)?;
-//! let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
-//! let options = BackboneOptions {
-//!     grid: PeriodGrid { start: 3.9, end: 3.7, steps: 5 },
-//!     ..Default::default()
-//! };
-//! let points = backbone(&system, settings, &options, SemismoothNewton::default())?;
-//! let last = points.last().unwrap();
-//! let exact = ClampedFirstMode::new(1e-3, last.period).energy_normalized();
-//! assert!(last.converged);
-//! assert!((last.energy_normalized / exact - 1.0).abs() < 0.1);
+//! // NSM 1 with 10 harmonics; the method and its grid are derived from the system.
+//! let run = compute(&system, &Request::new(1).harmonics(10))?;
+//! let point = run.converged().find(|p| p.period <= 3.7 + 1e-9).unwrap();
+//! let exact = ClampedFirstMode::new(1e-3, point.period).energy_normalized();
+//! assert!((point.energy_normalized / exact - 1.0).abs() < 0.1);
 //! # Ok::<(), nonsmooth_modes::Error>(())
 //! ```
 

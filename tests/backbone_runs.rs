@@ -1,12 +1,37 @@
 //! A backbone run keeps everything it computed: a run that stalls returns its points, each
 //! with its status, and the reason it ended.
 
-use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid, PointStatus};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, Method, ModeBranches, PeriodGrid, PointStatus, Request,
+};
 use nonsmooth_modes::continuation::EndReason;
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::HarmonicBalanceSettings;
+use nonsmooth_modes::solve::Solver;
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::{ContinuationError, Error, SettingsError};
+
+/// The period grid `options` with the full semismooth Newton (the solver these runs have
+/// always used).
+fn grid_run(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: BackboneOptions,
+) -> Result<ModeBranches, Error> {
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(options),
+        solver: Some(Solver::default()),
+        ..Request::new(options.mode)
+    };
+    compute(system, &request)
+}
+
+/// The paper's grid of the clamped bar (its derived grid, written out).
+const PAPER_GRID: PeriodGrid = PeriodGrid {
+    start: 3.95,
+    end: 3.05,
+    steps: 181,
+};
 
 /// A grid on which no branch can be entered is refused with what the start search tried,
 /// not run as points at rest: the clamped bar on periods near `T = 9`, more than twice its
@@ -15,19 +40,17 @@ use nonsmooth_modes::{ContinuationError, Error, SettingsError};
 #[test]
 fn a_grid_without_a_branch_is_refused_with_what_was_tried() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 9.1,
-            end: 8.9,
-            steps: 30,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 9.1,
+        end: 8.9,
+        steps: 30,
     };
+    let options = BackboneOptions::on_grid(grid, 1, 1);
     let settings = HarmonicBalanceSettings {
         harmonics: 10,
         ..Default::default()
     };
-    match backbone(&system, settings, &options, SemismoothNewton::default()) {
+    match grid_run(&system, settings, options) {
         Err(Error::Settings(SettingsError::StartNotFound {
             omega,
             up_to,
@@ -51,20 +74,20 @@ fn a_grid_without_a_branch_is_refused_with_what_was_tried() {
 #[test]
 fn a_stalled_run_keeps_its_points_and_says_why() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let grid = PeriodGrid {
+        start: 3.5,
+        end: 2.5,
+        steps: 41,
+    };
     let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.5,
-            end: 2.5,
-            steps: 41,
-        },
         max_consecutive_failures: 6,
-        ..Default::default()
+        ..BackboneOptions::on_grid(grid, 1, 1)
     };
     let settings = HarmonicBalanceSettings {
         harmonics: 10,
         ..Default::default()
     };
-    let run = backbone(&system, settings, &options, SemismoothNewton::default()).unwrap();
+    let run = grid_run(&system, settings, options).unwrap();
     match (&run.end, run.error()) {
         (EndReason::Stalled { failures, .. }, Some(ContinuationError::Stalled { .. })) => {
             assert_eq!(*failures, 6);
@@ -73,7 +96,7 @@ fn a_stalled_run_keeps_its_points_and_says_why() {
     }
     assert!(run.converged().count() >= 5);
     assert!(run.points.len() < 41);
-    for p in &run {
+    for p in &run.points {
         assert_eq!(p.converged, p.status == PointStatus::Converged);
         assert!(p.x.iter().all(|v| v.is_finite()));
     }
@@ -87,17 +110,16 @@ fn a_stalled_run_keeps_its_points_and_says_why() {
 #[test]
 fn a_completed_run_reports_each_step_status() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let run = backbone(
+    let run = grid_run(
         &system,
         HarmonicBalanceSettings::default(),
-        &BackboneOptions::default(),
-        SemismoothNewton::default(),
+        BackboneOptions::on_grid(PAPER_GRID, 1, 1),
     )
     .unwrap();
     assert_eq!(run.end, EndReason::Completed);
     assert_eq!(run.error(), None);
-    assert_eq!(run.len(), 181);
-    for p in &run {
+    assert_eq!(run.points.len(), 181);
+    for p in &run.points {
         assert_eq!(p.converged, p.status == PointStatus::Converged);
         if let PointStatus::SolverFailed(e) = &p.status {
             assert!(!e.to_string().is_empty());
@@ -110,13 +132,16 @@ fn a_completed_run_reports_each_step_status() {
 /// they came to: a chain of three unequal bars held only by contacts (walls at both outer
 /// ends), whose first family does not leave its grazing point. At most two solves (plain,
 /// then in the smoothing homotopy) per guess: the seed at each frequency and amplitude, and
-/// with each bar's rigid-body motion added at each of the rigid amplitudes.
+/// with each bar's rigid-body motion added at each of the rigid amplitudes. The search is
+/// that of `Method::Auto` at the first period of the system's grid, `0.9875` of its linear
+/// period; the grid then run from the unsolved seed converges nowhere either, and the run
+/// is refused with the search's error.
 #[test]
 fn a_failed_start_search_is_bounded_and_says_why() {
     use nonsmooth_modes::bar::Bar;
     use nonsmooth_modes::branches::{
-        backbone_start, linear_period, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES,
-        START_AMPLITUDES, START_RATIOS,
+        linear_period, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES,
+        START_RATIOS,
     };
     use nonsmooth_modes::system::AssemblyBuilder;
     let mut b = AssemblyBuilder::new();
@@ -135,11 +160,15 @@ fn a_failed_start_search_is_bounded_and_says_why() {
         ..Default::default()
     };
     let omega = 2.0 * std::f64::consts::PI / (linear_period(&system, 1, 1).unwrap() * 0.9875);
-    let solver = SemismoothNewton::default();
     let ratios = START_RATIOS.len() + FLOATING_RATIOS.len();
     let amplitudes = START_AMPLITUDES.len() + FLOATING_AMPLITUDES.len();
     let guesses = ratios * amplitudes * (1 + bars.len() * RIGID_AMPLITUDES.len());
-    match backbone_start(&system, settings, (1, 1), omega, 1e-6, &solver) {
+    let request = Request {
+        settings,
+        solver: Some(Solver::default()),
+        ..Request::new(1)
+    };
+    match compute(&system, &request) {
         Err(Error::Settings(SettingsError::StartNotFound {
             attempts,
             at_rest,

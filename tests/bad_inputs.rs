@@ -5,14 +5,14 @@ use nonsmooth_modes::bc::{
     BoundaryCondition, Contact, LinearRows, Quantity, Robin, Signorini, Term,
 };
 use nonsmooth_modes::branches::{
-    arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, PeriodGrid,
+    compute, ArclengthBackboneOptions, BackboneOptions, Method, ModeBranches, PeriodGrid, Request,
 };
 use nonsmooth_modes::continuation::{linspace, ContinuationProblem, Sequential, SequentialOptions};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{branch_seed, grazing_energy, natural_frequencies, ContactState};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::solve::{
-    Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton,
+    Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton, Solver,
 };
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
@@ -40,6 +40,28 @@ fn assert_not_positive(result: Result<impl std::fmt::Debug, ModelError>, what: &
 
 fn clamped() -> BarSystem {
     clamped_bar_with_obstacle(1e-3).unwrap()
+}
+
+/// The paper's grid of the clamped bar (its derived grid, written out).
+const PAPER_GRID: PeriodGrid = PeriodGrid {
+    start: 3.95,
+    end: 3.05,
+    steps: 181,
+};
+
+/// The period grid `options` with the full semismooth Newton, as these checks always ran it.
+fn grid_run(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: BackboneOptions,
+) -> Result<ModeBranches, Error> {
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(options),
+        solver: Some(Solver::default()),
+        ..Request::new(options.mode).subharmonic(options.subharmonic)
+    };
+    compute(system, &request)
 }
 
 fn linear_only() -> BarSystem {
@@ -269,13 +291,7 @@ fn bad_harmonic_balance_settings() {
     }
     // Errors reach backbone unchanged.
     assert_eq!(
-        backbone(
-            &system,
-            zero,
-            &BackboneOptions::default(),
-            SemismoothNewton::default()
-        )
-        .unwrap_err(),
+        grid_run(&system, zero, BackboneOptions::on_grid(PAPER_GRID, 1, 1)).unwrap_err(),
         Error::Settings(SettingsError::ZeroHarmonics)
     );
 }
@@ -293,11 +309,10 @@ fn system_without_contact() {
         SettingsError::NoContact
     );
     assert_eq!(
-        backbone(
+        grid_run(
             &system,
             HarmonicBalanceSettings::default(),
-            &BackboneOptions::default(),
-            SemismoothNewton::default()
+            BackboneOptions::on_grid(PAPER_GRID, 1, 1),
         )
         .unwrap_err(),
         Error::Settings(SettingsError::NoContact)
@@ -315,12 +330,8 @@ fn bad_modes_and_subharmonics() {
         ..Default::default()
     };
     let run = |mode, subharmonic| {
-        let options = BackboneOptions {
-            mode,
-            subharmonic,
-            ..Default::default()
-        };
-        backbone(&system, settings, &options, SemismoothNewton::default()).unwrap_err()
+        let options = BackboneOptions::on_grid(PAPER_GRID, mode, subharmonic);
+        grid_run(&system, settings, options).unwrap_err()
     };
     assert_eq!(
         run(0, 1),
@@ -841,11 +852,10 @@ fn bad_period_grids() {
     };
     let run = |grid: PeriodGrid, trivial_energy: f64| {
         let options = BackboneOptions {
-            grid,
             trivial_energy,
-            ..Default::default()
+            ..BackboneOptions::on_grid(grid, 1, 1)
         };
-        backbone(&system, settings, &options, SemismoothNewton::default())
+        grid_run(&system, settings, options)
     };
     for v in BAD {
         for grid in [
@@ -906,15 +916,15 @@ fn bad_period_grids() {
     for v in [-1.0, f64::NAN, f64::INFINITY] {
         let options = ArclengthBackboneOptions {
             trivial_energy: v,
-            ..Default::default()
+            ..ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap()
         };
-        let result = arclength_backbone(
-            &system,
+        let request = Request {
             settings,
-            &options,
-            SemismoothNewton::default(),
-            |_| std::ops::ControlFlow::Continue(()),
-        );
+            method: Method::Arclength(options),
+            solver: Some(Solver::default()),
+            ..Request::new(1)
+        };
+        let result = compute(&system, &request);
         match result.unwrap_err() {
             Error::Continuation(ContinuationError::InvalidOption { what, value }) => {
                 assert_eq!(what, "trivial_energy");
@@ -932,7 +942,8 @@ fn bad_period_grids() {
         },
         1e-6,
     )
-    .unwrap();
+    .unwrap()
+    .points;
     assert_eq!(points.len(), 5);
     for p in &points {
         assert!(p.period.is_finite() && p.omega.is_finite());

@@ -1,8 +1,7 @@
 //! Continuation drivers on the paper's systems (issue: pseudo-arclength, parameters, loops).
 
 use nonsmooth_modes::branches::{
-    arclength_backbone, backbone, ArclengthBackboneOptions, BackboneOptions, BackbonePoint,
-    PeriodGrid,
+    compute, ArclengthBackboneOptions, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
 };
 use nonsmooth_modes::continuation::{
     Arclength, ArclengthOptions, ContinuationProblem, EndReason, Event, PeriodParametrised, Point,
@@ -12,7 +11,7 @@ use nonsmooth_modes::modal::{branch_seed, energy};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::{residual_scale, Problem, SemismoothNewton};
+use nonsmooth_modes::solve::{residual_scale, Problem, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -21,24 +20,14 @@ fn run_backbone(
     system: &nonsmooth_modes::system::BarSystem,
     harmonics: usize,
     options: &ArclengthBackboneOptions,
-) -> (Vec<BackbonePoint>, nonsmooth_modes::continuation::Branch) {
-    let mut points = Vec::new();
-    let settings = HarmonicBalanceSettings {
-        harmonics,
-        ..Default::default()
+) -> (Vec<BackbonePoint>, EndReason) {
+    let request = Request {
+        method: Method::Arclength(*options),
+        solver: Some(Solver::default()),
+        ..Request::new(options.mode).harmonics(harmonics)
     };
-    let (_, branch) = arclength_backbone(
-        system,
-        settings,
-        options,
-        SemismoothNewton::default(),
-        |p| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
-    (points, branch)
+    let run = compute(system, &request).unwrap();
+    (run.points, run.end)
 }
 
 /// Every accepted point satisfies the corrector's tolerance on `|F|` at its own `Omega`.
@@ -67,16 +56,16 @@ fn assert_all_converged(
 fn clamped_bar_arclength_reaches_short_periods_without_manual_restarts() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
     for m in [20, 40] {
-        let (points, branch) = run_backbone(&system, m, &ArclengthBackboneOptions::default());
+        let options = ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap();
+        let (points, end) = run_backbone(&system, m, &options);
         let shortest = points
             .iter()
             .map(|p| p.period)
             .fold(f64::INFINITY, f64::min);
         assert!(shortest <= 3.1, "m = {m}: stopped at T = {shortest}");
         assert!(
-            matches!(branch.end, EndReason::ParameterOutOfRange { .. }),
-            "m = {m}: {:?}",
-            branch.end
+            matches!(end, EndReason::ParameterOutOfRange { .. }),
+            "m = {m}: {end:?}"
         );
         assert_all_converged(&system, m, &points);
         // A good share of the points lie on the exact backbone (the rest are resonances).
@@ -94,13 +83,10 @@ fn clamped_bar_arclength_reaches_short_periods_without_manual_restarts() {
 #[test]
 fn robin_bar_arclength_crosses_the_figure_10_range() {
     let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
-    let options = ArclengthBackboneOptions {
-        start_period: 9.5,
-        omega_range: (2.0 * PI / 9.55, 2.0 * PI / 6.6),
-        ..Default::default()
-    };
-    let (points, branch) = run_backbone(&system, 20, &options);
-    assert!(matches!(branch.end, EndReason::ParameterOutOfRange { .. }));
+    let options =
+        ArclengthBackboneOptions::seeded_at(9.5, (2.0 * PI / 9.55, 2.0 * PI / 6.6), (1, 1));
+    let (points, end) = run_backbone(&system, 20, &options);
+    assert!(matches!(end, EndReason::ParameterOutOfRange { .. }));
     assert!(points.iter().any(|p| p.period < 6.7));
     assert_all_converged(&system, 20, &points);
 }
@@ -111,15 +97,18 @@ fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
     // E / g0^2 is constant along the branch.
     let settings = HarmonicBalanceSettings::default();
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let grid = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.95,
-            end: 3.6,
-            steps: 71,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.6,
+        steps: 71,
     };
-    let walk = backbone(&system, settings, &grid, SemismoothNewton::default()).unwrap();
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(Solver::default()),
+        ..Request::new(1)
+    };
+    let walk = compute(&system, &request).unwrap().points;
     let gap_to_exact = |p: &&BackbonePoint| {
         (p.energy_normalized / ClampedFirstMode::new(1e-3, p.period).energy_normalized() - 1.0)
             .abs()
@@ -401,26 +390,24 @@ fn clamped_backbone_m40(
     options: &BackboneOptions,
     speculation: Option<nonsmooth_modes::continuation::Speculation>,
 ) -> Vec<BackbonePoint> {
-    use nonsmooth_modes::branches::{backbone_speculative_with, backbone_with};
     use nonsmooth_modes::solve::NewtonOptions;
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let settings = HarmonicBalanceSettings {
-        harmonics: 40,
-        ..Default::default()
-    };
     let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
-    let mut points = Vec::new();
-    let see = |p: &BackbonePoint| {
-        points.push(p.clone());
-        ControlFlow::Continue(())
+    let request = Request {
+        method: Method::PeriodGrid(*options),
+        solver: Some(Solver::Newton(solver)),
+        speculation,
+        ..Request::new(options.mode).harmonics(40)
     };
-    match speculation {
-        None => backbone_with(&system, settings, options, solver, see),
-        Some(s) => backbone_speculative_with(&system, settings, options, s, solver, see),
-    }
-    .unwrap();
-    points
+    compute(&system, &request).unwrap().points
 }
+
+/// The paper's grid of the clamped bar (its derived grid, written out).
+const PAPER_GRID: PeriodGrid = PeriodGrid {
+    start: 3.95,
+    end: 3.05,
+    steps: 181,
+};
 
 /// The points of `driver` stepped with [`Speculative::step`] to the end, and its stats.
 fn speculative_points<P, S>(
@@ -441,7 +428,7 @@ where
 #[test]
 fn speculative_backbone_is_the_serial_backbone() {
     use nonsmooth_modes::continuation::Speculation;
-    let options = BackboneOptions::default();
+    let options = BackboneOptions::on_grid(PAPER_GRID, 1, 1);
     let serial = clamped_backbone_m40(&options, None);
     assert_eq!(serial.len(), 181);
     assert!(serial.iter().filter(|p| !p.converged).count() > 0);
@@ -613,7 +600,7 @@ fn speculative_lowest_energy_backbone_is_the_serial_backbone() {
     let options = |selection| BackboneOptions {
         retry_depth: 2,
         selection,
-        ..Default::default()
+        ..BackboneOptions::on_grid(PAPER_GRID, 1, 1)
     };
     let lowest = options(Selection::LowestMeasure);
     let serial = clamped_backbone_m40(&lowest, None);

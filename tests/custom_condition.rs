@@ -7,7 +7,9 @@ use nonsmooth_modes::bc::{
     complementarity, BoundaryCondition, LawValue, LinearRows, Observable, Quantity, Term,
     UnilateralLaw,
 };
-use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::continuation::{
     ContinuationProblem, PeriodParametrised, Sequential, SequentialOptions, Step,
 };
@@ -18,7 +20,7 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, clamped_free_frequency, robin_bar_with_obstacle,
     ROBIN_FREE_FREQUENCIES,
 };
-use nonsmooth_modes::solve::{Problem, SemismoothNewton};
+use nonsmooth_modes::solve::{Problem, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
@@ -120,6 +122,22 @@ fn omegas(system: &BarSystem, max: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The points of the period grid `grid` of NSM 1 of `system`, with the full semismooth
+/// Newton.
+fn grid_points(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    grid: PeriodGrid,
+) -> Vec<BackbonePoint> {
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(Solver::Newton(SemismoothNewton::default())),
+        ..Request::new(1)
+    };
+    compute(system, &request).unwrap().points
+}
+
 /// A clamped bar with a mass `m` at its free end vibrates at `omega tan(omega) = 1/m`: for
 /// `m = 2` the Robin-free frequencies of formulation §8; as `m -> 0`, the clamped-free ones.
 #[test]
@@ -175,16 +193,13 @@ fn massless_spring_is_the_robin_condition() {
     b.parameter_derivative(&x, &mut fb);
     assert!(close(&fa, &fb));
 
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 9.5,
-            end: 7.0,
-            steps: 11,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 9.5,
+        end: 7.0,
+        steps: 11,
     };
-    let pa = backbone(&custom, settings, &options, SemismoothNewton::default()).unwrap();
-    let pb = backbone(&robin, settings, &options, SemismoothNewton::default()).unwrap();
+    let pa = grid_points(&custom, settings, grid);
+    let pb = grid_points(&robin, settings, grid);
     assert!(pb.iter().filter(|p| p.converged).count() >= 9);
     for (p, q) in pa.iter().zip(&pb) {
         assert_eq!(p.converged, q.converged);
@@ -408,16 +423,7 @@ fn compliant_obstacle_tends_to_the_rigid_one() {
     let periods: Vec<f64> = (0..grid.steps)
         .map(|i| grid.start - 0.05 * i as f64)
         .collect();
-    let rigid = backbone(
-        &clamped_bar_with_obstacle(GAP).unwrap(),
-        settings,
-        &BackboneOptions {
-            grid,
-            ..Default::default()
-        },
-        SemismoothNewton::default(),
-    )
-    .unwrap();
+    let rigid = grid_points(&clamped_bar_with_obstacle(GAP).unwrap(), settings, grid);
     let reference = rigid.last().unwrap();
     assert!(reference.converged);
     assert!((reference.period - periods[7]).abs() < 1e-12);

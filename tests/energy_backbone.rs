@@ -1,22 +1,22 @@
-//! Backbones parametrised by energy ([`EnergyLevel`], [`energy_backbone`]) and the robust
+//! Backbones parametrised by energy ([`EnergyLevel`], [`Method::Energy`]) and the robust
 //! start of the period backbone, on the clamped bar and on a free-free bar between two walls
 //! (whose exact first family is the clamped bar's at half length).
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
-    arclength_backbone, backbone, backbone_start, energy_backbone, split_frequency,
-    ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid,
-    EnergyLevel, PeriodGrid, PointStatus, FLOATING_RETRY_DEPTH,
+    compute, compute_observed, split_frequency, ArclengthBackboneOptions, AutoChoice,
+    BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid, EnergyLevel, Method,
+    ModeBranches, PeriodGrid, PointStatus, Request, FLOATING_RETRY_DEPTH,
 };
 use nonsmooth_modes::continuation::{geomspace, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
-use nonsmooth_modes::solve::{Problem, SemismoothNewton, Structured};
+use nonsmooth_modes::solve::{Problem, Solver, Structured};
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
-use nonsmooth_modes::{ContinuationError, Error, SettingsError};
+use nonsmooth_modes::{ContinuationError, Error};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -28,6 +28,22 @@ fn settings(harmonics: usize) -> HarmonicBalanceSettings {
         ..Default::default()
     }
 }
+
+/// NSM 1 of `system` with `harmonics` harmonics by `method`, with the full semismooth Newton
+/// (the solver these runs have always used).
+fn request(harmonics: usize, method: Method) -> Request {
+    Request {
+        solver: Some(Solver::default()),
+        ..Request::new(1).harmonics(harmonics).method(method)
+    }
+}
+
+/// The paper's grid of the clamped bar (its derived grid, written out).
+const PAPER_GRID: PeriodGrid = PeriodGrid {
+    start: 3.95,
+    end: 3.05,
+    steps: 181,
+};
 
 /// A unit free-free bar between two rigid walls, gap `GAP` each side.
 fn free_free_between_walls() -> BarSystem {
@@ -111,10 +127,9 @@ fn energy_backbone_of_the_clamped_bar_follows_the_exact_family_to_the_first_reso
             end: 1.15,
             steps: 6,
         },
-        ..Default::default()
+        ..EnergyBackboneOptions::for_mode(&system, 1, 1).unwrap()
     };
-    let run =
-        energy_backbone(&system, settings(20), &options, SemismoothNewton::default()).unwrap();
+    let run = compute(&system, &request(20, Method::Energy(options))).unwrap();
     assert!(run.error().is_none(), "{:?}", run.end);
     assert!(
         run.converged().count() >= 6,
@@ -154,9 +169,9 @@ fn energy_levels_must_be_positive() {
                 end,
                 steps: 5,
             },
-            ..Default::default()
+            ..EnergyBackboneOptions::for_mode(&system, 1, 1).unwrap()
         };
-        let run = energy_backbone(&system, settings(8), &options, SemismoothNewton::default());
+        let run = compute(&system, &request(8, Method::Energy(options)));
         assert!(
             matches!(
                 run,
@@ -196,16 +211,16 @@ fn free_free_bar_between_walls_has_a_period_backbone() {
     let clamped = clamped_bar_with_obstacle(GAP).unwrap();
     assert_eq!(
         BackboneOptions::for_mode(&clamped, 1, 1).unwrap(),
-        BackboneOptions::default()
+        BackboneOptions::on_grid(PAPER_GRID, 1, 1)
     );
     for (m, on_branch_share) in [(20, 0.5), (40, 0.45)] {
-        let run = backbone(&system, settings(m), &options, SemismoothNewton::default()).unwrap();
+        let run = compute(&system, &request(m, Method::PeriodGrid(options))).unwrap();
         let converged: Vec<_> = run.converged().collect();
         assert!(
-            converged.len() * 10 >= run.len() * 9,
+            converged.len() * 10 >= run.points.len() * 9,
             "m = {m}: {} of {}",
             converged.len(),
-            run.len()
+            run.points.len()
         );
         let on_branch = converged
             .iter()
@@ -234,16 +249,11 @@ fn energy_backbone_of_the_clamped_bar_is_as_faithful_as_the_period_grid() {
             .count();
         good as f64 / points.len() as f64
     };
-    let solver = SemismoothNewton::default;
-    let by_energy = energy_backbone(
-        &system,
-        settings(20),
-        &EnergyBackboneOptions::default(),
-        solver(),
-    )
-    .unwrap();
-    let by_period = backbone(&system, settings(20), &BackboneOptions::default(), solver()).unwrap();
-    let points = |run: &nonsmooth_modes::branches::Backbone| {
+    let energy_options = EnergyBackboneOptions::for_mode(&system, 1, 1).unwrap();
+    let by_energy = compute(&system, &request(20, Method::Energy(energy_options))).unwrap();
+    let grid = BackboneOptions::on_grid(PAPER_GRID, 1, 1);
+    let by_period = compute(&system, &request(20, Method::PeriodGrid(grid))).unwrap();
+    let points = |run: &ModeBranches| {
         run.converged()
             .map(|p| (p.period, p.energy_normalized))
             .collect::<Vec<_>>()
@@ -264,13 +274,8 @@ fn energy_backbone_of_the_clamped_bar_is_as_faithful_as_the_period_grid() {
 #[test]
 fn the_chain_with_a_floating_bar_starts_and_its_points_touch_both_contacts() {
     let system = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
-    let run = energy_backbone(
-        &system,
-        settings(20),
-        &EnergyBackboneOptions::default(),
-        SemismoothNewton::default(),
-    )
-    .unwrap();
+    let options = EnergyBackboneOptions::for_mode(&system, 1, 1).unwrap();
+    let run = compute(&system, &request(20, Method::Energy(options))).unwrap();
     let converged: Vec<_> = run.converged().cloned().collect();
     assert!(converged.len() >= 50, "{} converged", converged.len());
     assert_every_contact_touches(&system, &converged);
@@ -298,42 +303,65 @@ fn assert_every_contact_touches(system: &BarSystem, points: &[BackbonePoint]) {
 }
 
 /// The chain's branch cannot be entered at the period grid's first period: its start is found
-/// at a higher frequency only ([`backbone_start`]), while the branches of the clamped bar and
-/// of the free-free bar between walls are entered where asked.
+/// at a higher frequency only (`Method::Auto` says so and runs pseudo-arclength, which begins
+/// with the start, a solution), while the branches of the clamped bar and of the free-free bar
+/// between walls are entered where asked (and run on the period grid).
 #[test]
 fn the_chains_start_lies_above_the_grids_first_frequency() {
-    let solver = SemismoothNewton::default();
-    let start_of = |system: &BarSystem| {
-        let omega = 2.0 * PI / PeriodGrid::for_mode(system, 1, 1).unwrap().start;
-        let start = backbone_start(system, settings(20), (1, 1), omega, 1e-6, &solver).unwrap();
-        (start, omega)
-    };
+    let auto = request(20, Method::Auto);
     let chain = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
-    let (start, omega) = start_of(&chain);
+    let omega = 2.0 * PI / PeriodGrid::for_mode(&chain, 1, 1).unwrap().start;
+    let run = compute(&chain, &auto).unwrap();
+    let entered_at = match run.auto {
+        Some(AutoChoice::EnteredAtShorterPeriod { entered_at }) => entered_at,
+        other => panic!("{other:?}"),
+    };
+    let start_omega = 2.0 * PI / entered_at;
+    assert!(start_omega > omega, "{start_omega} {omega}");
     assert!(
-        start.moved_from(omega) && start.omega > omega,
-        "{} {omega}",
-        start.omega
+        matches!(run.method, Method::Arclength(_)),
+        "{:?}",
+        run.method
     );
+    // The start is a point of the run, and a solution.
+    let start = run
+        .points
+        .iter()
+        .find(|p| (p.omega - start_omega).abs() <= 1e-12 * start_omega)
+        .unwrap_or_else(|| panic!("no point at the start, Omega = {start_omega}"));
     let mut problem = NonsmoothSystem::new(&chain, settings(20)).unwrap();
     problem.set_parameter(start.omega);
     let mut f = vec![0.0; start.x.len()];
     problem.residual(&start.x, &mut f);
     let tolerance = 1e-9 * problem.residual_scale();
     assert!(f.iter().map(|v| v * v).sum::<f64>().sqrt() <= tolerance);
+    // The other systems' choice is made before their first point: stop there.
+    let first_point_only = |_: &BackbonePoint| ControlFlow::Break(());
     for system in [
         clamped_bar_with_obstacle(GAP).unwrap(),
         free_free_between_walls(),
     ] {
-        let (start, omega) = start_of(&system);
-        assert!(!start.moved_from(omega), "{} {omega}", start.omega);
+        let run = compute_observed(&system, &auto, first_point_only).unwrap();
+        assert_eq!(run.auto, Some(AutoChoice::EnteredAtGridStart));
+        assert!(matches!(run.method, Method::PeriodGrid(_)));
     }
+    // A start frequency that is not positive is refused (the old start search's
+    // `NotPositive`; through a request the frequency is the seed period of the options).
+    let options = ArclengthBackboneOptions {
+        start_period: -1.0,
+        ..ArclengthBackboneOptions::for_mode(&chain, 1, 1).unwrap()
+    };
     assert!(matches!(
-        backbone_start(&chain, settings(20), (1, 1), -1.0, 1e-6, &solver),
-        Err(Error::Settings(SettingsError::NotPositive { value, .. })) if value == -1.0
+        compute(&chain, &request(20, Method::Arclength(options))),
+        Err(Error::Continuation(ContinuationError::InvalidOption { value, .. })) if value == -1.0
     ));
+    // A floor that is not a number is refused before any start search.
+    let options = BackboneOptions {
+        trivial_energy: f64::NAN,
+        ..BackboneOptions::for_mode(&chain, 1, 1).unwrap()
+    };
     assert!(matches!(
-        backbone_start(&chain, settings(20), (1, 1), omega, f64::NAN, &solver),
+        compute(&chain, &request(20, Method::PeriodGrid(options))),
         Err(Error::Continuation(ContinuationError::InvalidOption {
             what: "trivial_energy",
             ..
@@ -353,28 +381,23 @@ fn the_chains_arclength_backbone_starts_where_its_guesses_converge() {
     let options = ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap();
     let grid = PeriodGrid::for_mode(&system, 1, 1).unwrap();
     let mut points = Vec::new();
-    let (_, branch) = arclength_backbone(
-        &system,
-        settings(20),
-        &options,
-        SemismoothNewton::default(),
-        |p| {
-            points.push(p.clone());
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
+    let observer = |p: &BackbonePoint| {
+        points.push(p.clone());
+        ControlFlow::Continue(())
+    };
+    let run =
+        compute_observed(&system, &request(20, Method::Arclength(options)), observer).unwrap();
     assert!(
         points.len() >= 200,
         "{} points, end {:?}",
         points.len(),
-        branch.end
+        run.end
     );
     let (first, last) = (&points[0], &points[points.len() - 1]);
     let span = grid.start - grid.end;
     assert!(first.period > grid.start - 0.05 * span, "{}", first.period);
     assert!(last.period < grid.end + 0.1 * span, "{}", last.period);
     assert!(points.windows(2).all(|w| w[1].step > w[0].step));
-    assert_eq!(branch.points.len(), points.len());
+    assert_eq!(run.points, points);
     assert_every_contact_touches(&system, &points);
 }

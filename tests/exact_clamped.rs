@@ -2,7 +2,9 @@
 //! and the linear frequencies (formulation §7–§8) as oracles.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{energy, grazing_energy, natural_frequencies, ContactState};
 use nonsmooth_modes::reference::{
@@ -10,7 +12,7 @@ use nonsmooth_modes::reference::{
     clamped_grazing_energy, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
     ROBIN_CLAMPED_FREQUENCIES, ROBIN_FREE_FREQUENCIES, ROBIN_GRAZING_ENERGY_PER_GAP2,
 };
-use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, SemismoothNewton};
+use nonsmooth_modes::solve::{Dogleg, NonlinearSolver, SemismoothNewton, Solver};
 use nonsmooth_modes::system::rows::HarmonicRows;
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use proptest::prelude::*;
@@ -31,7 +33,7 @@ fn score(points: &[BackbonePoint]) -> (usize, usize) {
     (converged, accurate)
 }
 
-fn paper_grid_backbone(solver: impl NonlinearSolver) -> Vec<BackbonePoint> {
+fn paper_grid_backbone(solver: Solver) -> Vec<BackbonePoint> {
     let system = clamped_bar_with_obstacle(GAP).unwrap();
     let settings = HarmonicBalanceSettings::default();
     assert_eq!(
@@ -42,8 +44,19 @@ fn paper_grid_backbone(solver: impl NonlinearSolver) -> Vec<BackbonePoint> {
         ),
         (20, 30, 4.0)
     );
-    let options = BackboneOptions::default();
-    let points = backbone(&system, settings, &options, solver).unwrap();
+    // The paper's grid (the clamped bar's derived grid, written out).
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.05,
+        steps: 181,
+    };
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(solver),
+        ..Request::new(1)
+    };
+    let points = compute(&system, &request).unwrap().points;
     assert_eq!(points.len(), 181, "every period of the grid is visited");
     assert!((points[0].period - 3.95).abs() < 1e-12);
     assert!((points[180].period - 3.05).abs() < 1e-12);
@@ -52,7 +65,7 @@ fn paper_grid_backbone(solver: impl NonlinearSolver) -> Vec<BackbonePoint> {
         assert!(p.x.iter().all(|v| v.is_finite()));
         assert!((p.omega * p.period - 2.0 * PI).abs() < 1e-12);
     }
-    points.points
+    points
 }
 
 /// Acceptance (formulation §9): on the paper's 181-point grid with `m = 20`, `n_h = 30`,
@@ -60,7 +73,7 @@ fn paper_grid_backbone(solver: impl NonlinearSolver) -> Vec<BackbonePoint> {
 /// the exact energy on about 55% of it.
 #[test]
 fn paper_grid_with_semismooth_newton() {
-    let points = paper_grid_backbone(SemismoothNewton::default());
+    let points = paper_grid_backbone(Solver::Newton(SemismoothNewton::default()));
     let (converged, accurate) = score(&points);
     println!("semismooth Newton: {converged}/181 converged, {accurate}/181 within 5%");
     assert!(10 * converged >= 9 * 181, "{converged}/181 converged");
@@ -79,7 +92,7 @@ fn paper_grid_with_semismooth_newton() {
 /// 110/181 within 5%, as with Newton; asserted with some slack.
 #[test]
 fn paper_grid_with_dogleg() {
-    let points = paper_grid_backbone(Dogleg::default());
+    let points = paper_grid_backbone(Solver::Dogleg(Dogleg::default()));
     let (converged, accurate) = score(&points);
     println!("dogleg: {converged}/181 converged, {accurate}/181 within 5%");
     assert!(100 * converged >= 85 * 181, "{converged}/181 converged");

@@ -288,8 +288,8 @@ proptest! {
 /// a short backbone of each system, each converged point perturbed by 1% of `g0`.
 #[test]
 fn jacobian_matches_finite_differences_near_converged_points() {
-    use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
-    use nonsmooth_modes::solve::SemismoothNewton;
+    use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
+    use nonsmooth_modes::solve::Solver;
     let mut checked = 0;
     let mut total = 0;
     let mut omega_checked = 0;
@@ -303,15 +303,18 @@ fn jacobian_matches_finite_differences_near_converged_points() {
                 kink_blend: 0.0,
                 ..Default::default()
             };
-            let options = BackboneOptions {
-                grid: PeriodGrid {
-                    start: t1 - 0.05 * (t1 - t0),
-                    end: t0 + 0.6 * (t1 - t0),
-                    steps: 5,
-                },
-                ..Default::default()
+            let grid = PeriodGrid {
+                start: t1 - 0.05 * (t1 - t0),
+                end: t0 + 0.6 * (t1 - t0),
+                steps: 5,
             };
-            let branch = backbone(&sys, settings, &options, SemismoothNewton::default()).unwrap();
+            let request = Request {
+                settings,
+                method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+                solver: Some(Solver::default()),
+                ..Request::new(1)
+            };
+            let branch = compute(&sys, &request).unwrap().points;
             let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
             for (k, p) in branch.iter().filter(|p| p.converged).enumerate() {
                 let x: Vec<f64> =

@@ -3,27 +3,36 @@
 //! (`x(s g0) = s x(g0)`, so `E / g0^2` and `E / E_g` stay constant along the branch).
 
 use nonsmooth_modes::branches::{
-    backbone, parameter_branch, BackboneOptions, BackbonePoint, ParameterSteps, PeriodGrid,
+    compute, parameter_branch, BackboneOptions, BackbonePoint, Method, ParameterSteps, PeriodGrid,
+    Request,
 };
 use nonsmooth_modes::continuation::{ArclengthOptions, EndReason, SequentialOptions};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::{SemismoothNewton, Solver};
 use nonsmooth_modes::system::HarmonicBalanceSettings;
 use nonsmooth_modes::Error;
 use std::ops::ControlFlow;
 
+/// The points of the clamped bar's first mode on `grid`, with the full semismooth Newton.
+fn grid_points(settings: HarmonicBalanceSettings, grid: PeriodGrid) -> Vec<BackbonePoint> {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(Solver::default()),
+        ..Request::new(1)
+    };
+    compute(&system, &request).unwrap().points
+}
+
 /// A converged point of the clamped bar's first mode near `T = 3.8`.
 fn start(settings: HarmonicBalanceSettings) -> BackbonePoint {
-    let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.95,
-            end: 3.8,
-            steps: 31,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.8,
+        steps: 31,
     };
-    let points = backbone(&system, settings, &options, SemismoothNewton::default()).unwrap();
+    let points = grid_points(settings, grid);
     points.into_iter().rev().find(|p| p.converged).unwrap()
 }
 
@@ -132,17 +141,12 @@ fn bad_starts_are_typed_errors() {
 fn a_gap_branch_that_slides_to_rest_reports_it() {
     use nonsmooth_modes::branches::PointStatus;
     let settings = HarmonicBalanceSettings::default();
-    let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.96,
-            end: 3.95,
-            steps: 2,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.96,
+        end: 3.95,
+        steps: 2,
     };
-    let from = backbone(&system, settings, &options, SemismoothNewton::default())
-        .unwrap()
+    let from = grid_points(settings, grid)
         .into_iter()
         .rev()
         .find(|p| p.converged)

@@ -18,9 +18,9 @@
 //!   --nocapture`.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{backbone, BackboneOptions};
+use nonsmooth_modes::branches::{compute, BackboneOptions, Method, Request};
 use nonsmooth_modes::modal::drifting_bars;
-use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 use nonsmooth_modes::{Error, SettingsError};
@@ -148,7 +148,13 @@ fn run(system: &BarSystem, harmonics: usize, verify: bool) -> Outcome {
         Err(e) => return Outcome::Refused(e.into()),
     };
     let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).expect("valid options");
-    let result = backbone(system, settings, &options, solver);
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(options),
+        solver: Some(Solver::Newton(solver)),
+        ..Request::new(1)
+    };
+    let result = compute(system, &request);
     let drifting = drifting_bars(system);
     let bb = match result {
         Err(Error::Settings(SettingsError::Unconfined { bars })) => {

@@ -4,7 +4,9 @@
 //! all finite; none panics or aborts on an allocation. The errors carry the numbers that
 //! explain them.
 
-use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, Method, ModeBranches, PeriodGrid, Request,
+};
 use nonsmooth_modes::continuation::linspace;
 use nonsmooth_modes::error::OverBudget;
 use nonsmooth_modes::fourier::{check_memory, Basis, CosineBasis, MEMORY_BUDGET_BYTES};
@@ -13,7 +15,7 @@ use nonsmooth_modes::modal::{branch_seed, diagnose, grazing_energy, law_history}
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::{SemismoothNewton, Solver};
 use nonsmooth_modes::system::{
     BarSystem, HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily, COMPLEMENTARITY_RANGE,
 };
@@ -128,6 +130,17 @@ fn all_finite<'a>(values: impl IntoIterator<Item = &'a f64>) -> bool {
     values.into_iter().all(|v| v.is_finite())
 }
 
+/// NSM 1 of `system` with [`settings`] by `method`, with the full semismooth Newton.
+fn run_with_newton(system: &BarSystem, method: Method) -> Result<ModeBranches, Error> {
+    let request = Request {
+        settings: settings(),
+        method,
+        solver: Some(Solver::Newton(SemismoothNewton::default())),
+        ..Request::new(1)
+    };
+    compute(system, &request)
+}
+
 proptest! {
     #![proptest_config(config())]
 
@@ -178,11 +191,8 @@ proptest! {
     /// A backbone over a period grid of `2^30` steps or more fails before it starts.
     #[test]
     fn period_grids_beyond_the_budget(steps in (1usize << 30)..=usize::MAX) {
-        let options = BackboneOptions {
-            grid: PeriodGrid { start: 3.9, end: 3.1, steps },
-            ..Default::default()
-        };
-        let result = backbone(&clamped(), settings(), &options, SemismoothNewton::default());
+        let options = BackboneOptions::on_grid(PeriodGrid { start: 3.9, end: 3.1, steps }, 1, 1);
+        let result = run_with_newton(&clamped(), Method::PeriodGrid(options));
         prop_assert!(
             matches!(result, Err(Error::Continuation(ContinuationError::TooLarge(_)))),
             "{result:?}"
@@ -776,7 +786,7 @@ fn overflowing_steps_and_missing_grazing_energy_are_typed_errors() {
 /// limit; at the limit a motion's numbers are finite.
 #[test]
 fn huge_frequencies_are_rejected_with_the_problem_limit() {
-    use nonsmooth_modes::branches::{arclength_backbone, ArclengthBackboneOptions};
+    use nonsmooth_modes::branches::ArclengthBackboneOptions;
     use nonsmooth_modes::system::MAX_PHASE;
     let system = clamped();
     let mut problem = NonsmoothSystem::new(&system, settings()).unwrap();
@@ -815,27 +825,17 @@ fn huge_frequencies_are_rejected_with_the_problem_limit() {
             end: 2.0 * PI / omega,
             steps: 3,
         };
-        let options = BackboneOptions {
-            grid,
-            ..Default::default()
-        };
+        let options = BackboneOptions::on_grid(grid, 1, 1);
         too_large(
-            backbone(&system, settings(), &options, SemismoothNewton::default()).map(|_| ()),
+            run_with_newton(&system, Method::PeriodGrid(options)).map(|_| ()),
             "backbone",
         );
         let options = ArclengthBackboneOptions {
             omega_range: (1.0, omega),
-            ..Default::default()
+            ..ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap()
         };
         too_large(
-            arclength_backbone(
-                &system,
-                settings(),
-                &options,
-                SemismoothNewton::default(),
-                |_| std::ops::ControlFlow::Continue(()),
-            )
-            .map(|_| ()),
+            run_with_newton(&system, Method::Arclength(options)).map(|_| ()),
             "arclength_backbone",
         );
     }

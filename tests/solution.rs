@@ -2,12 +2,14 @@
 //! exact first mode where one is known, and bad requests are typed errors.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::modal::{energy, grazing_energy};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::SemismoothNewton;
+use nonsmooth_modes::solve::Solver;
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use nonsmooth_modes::verify::PeriodicityOptions;
 use nonsmooth_modes::{SettingsError, Solution};
@@ -21,15 +23,18 @@ fn settings() -> HarmonicBalanceSettings {
 
 /// The converged points of a short backbone of `system` from `T = 3.93` to `3.63`.
 fn points(system: &BarSystem) -> Vec<BackbonePoint> {
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.93,
-            end: 3.63,
-            steps: 7,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.93,
+        end: 3.63,
+        steps: 7,
     };
-    let all = backbone(system, settings(), &options, SemismoothNewton::default()).unwrap();
+    let request = Request {
+        settings: settings(),
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(Solver::default()),
+        ..Request::new(1)
+    };
+    let all = compute(system, &request).unwrap().points;
     all.into_iter().filter(|p| p.converged).collect()
 }
 

@@ -3,15 +3,15 @@
 //! along the complement block's most singular direction.
 
 use nonsmooth_modes::branches::{
-    genuine_subharmonic_backbone, linear_period, symmetry_breaking_direction, BackboneOptions,
-    PeriodGrid, PointStatus, GENUINE_SHARE,
+    compute, linear_period, symmetry_breaking_direction, BackboneOptions, Method, PeriodGrid,
+    PointStatus, Request, GENUINE_SHARE,
 };
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::Basis;
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{branch_seed, subharmonic_share};
 use nonsmooth_modes::reference::robin_bar_with_obstacle;
-use nonsmooth_modes::solve::{Problem, SemismoothNewton};
+use nonsmooth_modes::solve::{Problem, Solver};
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -88,20 +88,19 @@ fn the_multiples_of_k_are_an_invariant_subspace() {
 #[test]
 fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
     let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            steps: 30,
-            ..PeriodGrid::for_mode(&system, 2, K).unwrap()
-        },
-        mode: 2,
-        subharmonic: K,
-        ..Default::default()
+    let grid = PeriodGrid {
+        steps: 30,
+        ..PeriodGrid::for_mode(&system, 2, K).unwrap()
     };
+    let options = BackboneOptions::on_grid(grid, 2, K);
     let problem = NonsmoothSystem::new(&system, settings(30)).unwrap();
-    let points =
-        genuine_subharmonic_backbone(&system, settings(30), &options, SemismoothNewton::default())
-            .unwrap()
-            .points;
+    let request = Request {
+        settings: settings(30),
+        method: Method::GenuineSubharmonic(options),
+        solver: Some(Solver::default()),
+        ..Request::new(2).subharmonic(K)
+    };
+    let points = compute(&system, &request).unwrap().points;
     let share = |p: &nonsmooth_modes::branches::BackbonePoint| {
         subharmonic_share(&system, problem.basis(), &p.x, p.omega, K).unwrap()
     };
@@ -132,27 +131,29 @@ fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
 /// never reaches leaves the run as it is without a switch; a bad request is refused.
 #[test]
 fn switching_at_a_branch_point_of_the_repeated_branch_leaves_the_subspace() {
-    use nonsmooth_modes::branches::{arclength_backbone, ArclengthBackboneOptions, SwitchAt};
+    use nonsmooth_modes::branches::{ArclengthBackboneOptions, SwitchAt};
     use nonsmooth_modes::continuation::{EndReason, Event};
     use nonsmooth_modes::{ContinuationError, Error};
     let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
-    let run = |switch| {
-        let options = ArclengthBackboneOptions {
-            switch,
-            ..ArclengthBackboneOptions::for_mode(&system, 2, K).unwrap()
+    let run = |switch: Option<SwitchAt>| {
+        let options = ArclengthBackboneOptions::for_mode(&system, 2, K).unwrap();
+        let method = match switch {
+            Some(at) => Method::Switch(options, at),
+            None => Method::Arclength(options),
+        };
+        let request = Request {
+            settings: settings(40),
+            method,
+            solver: Some(Solver::default()),
+            ..Request::new(2).subharmonic(K)
         };
         let mut points = Vec::new();
-        let result = arclength_backbone(
-            &system,
-            settings(40),
-            &options,
-            SemismoothNewton::default(),
-            |p| {
-                points.push(p.clone());
-                ControlFlow::Continue(())
-            },
-        );
-        result.map(|(_, branch)| (points, branch))
+        let observer = |p: &nonsmooth_modes::branches::BackbonePoint| {
+            points.push(p.clone());
+            ControlFlow::Continue(())
+        };
+        let result = nonsmooth_modes::branches::compute_observed(&system, &request, observer);
+        result.map(|run| (points, run))
     };
     let problem = NonsmoothSystem::new(&system, settings(40)).unwrap();
     let basis = problem.basis().clone();
@@ -164,7 +165,7 @@ fn switching_at_a_branch_point_of_the_repeated_branch_leaves_the_subspace() {
         side: 1.0,
     }))
     .unwrap();
-    assert_eq!(points.len(), branch.points.len());
+    assert_eq!(points, branch.points);
     let at = points
         .iter()
         .position(|p| {

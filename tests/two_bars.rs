@@ -2,10 +2,12 @@
 //! degenerate harmonics of formulation §5.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{backbone, BackboneOptions, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, ModeBranches, PeriodGrid, Request,
+};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
-use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
+use nonsmooth_modes::solve::Solver;
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::f64::consts::PI;
 
 const GAP: f64 = 1e-3;
@@ -27,27 +29,39 @@ fn bar_unknowns(x: &[f64], bar: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The period grid `options` of `system`, with the full semismooth Newton.
+fn grid_run(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    options: BackboneOptions,
+) -> ModeBranches {
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(options),
+        solver: Some(Solver::default()),
+        ..Request::new(options.mode)
+    };
+    compute(system, &request).unwrap()
+}
+
 /// Backbones of the two systems on the same grid: two unit bars (gap `g0`, complementarity parameter `a_c`)
 /// and one clamped unit bar (gap `g0/2`, `2 a_c`).
 fn pair(harmonics: usize, a_c: f64, grid: PeriodGrid) -> (Vec<BackbonePoint>, Vec<BackbonePoint>) {
-    let options = BackboneOptions {
-        grid,
-        ..Default::default()
-    };
+    let options = BackboneOptions::on_grid(grid, 1, 1);
     let twins = two_bars_in_contact(Bar::unit(), GAP).unwrap();
     let settings = HarmonicBalanceSettings {
         harmonics,
         complementarity: a_c,
         ..Default::default()
     };
-    let two = backbone(&twins, settings, &options, SemismoothNewton::default()).unwrap();
+    let two = grid_run(&twins, settings, options);
     let single = clamped_bar_with_obstacle(0.5 * GAP).unwrap();
     let settings = HarmonicBalanceSettings {
         harmonics,
         complementarity: 2.0 * a_c,
         ..Default::default()
     };
-    let one = backbone(&single, settings, &options, SemismoothNewton::default()).unwrap();
+    let one = grid_run(&single, settings, options);
     (two.points, one.points)
 }
 
@@ -161,18 +175,13 @@ fn degenerate_harmonic_of_two_identical_bars() {
 /// (from 3.95, the grazing seed of configuration 2 slides to rest).
 fn nsm1_of(second: Bar) -> Vec<BackbonePoint> {
     let system = two_bars_in_contact(second, GAP).unwrap();
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.9,
-            end: 3.3,
-            steps: 25,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.9,
+        end: 3.3,
+        steps: 25,
     };
     let settings = HarmonicBalanceSettings::default();
-    backbone(&system, settings, &options, SemismoothNewton::default())
-        .unwrap()
-        .points
+    grid_run(&system, settings, BackboneOptions::on_grid(grid, 1, 1)).points
 }
 
 /// The paper's configuration 2 `(3.8, 4, 4)` read as `EA_2/EA_1 = alpha` gives bar 2 the

@@ -5,9 +5,11 @@
 //! commensurate grid the check gives the numbers it gave before.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{backbone_with, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, compute_observed, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
-use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::verify::{
     march, periodicity_check, periodicity_of_state, Condition, Grid, Integrator, MarchOptions,
@@ -330,21 +332,18 @@ fn harmonic_balance_point_with_incommensurate_bars_is_checked() {
     let basis = settings.cosine_basis().unwrap();
     for length in [FRAC_1_SQRT_2, 0.95] {
         let system = two_bars_in_contact(Bar::new(length, 1.0, 1.0).unwrap(), 1e-3).unwrap();
-        let options = BackboneOptions {
-            grid: PeriodGrid {
-                start: 3.95,
-                end: 3.85,
-                steps: 3,
-            },
-            ..Default::default()
+        let grid = PeriodGrid {
+            start: 3.95,
+            end: 3.85,
+            steps: 3,
         };
-        let points = nonsmooth_modes::branches::backbone(
-            &system,
+        let request = Request {
             settings,
-            &options,
-            SemismoothNewton::default(),
-        )
-        .unwrap();
+            method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+            solver: Some(Solver::default()),
+            ..Request::new(1)
+        };
+        let points = compute(&system, &request).unwrap().points;
         let point = points.first().unwrap();
         assert!(point.converged);
         let mut reports = Vec::new();
@@ -387,17 +386,20 @@ fn commensurate_checks_give_the_numbers_they_gave_before() {
         ),
     ];
     for (system, before) in cases {
-        let options = BackboneOptions {
-            grid: PeriodGrid {
-                start: 3.95,
-                end: 3.05,
-                steps: 181,
-            },
-            ..Default::default()
+        let grid = PeriodGrid {
+            start: 3.95,
+            end: 3.05,
+            steps: 181,
         };
         let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
+        let request = Request {
+            settings,
+            method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+            solver: Some(Solver::Newton(solver)),
+            ..Request::new(1)
+        };
         let mut first = None;
-        backbone_with(&system, settings, &options, solver, |p| {
+        compute_observed(&system, &request, |p: &BackbonePoint| {
             first = Some(p.clone());
             ControlFlow::Break(())
         })

@@ -2,13 +2,15 @@
 //! solution) and the paper's two-bar check (its Fig. 16).
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::modal::energy;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
 };
-use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::HarmonicBalanceSettings;
+use nonsmooth_modes::solve::Solver;
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions, State, VerifyError};
 use std::f64::consts::PI;
 
@@ -27,6 +29,22 @@ fn truncated_exact(period: f64, m: usize) -> (Vec<f64>, f64) {
         x[2 * j + 1] = exact.displacement_harmonic(j) * k / k.sin();
     }
     (x, omega)
+}
+
+/// The points of the period grid `grid` of NSM 1 of `system`, with the full semismooth
+/// Newton.
+fn grid_points(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    grid: PeriodGrid,
+) -> Vec<BackbonePoint> {
+    let request = Request {
+        settings,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(Solver::default()),
+        ..Request::new(1)
+    };
+    compute(system, &request).unwrap().points
 }
 
 #[test]
@@ -70,15 +88,12 @@ fn clamped_bar_harmonic_balance_point_is_as_periodic_as_the_truncated_exact_mode
         harmonics: 20,
         ..Default::default()
     };
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.95,
-            end: 3.65,
-            steps: 7,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.95,
+        end: 3.65,
+        steps: 7,
     };
-    let points = backbone(&system, settings, &options, SemismoothNewton::default()).unwrap();
+    let points = grid_points(&system, settings, grid);
     let point = points.last().unwrap();
     assert!(point.converged);
     // This point is within 1% of the exact energy (away from internal resonances).
@@ -116,15 +131,12 @@ fn two_bar_check_of_the_paper_figure_16() {
         harmonics: 20,
         ..Default::default()
     };
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: 3.79,
-            end: 3.65,
-            steps: 15,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: 3.79,
+        end: 3.65,
+        steps: 15,
     };
-    let points = backbone(&system, settings, &options, SemismoothNewton::default()).unwrap();
+    let points = grid_points(&system, settings, grid);
     let point = points.last().unwrap();
     assert!(point.converged && (point.period - 3.65).abs() < 1e-12);
     let basis = settings.cosine_basis().unwrap();

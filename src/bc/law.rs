@@ -182,9 +182,10 @@ pub fn complementarity_samples(
 /// ```
 /// use nonsmooth_modes::bar::{Bar, EndRef};
 /// use nonsmooth_modes::bc::{BoundaryCondition, Observable, Quantity, Term, UnilateralLaw};
-/// use nonsmooth_modes::modal::{backbone, natural_frequencies, BackboneOptions, ContactState, PeriodGrid};
-/// use nonsmooth_modes::solve::SemismoothNewton;
-/// use nonsmooth_modes::system::{AssemblyBuilder, HarmonicBalanceSettings};
+/// use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
+/// use nonsmooth_modes::modal::{natural_frequencies, ContactState};
+/// use nonsmooth_modes::solve::Solver;
+/// use nonsmooth_modes::system::AssemblyBuilder;
 ///
 /// #[derive(Debug)]
 /// struct CompliantObstacle {
@@ -251,12 +252,12 @@ pub fn complementarity_samples(
 ///
 /// // A backbone of its first nonsmooth mode, as for a built-in condition: it hardens (the
 /// // energy grows as the period falls).
-/// let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
-/// let options = BackboneOptions {
-///     grid: PeriodGrid { start: 3.95, end: 3.6, steps: 8 },
-///     ..Default::default()
+/// let grid = PeriodGrid { start: 3.95, end: 3.6, steps: 8 };
+/// let request = Request {
+///     solver: Some(Solver::default()),
+///     ..Request::new(1).harmonics(10).method(Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)))
 /// };
-/// let points = backbone(&system, settings, &options, SemismoothNewton::default())?;
+/// let points = compute(&system, &request)?.points;
 /// assert!(points.iter().all(|p| p.converged));
 /// assert!(points.windows(2).all(|w| w[1].energy_normalized > w[0].energy_normalized));
 /// # Ok::<(), nonsmooth_modes::Error>(())

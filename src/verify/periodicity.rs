@@ -198,23 +198,19 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
 /// defect, the penetration, the smallest contact force and the energy drift.
 ///
 /// ```
-/// use nonsmooth_modes::modal::{backbone, BackboneOptions, PeriodGrid};
+/// use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
 /// use nonsmooth_modes::reference::clamped_bar_with_obstacle;
-/// use nonsmooth_modes::solve::SemismoothNewton;
-/// use nonsmooth_modes::system::HarmonicBalanceSettings;
+/// use nonsmooth_modes::solve::Solver;
 /// use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions};
 ///
 /// let system = clamped_bar_with_obstacle(1e-3)?;
-/// let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
-/// let options = BackboneOptions {
-///     grid: PeriodGrid { start: 3.9, end: 3.8, steps: 3 },
-///     ..Default::default()
+/// let grid = PeriodGrid { start: 3.9, end: 3.8, steps: 3 };
+/// let request = Request {
+///     solver: Some(Solver::default()),
+///     ..Request::new(1).harmonics(10).method(Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)))
 /// };
-/// let point = backbone(&system, settings, &options, SemismoothNewton::default())?
-///     .points
-///     .pop()
-///     .unwrap();
-/// let basis = settings.cosine_basis()?;
+/// let point = compute(&system, &request)?.points.pop().unwrap();
+/// let basis = request.settings.cosine_basis()?;
 /// let check = PeriodicityOptions { dt: 0.01, ..Default::default() };
 /// let report = periodicity_check(&system, &basis, &point.x, point.omega, &check).unwrap();
 /// // Ten harmonics: the displacement comes back within a few percent; the energy-norm defect

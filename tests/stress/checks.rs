@@ -4,7 +4,7 @@
 //! than the budget counted, a file read back with other numbers than were written); and which
 //! inputs are moderate enough for the plain-number evaluators to be checked.
 
-use nonsmooth_modes::branches::{BackbonePoint, PointStatus};
+use nonsmooth_modes::branches::{BackbonePoint, ModeBranches, PointStatus};
 use nonsmooth_modes::continuation::{Branch, EndReason, Event, Point};
 use nonsmooth_modes::solve::SolveInfo;
 use nonsmooth_modes::system::BarSystem;
@@ -89,6 +89,24 @@ impl Checks {
             self.no_end.push(format!(
                 "{what}: observer stopped = {stopped}, end = {:?}",
                 branch.end
+            ));
+        }
+    }
+
+    /// A run of `branches::compute`: its grazing energy and points are finite (as
+    /// [`Checks::backbone_point`]), and it says it was stopped exactly when its observer
+    /// stopped it.
+    pub(crate) fn mode_branches(&mut self, what: &str, run: &ModeBranches, stopped: bool) {
+        self.finite(&format!("{what} E_g"), [&run.grazing_energy]);
+        for p in &run.points {
+            self.backbone_point(what, p);
+        }
+        let by_observer = run.end == EndReason::StoppedByObserver;
+        if by_observer != stopped {
+            self.no_end.push(format!(
+                "{what}: {} points, observer stopped = {stopped}, end = {:?}",
+                run.points.len(),
+                run.end
             ));
         }
     }

@@ -1,28 +1,29 @@
-//! Backbones over a period grid and by arclength, and branches in a parameter of the system.
+//! Backbones over a period grid and by arclength, requests by any method (`branches::compute`),
+//! and branches in a parameter of the system.
 
 use super::drivers::{
     arclength_bounded, arclength_options, sequential_options, stall_escape, stop_policy, Stop,
     Watcher, STEP_CAP,
 };
-use super::solvers::solver;
+use super::solvers::{request_solver, solver};
 use super::{reference_system, settings, MAX_HARMONICS};
 use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
-    arclength_backbone_observed, backbone, backbone_speculative_with, backbone_with,
-    parameter_branch, ArclengthBackboneOptions, BackboneObserver, BackboneOptions, BackbonePoint,
-    ParameterSteps, PeriodGrid, PointStatus, SwitchAt,
+    compute, compute_observed, parameter_branch, ArclengthBackboneOptions, BackboneObserver,
+    BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid, Method, ParameterSteps,
+    PeriodGrid, PointStatus, Request, SwitchAt, TimeDomainCheck,
 };
-use nonsmooth_modes::continuation::{EndReason, Rejection, SequentialOptions, Speculation};
-use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
+use nonsmooth_modes::continuation::{Rejection, SequentialOptions, Speculation};
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, contact_chain, ClampedFirstMode};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::ModelError;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
-/// `branches::backbone`, `backbone_with` (an observer that may stop it) and
-/// `backbone_speculative_with`, with any grid, mode, options and solver.
+/// A period grid through `branches::compute_observed` (an observer that may stop it), with
+/// speculative retries, and through `compute`, with any grid, mode, options and solver.
 pub(crate) fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let system = reference_system(d, c)?;
     let s = settings(d);
@@ -45,7 +46,12 @@ pub(crate) fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
         selection: sequential.selection,
         trivial_energy: d.real("trivial_energy", 0.0..=1e-3),
     };
-    let solver = solver(d, c)?;
+    let mut request = Request {
+        settings: s,
+        method: Method::PeriodGrid(options),
+        solver: request_solver(d, c)?,
+        ..Request::new(mode).subharmonic(subharmonic)
+    };
     let mut points = Vec::new();
     let stop = stop_policy(d, true);
     let (mut seen, mut stopped) = (0, false);
@@ -59,27 +65,32 @@ pub(crate) fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
             ControlFlow::Continue(())
         }
     };
-    let run = match d.pick("backbone", &["with", "speculative", "plain"]) {
-        "with" => backbone_with(&system, s, &options, solver, collect),
+    let observed = match d.pick("backbone", &["with", "speculative", "plain"]) {
+        "with" => true,
         "speculative" => {
-            let speculation = Speculation {
+            request.speculation = Some(Speculation {
                 after_evaluations: d.size("after_evaluations", 0..=20),
-            };
-            backbone_speculative_with(&system, s, &options, speculation, solver, collect)
+            });
+            true
         }
-        _ => backbone(&system, s, &options, solver).map(|b| {
-            points = b.points;
-            (b.grazing_energy, b.end)
-        }),
+        _ => false,
     };
-    let (e_g, end) = typed(c, "backbone", run)?;
-    c.finite("E_g", [&e_g]);
+    let run = if observed {
+        compute_observed(&system, &request, collect)
+    } else {
+        compute(&system, &request)
+    };
+    let run = typed(c, "backbone", run)?;
     // A run stopped by the observer says so (the plain form's observer never stops it).
-    if (end == EndReason::StoppedByObserver) != stopped {
-        c.no_end
-            .push(format!("backbone: {} points, end {end:?}", points.len()));
+    c.mode_branches("backbone", &run, stopped);
+    // The observer saw the points the run returns.
+    if observed && points != run.points {
+        c.no_end.push(format!(
+            "backbone: the observer saw {} points, the run returned {}",
+            points.len(),
+            run.points.len()
+        ));
     }
-    points.iter().for_each(|p| c.backbone_point("backbone", p));
     Ok(())
 }
 
@@ -99,7 +110,8 @@ impl BackboneObserver for &mut BackboneWatcher {
     }
 }
 
-/// `branches::arclength_backbone_observed` with any options, escape and observer.
+/// `branches::compute_observed` by `Method::Arclength` (or `Method::Switch`) with any options,
+/// escape and observer.
 pub(crate) fn arclength_backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let system = reference_system(d, c)?;
     let s = settings(d);
@@ -122,29 +134,180 @@ pub(crate) fn arclength_backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResul
             side: d.choice("switch side", &[1.0, -1.0], &[0.0, f64::NAN, 2.0]),
         }),
     };
-    let solver = solver(d, c)?;
+    let method = match options.switch {
+        Some(at) => Method::Switch(options, at),
+        None => Method::Arclength(options),
+    };
+    let request = Request {
+        settings: s,
+        method,
+        solver: request_solver(d, c)?,
+        ..Request::new(options.mode).subharmonic(options.subharmonic)
+    };
     // The observer sees rejected steps too, so an unbounded run (a shrink factor close to 1
     // with no rejection budget) is stopped by the watcher's step cap.
     let mut observer = BackboneWatcher {
         watcher: Watcher::new(stop_policy(d, arclength_bounded(&arclength))),
         points: Vec::new(),
     };
-    let (e_g, branch) = typed(
+    let run = typed(
         c,
         "arclength_backbone",
-        arclength_backbone_observed(&system, s, &options, solver, &mut observer),
+        compute_observed(&system, &request, &mut observer),
     )?;
     let BackboneWatcher { watcher, points } = observer;
     let stopped = watcher.stopped;
-    c.finite("E_g", [&e_g]);
     if watcher.seen >= STEP_CAP {
         c.no_end
             .push(format!("arclength backbone: no end after {STEP_CAP} steps"));
     }
-    c.branch("arclength backbone", &branch, stopped);
-    points
-        .iter()
-        .for_each(|p| c.backbone_point("arclength backbone", p));
+    c.mode_branches("arclength backbone", &run, stopped);
+    if points != run.points {
+        c.no_end.push(format!(
+            "arclength backbone: the observer saw {} points, the run returned {}",
+            points.len(),
+            run.points.len()
+        ));
+    }
+    Ok(())
+}
+
+/// `branches::compute_observed` with a random request: any method (`Auto` and the options
+/// derived from the system among them, or options drawn at random), mode, order, solver,
+/// speculation and time-domain check, on one of the paper's systems or the three-bar chain
+/// (whose floating bar makes `Auto` enter its branch at a shorter period). Every run is
+/// stopped by its observer after a few steps, so that the system-derived grids stay cheap.
+pub(crate) fn request_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
+    let system = if d.flag("three-bar chain", 0.2) {
+        let gap = d.real("chain gap", 1e-4..=0.1);
+        let spring = d.real("chain spring", 0.05..=5.0);
+        typed(c, "contact_chain", contact_chain(3, gap, spring))?
+    } else {
+        reference_system(d, c)?
+    };
+    let s = settings(d);
+    let mode = d.size("mode", 1..=2);
+    let subharmonic = d.size("subharmonic", 1..=3);
+    let derived = d.flag("options from the system", 0.7);
+    let name = d.pick(
+        "method",
+        &[
+            "auto",
+            "period-grid",
+            "arclength",
+            "switch",
+            "energy",
+            "genuine-subharmonic",
+        ],
+    );
+    let grid = |d: &mut Draw, c: &mut Checks| -> Result<BackboneOptions, String> {
+        if derived {
+            typed(
+                c,
+                "BackboneOptions::for_mode",
+                BackboneOptions::for_mode(&system, mode, subharmonic),
+            )
+        } else {
+            let period = 3.9 * d.real("period factor", 0.5..=2.0);
+            let grid = PeriodGrid {
+                start: d.real("grid start", period..=period),
+                end: d.real("grid end", period * 0.8..=period),
+                steps: d.size("steps", 2..=8),
+            };
+            Ok(BackboneOptions::on_grid(grid, mode, subharmonic))
+        }
+    };
+    let arclength = |d: &mut Draw, c: &mut Checks| -> Result<ArclengthBackboneOptions, String> {
+        let mut options = if derived {
+            typed(
+                c,
+                "ArclengthBackboneOptions::for_mode",
+                ArclengthBackboneOptions::for_mode(&system, mode, subharmonic),
+            )?
+        } else {
+            let range = (d.real("omega lo", 1.0..=1.6), d.real("omega hi", 1.6..=2.5));
+            let start = d.real("start_period", 3.0..=4.5);
+            ArclengthBackboneOptions::seeded_at(start, range, (mode, subharmonic))
+        };
+        options.escape = d.flag("escape", 0.5).then(|| stall_escape(d));
+        Ok(options)
+    };
+    let method = match name {
+        "auto" => Method::Auto,
+        "period-grid" => Method::PeriodGrid(grid(d, c)?),
+        "genuine-subharmonic" => Method::GenuineSubharmonic(grid(d, c)?),
+        "arclength" => Method::Arclength(arclength(d, c)?),
+        "switch" => Method::Switch(
+            arclength(d, c)?,
+            SwitchAt {
+                branch_point: d.size("switch branch point", 0..=3),
+                side: d.choice("switch side", &[1.0, -1.0], &[0.0, f64::NAN, 2.0]),
+            },
+        ),
+        _ => {
+            let mut options = typed(
+                c,
+                "EnergyBackboneOptions::for_mode",
+                EnergyBackboneOptions::for_mode(&system, mode, subharmonic),
+            )?;
+            if !derived {
+                options.levels = EnergyGrid {
+                    start: d.real("level start", 0.5..=2.0),
+                    end: d.real("level end", 1.0..=50.0),
+                    steps: d.size("levels", 2..=8),
+                };
+            }
+            Method::Energy(options)
+        }
+    };
+    let mut request = Request::new(mode).subharmonic(subharmonic).method(method);
+    request.settings = s;
+    request.solver = request_solver(d, c)?;
+    if d.flag("speculation", 0.2) {
+        request.speculation = Some(Speculation {
+            after_evaluations: d.size("after_evaluations", 0..=20),
+        });
+    }
+    if d.flag("time-domain check", 0.2) {
+        request = request.checked(TimeDomainCheck::for_system(&system));
+    }
+    // The observer sees rejected steps too; it always stops the run (after a few steps).
+    let mut observer = BackboneWatcher {
+        watcher: Watcher::new(stop_policy(d, false)),
+        points: Vec::new(),
+    };
+    let run = typed(
+        c,
+        "compute",
+        compute_observed(&system, &request, &mut observer),
+    )?;
+    let BackboneWatcher { watcher, points } = observer;
+    c.mode_branches(&format!("compute ({name})"), &run, watcher.stopped);
+    c.expect(points == run.points, || {
+        format!(
+            "compute ({name}): the observer saw {} points, the run returned {}",
+            points.len(),
+            run.points.len()
+        )
+    });
+    // `Auto` says what it chose; any other method runs as asked.
+    c.expect((name == "auto") == run.auto.is_some(), || {
+        format!(
+            "compute ({name}): ran {} with choice {:?}",
+            run.method.name(),
+            run.auto
+        )
+    });
+    if name != "auto" {
+        c.expect(run.method.name() == name, || {
+            format!("compute ({name}): ran {}", run.method.name())
+        });
+    }
+    for p in run.converged() {
+        if let Some(defect) = p.displacement_defect {
+            c.finite("compute displacement defect", [&defect]);
+        }
+    }
     Ok(())
 }
 

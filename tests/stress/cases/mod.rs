@@ -32,10 +32,11 @@ pub(crate) enum Kind {
     ArclengthBackbone,
     ParameterBranch,
     PostProcessing,
+    Request,
 }
 
 /// Every kind, drawn uniformly by each case.
-pub(crate) const KINDS: [Kind; 9] = [
+pub(crate) const KINDS: [Kind; 10] = [
     Kind::Assembly,
     Kind::Settings,
     Kind::Solver,
@@ -45,6 +46,7 @@ pub(crate) const KINDS: [Kind; 9] = [
     Kind::ArclengthBackbone,
     Kind::ParameterBranch,
     Kind::PostProcessing,
+    Kind::Request,
 ];
 
 impl Kind {
@@ -59,6 +61,7 @@ impl Kind {
             Kind::ArclengthBackbone => backbones::arclength_backbone_case(d, c),
             Kind::ParameterBranch => backbones::parameter_case(d, c),
             Kind::PostProcessing => post::post_processing(d, c),
+            Kind::Request => backbones::request_case(d, c),
         }
     }
 }

@@ -6,11 +6,11 @@ use crate::checks::{moderate_motion, typed, CaseResult, Checks};
 use crate::draw::Draw;
 use nonsmooth_modes::bar::{Bar, BarId, EndRef};
 use nonsmooth_modes::bc::{BoundaryCondition, LinearRows, Quantity, Term};
-use nonsmooth_modes::branches::{backbone, BackboneOptions, PeriodGrid};
+use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
 use nonsmooth_modes::modal::{
     branch_seed, energy, grazing_energy, natural_frequencies, ContactState,
 };
-use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton};
+use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
@@ -157,17 +157,22 @@ pub(crate) fn assembly(d: &mut Draw, c: &mut Checks) -> CaseResult {
             c.finite("seed energy", [&e]);
         }
     }
-    let options = BackboneOptions {
-        grid: PeriodGrid {
-            start: period * 0.99,
-            end: period * 0.9,
-            steps: 3,
-        },
-        ..Default::default()
+    let grid = PeriodGrid {
+        start: period * 0.99,
+        end: period * 0.9,
+        steps: 3,
     };
     let fast = SemismoothNewton::new(NewtonOptions::fail_fast()).expect("valid");
-    let points = typed(c, "backbone", backbone(&system, s, &options, fast))?;
-    points.iter().for_each(|p| c.backbone_point("backbone", p));
+    let request = Request {
+        settings: s,
+        method: Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)),
+        solver: Some(Solver::Newton(fast)),
+        ..Request::new(1)
+    };
+    let run = typed(c, "backbone", compute(&system, &request))?;
+    run.points
+        .iter()
+        .for_each(|p| c.backbone_point("backbone", p));
     Ok(())
 }
 

@@ -7,7 +7,7 @@ use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::branch_seed;
 use nonsmooth_modes::solve::{
     Dogleg, DoglegOptions, NewtonOptions, NonlinearSolver, Problem, SemismoothNewton,
-    SmoothingHomotopy, SolveInfo, SolveMonitor,
+    SmoothingHomotopy, SolveInfo, SolveMonitor, Solver,
 };
 use nonsmooth_modes::SolveError;
 use std::f64::consts::PI;
@@ -84,15 +84,7 @@ pub(crate) fn solver(d: &mut Draw, c: &mut Checks) -> Result<AnySolver, String> 
             let solver = typed(c, "SemismoothNewton::new", SemismoothNewton::new(o))?;
             Ok(AnySolver::Newton(solver))
         }
-        "dogleg" => {
-            let o = DoglegOptions {
-                tolerance: d.tolerance("tolerance", 1e-12..=1e-3),
-                max_iterations: iterations(d, 0..=60, 0.15),
-                initial_radius: d.real("initial_radius", 1e-3..=10.0),
-                min_radius: d.real("min_radius", 1e-14..=1e-2),
-            };
-            Ok(AnySolver::Dogleg(typed(c, "Dogleg::new", Dogleg::new(o))?))
-        }
+        "dogleg" => Ok(AnySolver::Dogleg(dogleg(d, c)?)),
         _ => {
             let levels = (0..d.size("levels", 0..=4))
                 .take(8)
@@ -102,6 +94,39 @@ pub(crate) fn solver(d: &mut Draw, c: &mut Checks) -> Result<AnySolver, String> 
             Ok(AnySolver::Homotopy(SmoothingHomotopy { inner, levels }))
         }
     }
+}
+
+/// A dogleg with random options (a typed error when invalid).
+fn dogleg(d: &mut Draw, c: &mut Checks) -> Result<Dogleg, String> {
+    let o = DoglegOptions {
+        tolerance: d.tolerance("tolerance", 1e-12..=1e-3),
+        max_iterations: iterations(d, 0..=60, 0.15),
+        initial_radius: d.real("initial_radius", 1e-3..=10.0),
+        min_radius: d.real("min_radius", 1e-14..=1e-2),
+    };
+    typed(c, "Dogleg::new", Dogleg::new(o))
+}
+
+/// The solver of a request ([`Solver`], which has no smoothing homotopy): the method's own
+/// (`None`), the defaults, `fail_fast`, or random options (a typed error when invalid).
+pub(crate) fn request_solver(d: &mut Draw, c: &mut Checks) -> Result<Option<Solver>, String> {
+    Ok(Some(
+        match d.pick(
+            "request solver",
+            &["method's", "default", "fail_fast", "newton", "dogleg"],
+        ) {
+            "method's" => return Ok(None),
+            "default" => Solver::default(),
+            "fail_fast" => Solver::Newton(
+                SemismoothNewton::new(NewtonOptions::fail_fast()).expect("fail_fast is valid"),
+            ),
+            "newton" => {
+                let o = newton_options(d);
+                Solver::Newton(typed(c, "SemismoothNewton::new", SemismoothNewton::new(o))?)
+            }
+            _ => Solver::Dogleg(dogleg(d, c)?),
+        },
+    ))
 }
 
 /// A solve from a scaled seed with any solver and options, at any frequency; or a
