@@ -308,7 +308,7 @@ fn assert_every_contact_touches(system: &BarSystem, points: &[BackbonePoint]) {
 /// between walls are entered where asked (and run on the period grid).
 #[test]
 fn the_chains_start_lies_above_the_grids_first_frequency() {
-    let auto = request(20, Method::Auto);
+    let auto = request(20, Method::Auto(None));
     let chain = nonsmooth_modes::reference::contact_chain(3, GAP, 0.5).unwrap();
     let omega = 2.0 * PI / PeriodGrid::for_mode(&chain, 1, 1).unwrap().start;
     let run = compute(&chain, &auto).unwrap();

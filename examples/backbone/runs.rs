@@ -102,9 +102,10 @@ fn request(
             Some(at) => Method::Switch(options, at),
             None => Method::Arclength(options),
         }
-    } else if a.subharmonic > 1 && a.repeated {
-        Method::PeriodGrid(grid)
-    } else if a.arclength == Some(false) && a.subharmonic == 1 {
+    } else if (a.subharmonic > 1 && a.repeated)
+        || (a.arclength == Some(false) && a.subharmonic == 1)
+    {
+        // The repeated branch of a subharmonic, or the grid asked for.
         Method::PeriodGrid(grid)
     } else {
         Method::Auto(Some(grid))

@@ -49,7 +49,7 @@ use std::ops::ControlFlow;
 /// let system = clamped_bar_with_obstacle(1e-3)?;
 /// let run = compute(&system, &Request::new(1).harmonics(10))?;
 /// assert!(run.converged().count() > 100);
-/// println!("{} by {}", run.end.label(), run.method.name());
+/// println!("{:?} by {}", run.end, run.method.name());
 /// # Ok::<(), nonsmooth_modes::Error>(())
 /// ```
 pub fn compute(system: &BarSystem, request: &Request) -> Result<ModeBranches, Error> {

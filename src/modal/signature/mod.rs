@@ -242,12 +242,15 @@ pub(crate) fn contact_samples<B: Basis>(
     Ok(laws.into_iter().map(|(contact, _)| contact).collect())
 }
 
+/// One law's samples over a period: in contact or not, and the gap.
+pub(crate) type ContactAndGap = (Vec<bool>, Vec<f64>);
+
 /// For each law, [`contact_samples`] and the gap history it was computed from.
 pub(crate) fn contact_and_gap_samples<B: Basis>(
     problem: &mut NonsmoothSystem<B>,
     x: &[f64],
     omega: f64,
-) -> Result<Vec<(Vec<bool>, Vec<f64>)>, SettingsError> {
+) -> Result<Vec<ContactAndGap>, SettingsError> {
     check_motion(problem, x, omega)?;
     // The histories first: they move the problem to `omega`, the laws then borrow it.
     let histories: Vec<(Vec<f64>, Vec<f64>)> = (0..problem.system().contact_count())

@@ -233,7 +233,7 @@ pub(crate) fn request_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
         Ok(options)
     };
     let method = match name {
-        "auto" => Method::Auto,
+        "auto" => Method::Auto(d.flag("auto grid", 0.5).then(|| grid(d, c)).transpose()?),
         "period-grid" => Method::PeriodGrid(grid(d, c)?),
         "genuine-subharmonic" => Method::GenuineSubharmonic(grid(d, c)?),
         "arclength" => Method::Arclength(arclength(d, c)?),
@@ -304,8 +304,15 @@ pub(crate) fn request_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
         });
     }
     for p in run.converged() {
-        if let Some(defect) = p.displacement_defect {
-            c.finite("compute displacement defect", [&defect]);
+        if let Some(report) = p.time_domain {
+            c.finite("compute displacement defect", [&report.displacement_defect]);
+        }
+        if let Some(character) = &p.character {
+            let shares = character
+                .energy_by_bar
+                .iter()
+                .chain(&character.energy_by_harmonic);
+            c.finite("compute energy shares", shares);
         }
     }
     Ok(())
