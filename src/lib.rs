@@ -31,14 +31,15 @@
 //! | [`solve::NonlinearSolver`] | [`solve::SemismoothNewton`], [`solve::Dogleg`], [`solve::SmoothingHomotopy`] |
 //! | [`solve::Problem`], [`solve::Structured`] | what a solver sees: residual, Jacobian, and optional capabilities (structured solve, line-search residual, smoothing, weights, active sets) |
 //! | [`continuation::ContinuationProblem`] | a problem with a parameter: [`continuation::Sequential`], [`continuation::Speculative`], [`continuation::Arclength`], all with one shape ([`continuation::Step`], iterator, `run` with an [`continuation::Observer`]) |
-//! | [`branches::backbone()`], [`branches::arclength_backbone`] (with [`branches::StallEscape`]), [`branches::parameter_branch`] | one call: a backbone with `E / E_g`; a point continued in any system parameter |
-//! | [`branches::energy_backbone`], [`branches::EnergyLevel`] | a backbone continued in `E / E_g`, the frequency an unknown (the state of rest excluded) |
+//! | [`branches::compute`] with a [`branches::Request`] → [`branches::ModeBranches`] | the one call: a branch of NSM `i` (sub `K`) by a [`branches::Method`] (period grid, arclength with the [`branches::StallEscape`], switch at a branch point, energy level, genuine subharmonic, or `Auto`), every point with its status, branch, [`modal::Character`], [`modal::Label`] and, when asked, time-domain check |
+//! | [`branches::parameter_branch`] | a point continued in any system parameter |
+//! | [`modal::character`], [`modal::label`] | what a motion is: contacts and grazings per period, energy by bar and harmonic, dominant modes; skeleton, internal resonance, subharmonic or unverified |
 //! | [`Solution`] | a computed motion (problem, unknowns, frequency): energy, `E/E_g`, fields, end and law histories, diagnostics, time-domain check |
 //! | [`modal::diagnose`], [`modal::FieldEvaluator`] | residual norm `R^(m)`, penetration, fields, histories of a point |
 //! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |
 //! | [`mod@reference`] | the paper's systems and exact solutions |
 //! | [`io`] | CSV, and JSON with the `serde` feature; with it, assemblies from TOML/JSON files |
-//! | [`sweep::backbones`] | many backbones at once; in parallel with the `parallel` feature (rayon), results identical to the serial run |
+//! | [`sweep::backbones`] | many requests at once; in parallel with the `parallel` feature (rayon), results identical to the serial run |
 //!
 //! ## Features
 //!

@@ -1,4 +1,4 @@
-//! Backbone of a nonsmooth mode by sequential continuation in the period, written as CSV.
+//! Backbone of a nonsmooth mode, written as CSV: a thin front end of `branches::compute`.
 //!
 //! ```text
 //! cargo run --release --example backbone -- [--system ds|rs|two-bar] [--gap 1e-3]
@@ -42,9 +42,11 @@
 //! first mode of the clamped bar, formulation §9, when the system is the clamped bar —
 //! `--system ds` or a file with the same bars and conditions — with `--mode 1 --subharmonic 1`,
 //! and empty otherwise; `event` lists fold/jump/grazing events separated by `;`; `parameter` is the
-//! continued parameter's value). `--verify` marches every point one period in time with the
-//! exact integrator (`verify::periodicity_check`, `dt = 1/400`) and adds the columns
-//! `periodicity_defect,displacement_defect,max_penetration`.
+//! continued parameter's value). `--verify` asks the library to check every converged point
+//! (`branches::TimeDomainCheck::for_system`: one period of the exact integrator with a step of
+//! 1/400 of the shortest travel time, at most 10^6 steps per point) and adds the columns
+//! `periodicity_defect,displacement_defect,max_penetration` (empty, with a message, for a
+//! point it could not check).
 //!
 //! Last in every row, so that the columns before them keep their places:
 //! `contacts_per_period`, the number of contact intervals per period summed over the
@@ -55,26 +57,31 @@
 //! (`modal::subharmonic_share`: 0 while the branch is the `T`-periodic mode repeated, away
 //! from 0 where it is genuinely subharmonic; empty for a point collapsed to rest). A cell is
 //! left empty, with a message on stderr, where the point's unknowns do not allow the
-//! computation (not finite).
+//! computation (not finite). Then `label,branch,dominant_harmonic` (`modal::Label`,
+//! `BackbonePoint::branch`, `modal::Character::dominant_harmonic`): `skeleton`,
+//! `internal-resonance-hJ-modeK` (harmonic `J` meets linear mode `K`), `subharmonic-K` or,
+//! with `--verify`, `unverified` for a point whose displacement defect exceeds 5 % (empty for
+//! a point that did not converge); the index of the branch within the run (one more after
+//! each jump); the harmonic holding the most energy.
 //!
 //! `--subharmonic K > 1` (sequential runs in the period): the seed on harmonic `K` gives the
 //! mode of period `T/K` traced `K` times, a subspace Newton's method never leaves; the run
 //! follows it until a point can be left along the most singular direction off the multiples
 //! of `K`, then continues on that genuinely `T`-periodic branch
-//! (`branches::genuine_subharmonic_backbone_with`). `--repeated` keeps the repeated branch.
+//! (`Method::GenuineSubharmonic`). `--repeated` keeps the repeated branch.
 //!
 //! `--method sequential` visits `--steps` equispaced periods. `--method arclength` follows
 //! the branch in `Omega` inside `--omega-range` (default: the periods' range) with automatic
 //! escape from internal-resonance stalls, walking it back first where its start is found only
-//! above the first period's frequency. Without `--method` a run in the period is sequential,
-//! except for an assembly file whose branch cannot be entered at the first period
-//! (`branches::backbone_start`, `BackboneStart::moved_from`; the three-bar chain), which is
-//! followed by arclength, as stderr says; its `event` column marks folds, jumps, grazing and
+//! above the first period's frequency. Without `--method` the library chooses
+//! (`Method::Auto` on the period grid): sequential, except where the branch cannot be
+//! entered at the first period (the three-bar chain), which is followed by arclength, as
+//! stderr says; its `event` column marks folds, jumps, grazing and
 //! branch points (`branch-point`: the sign of the bordered Jacobian's determinant changed),
 //! and `--switch-at N[:SIDE]` leaves the branch at its `N`-th branch point for the branch
 //! crossing there, on side `SIDE` (`1`, the default, or `-1`) of its direction
 //! (`ArclengthBackboneOptions::switch`). `--parameter energy` continues the branch in the
-//! energy level `E/E_g` with the frequency an unknown (`branches::energy_backbone`; levels from
+//! energy level `E/E_g` with the frequency an unknown (`Method::Energy`; levels from
 //! `--energy-range LO:HI`, default from mode `i`'s grazing energy to 300 times it, in `--steps`
 //! geometric levels; sequential only); the points where it walks an internal resonance in the
 //! period are rows too (`docs/assemblies.md`). `--parameter gap|robin-stiffness|stiffness-ratio`
@@ -89,7 +96,7 @@
 //! `--retry-depth` earlier converged points (default 1; 2 for a period backbone of a file
 //! with a bar held only by contacts, `BackboneOptions::for_mode`; 0
 //! switches the retry off). Where the machine has more than one core, the first retry runs on
-//! a second thread beside the first attempt (`backbone_speculative_with`; the same points, bit
+//! a second thread beside the first attempt (`Request::speculation`; the same points, bit
 //! for bit); `--serial` keeps everything on one thread. A sequential run ends as stalled
 //! (exit code 1, after writing every row) after `--max-failures` consecutive failed steps
 //! (`BackboneOptions::max_consecutive_failures`, default 40).
@@ -106,8 +113,7 @@
 //! hours or days are refused with exit code 2: `--steps` and `--max-steps` at most
 //! [`MAX_POINTS`] (an arclength run whose steps are too small to move the parameter only ends
 //! at `--max-steps`), `--harmonics` at most [`MAX_HARMONICS`], `--samples-per-harmonic` at
-//! most [`MAX_SAMPLES_PER_HARMONIC`]. `--verify` skips, with a message, a point whose march
-//! would take more than [`MAX_VERIFY_STEPS`] time steps (a period over 2500).
+//! most [`MAX_SAMPLES_PER_HARMONIC`].
 //!
 //! Exit codes: 0 when the run completed (steps that did not converge are reported, not
 //! errors); 1 when the run failed, including values the library rejects (`--steps 0`,
@@ -119,7 +125,6 @@
 //! [`MAX_POINTS`]: args::MAX_POINTS
 //! [`MAX_HARMONICS`]: args::MAX_HARMONICS
 //! [`MAX_SAMPLES_PER_HARMONIC`]: args::MAX_SAMPLES_PER_HARMONIC
-//! [`MAX_VERIFY_STEPS`]: args::MAX_VERIFY_STEPS
 
 mod args;
 mod output;

@@ -43,12 +43,18 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         let mut problem = NonsmoothSystem::new(&system, a.settings)?;
         let see = |p: &BackbonePoint| sink.row(&mut problem, p, f64::NAN);
         let run = compute_observed(&system, &request, see)?;
-        if let Some(AutoChoice::EnteredAtShorterPeriod { entered_at }) = run.auto {
-            eprintln!(
+        match run.auto {
+            Some(AutoChoice::EnteredAtShorterPeriod { entered_at }) => eprintln!(
                 "backbone: the branch is entered at T = {entered_at:.6}, not at the grid's first \
                  period {t0:.6}: it is followed by pseudo-arclength from T0 (--method sequential \
                  keeps the period grid)"
-            );
+            ),
+            Some(AutoChoice::GridFellShort { converged, steps }) => eprintln!(
+                "backbone: the period grid converged {converged} of {steps} steps: the branch \
+                 is followed by pseudo-arclength over its range instead (--method sequential \
+                 keeps the period grid)"
+            ),
+            _ => {}
         }
         eprintln!(
             "backbone: {} ended: {:?}; {} rejected steps",

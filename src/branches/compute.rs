@@ -10,8 +10,9 @@ use crate::branches::request::{AutoChoice, Method, Request};
 use crate::branches::result::{Annotator, ModeBranches};
 use crate::branches::start::{backbone_start, BackboneStart};
 use crate::branches::subharmonic::genuine_subharmonic_backbone_with;
-use crate::continuation::Rejection;
+use crate::continuation::{EndReason, Rejection};
 use crate::error::{Error, SettingsError};
+use crate::solve::Solver;
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -29,7 +30,11 @@ use std::ops::ControlFlow;
 ///   period grid runs from that start; where it is entered only at a higher frequency (a
 ///   floating bar that must be pushed hard enough to shuttle within a period),
 ///   pseudo-arclength from the grid's first period walks the branch back and follows it
-///   through its folds ([`ArclengthBackboneOptions::for_mode`]).
+///   through its folds ([`ArclengthBackboneOptions::over_grid`]).
+/// - A period grid is judged before its points are shown: where it stalls or converges
+///   fewer than half its steps (its branch saturates at a period inside the grid, or it walks
+///   the truncated system's resonances), pseudo-arclength over the grid's range is run
+///   instead, and the grid's points are not returned ([`AutoChoice::GridFellShort`]).
 ///
 /// The choice is [`ModeBranches::auto`].
 ///
@@ -71,18 +76,62 @@ pub fn compute_observed(
 ) -> Result<ModeBranches, Error> {
     let problem = NonsmoothSystem::new(system, request.settings)?;
     let (plan, method, auto) = resolve(system, request)?;
-    let solver = request.solver_for(&method)?;
     let mut annotator = Annotator::new(&problem, request, observer);
+    if let (Plan::Grid(options, _), Some(AutoChoice::EnteredAtGridStart)) = (&plan, auto) {
+        // Auto's period grid is judged before it is shown: a grid that falls short gives
+        // way to pseudo-arclength over its range.
+        let options = *options;
+        let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
+        let mut trial = Annotator::new(&problem, request, quiet);
+        let solver = request.solver_for(&method)?;
+        let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut trial)?;
+        let converged = trial.converged();
+        if !grid_fell_short(converged, options.grid.steps, &end) {
+            let end = annotator.replay(trial.into_points(), end);
+            return Ok(annotator.finish((method, auto), e_g, end, rejected));
+        }
+        let arclength = ArclengthBackboneOptions::over_grid(&options);
+        let method = Method::Arclength(arclength);
+        let auto = Some(AutoChoice::GridFellShort {
+            converged,
+            steps: options.grid.steps,
+        });
+        let solver = request.solver_for(&method)?;
+        let plan = Plan::Arclength(arclength);
+        let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
+        return Ok(annotator.finish((method, auto), e_g, end, rejected));
+    }
+    let solver = request.solver_for(&method)?;
+    let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
+    Ok(annotator.finish((method, auto), e_g, end, rejected))
+}
+
+/// Whether a period grid of `steps` steps that converged `converged` of them and ended with
+/// `end` falls short of a backbone: it stalled, or fewer than half its steps converged (its
+/// branch left the grid's range, or the grid walks the truncated system's resonances).
+fn grid_fell_short(converged: usize, steps: usize, end: &EndReason) -> bool {
+    end.error().is_some() || 2 * converged < steps
+}
+
+/// Runs `plan` with `solver`, handing every point to `annotator`; returns `E_g`, the end
+/// reason and the rejected steps.
+fn run_plan<O: BackboneObserver>(
+    system: &BarSystem,
+    request: &Request,
+    plan: Plan,
+    solver: Solver,
+    annotator: &mut Annotator<O>,
+) -> Result<(f64, EndReason, usize), Error> {
     let settings = request.settings;
+    let spec = request.speculation;
     let see = |p: &BackbonePoint| annotator.point(p);
-    let (grazing_energy, end, rejected) = match plan {
+    Ok(match plan {
         Plan::Grid(options, Some(start)) => {
-            let spec = request.speculation;
             let (e_g, end) = backbone_from(system, settings, &options, start, spec, solver, see)?;
             (e_g, end, 0)
         }
         Plan::Grid(options, None) => {
-            let (e_g, end) = match request.speculation {
+            let (e_g, end) = match spec {
                 Some(spec) => {
                     backbone_speculative_with(system, settings, &options, spec, solver, see)?
                 }
@@ -100,21 +149,19 @@ pub fn compute_observed(
             (e_g, end, 0)
         }
         Plan::Arclength(options) => {
-            let seen = Forward(&mut annotator);
+            let seen = Forward(annotator);
             let (e_g, branch) =
                 arclength_backbone_observed(system, settings, &options, solver, seen)?;
             (e_g, branch.end, branch.rejections)
         }
         Plan::FromSeed(options, start, not_found) => {
-            let spec = request.speculation;
             let (e_g, end) = backbone_from(system, settings, &options, start, spec, solver, see)?;
             if annotator.converged() == 0 {
                 return Err(not_found);
             }
             (e_g, end, 0)
         }
-    };
-    Ok(annotator.finish((method, auto), grazing_energy, end, rejected))
+    })
 }
 
 /// An observer that hands what it sees to the annotator (the arclength backbone takes its

@@ -65,6 +65,14 @@ pub enum AutoChoice {
     Subharmonic,
     /// The branch can be entered at the grid's first period: the period grid.
     EnteredAtGridStart,
+    /// The period grid fell short (it stalled, or fewer than half its steps converged):
+    /// pseudo-arclength over its range ran instead.
+    GridFellShort {
+        /// Converged steps of the grid.
+        converged: usize,
+        /// Steps of the grid.
+        steps: usize,
+    },
     /// No start was found near the grid's first period: the period grid runs from the
     /// unsolved seed, and may enter its branch further on (a run that never does ends with
     /// [`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound)).

@@ -137,6 +137,26 @@ impl<O: BackboneObserver> Annotator<O> {
         self.observer.rejected(rejection)
     }
 
+    /// Shows points annotated by another annotator of the same request to the observer and
+    /// keeps them, up to the one at which it stops the run; returns `end`, or
+    /// [`EndReason::StoppedByObserver`] if it stopped.
+    pub(crate) fn replay(&mut self, points: Vec<BackbonePoint>, end: EndReason) -> EndReason {
+        for point in points {
+            self.converged += usize::from(point.converged);
+            let flow = self.observer.point(&point);
+            self.points.push(point);
+            if flow.is_break() {
+                return EndReason::StoppedByObserver;
+            }
+        }
+        end
+    }
+
+    /// The points kept, in order.
+    pub(crate) fn into_points(self) -> Vec<BackbonePoint> {
+        self.points
+    }
+
     /// The converged points so far.
     pub(crate) fn converged(&self) -> usize {
         self.converged
