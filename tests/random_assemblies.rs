@@ -279,6 +279,23 @@ fn every_assembly_gives_a_branch_or_a_typed_reason() {
         .any(|o| matches!(o, Outcome::Run { converged, .. } if *converged > 0)));
 }
 
+/// The energy backbone refuses the drifting assemblies of the sequence as the others do,
+/// before any solve.
+#[test]
+fn the_energy_backbone_refuses_drifting_assemblies() {
+    let mut refused = 0;
+    for seed in 0..12 {
+        let drawn = draw(seed);
+        if drifting_bars(&drawn.system).is_none() {
+            continue;
+        }
+        let outcome = run(&drawn.system, Method::Energy, 8, false);
+        assert!(matches!(outcome, Outcome::Unconfined), "{outcome:?}");
+        refused += 1;
+    }
+    assert!(refused > 0);
+}
+
 fn env_number(name: &str, default: usize) -> usize {
     std::env::var(name)
         .ok()
