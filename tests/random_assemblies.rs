@@ -14,11 +14,15 @@
 //!   few assemblies at `m = 8`.
 //! - `random_assembly_census` (`#[ignore]`): the figures of `docs/assemblies.md`, at the
 //!   harmonics `RANDOM_HARMONICS` (default 20) over `RANDOM_COUNT` (default 50) held
-//!   assemblies: `cargo test --release --all-features --test random_assemblies -- --ignored
-//!   --nocapture`.
+//!   assemblies from seed `RANDOM_SEED_OFFSET` (default 0), by the methods of
+//!   `RANDOM_METHODS` (default `grid`): `cargo test --release --all-features --test
+//!   random_assemblies -- --ignored --nocapture`.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{compute, BackboneOptions, Method, Request};
+use nonsmooth_modes::branches::{
+    compute, ArclengthBackboneOptions, BackboneOptions, EnergyBackboneOptions, Method,
+    ModeBranches, Request, TRIVIAL_ENERGY,
+};
 use nonsmooth_modes::modal::drifting_bars;
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
@@ -136,27 +140,81 @@ enum Outcome {
     },
 }
 
-/// The default backbone of `system` at `harmonics`, checking the invariants every run must
-/// keep; `verify` marches each converged point one period in time.
-fn run(system: &BarSystem, harmonics: usize, verify: bool) -> Outcome {
+/// How a backbone is computed: each method's defaults from the system.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Way {
+    /// The period grid ([`BackboneOptions::for_mode`]), fail-fast Newton.
+    Grid,
+    /// Pseudo-arclength in the frequency ([`ArclengthBackboneOptions::for_mode`]), Newton.
+    Arclength,
+    /// Sequential in the energy ([`EnergyBackboneOptions::for_mode`]), fail-fast Newton.
+    Energy,
+    /// The library's choice, [`Method::Auto`], with its own solvers.
+    Auto,
+}
+
+/// Converged points below which the census's "arclength, then grid" falls back to the
+/// period grid: a rule `docs/assemblies.md` compares with `Method::Auto`.
+const AUTO_POINTS: usize = 20;
+
+impl Way {
+    fn parse(name: &str) -> Option<Self> {
+        match name.trim() {
+            "grid" => Some(Self::Grid),
+            "arclength" => Some(Self::Arclength),
+            "energy" => Some(Self::Energy),
+            "auto" => Some(Self::Auto),
+            _ => None,
+        }
+    }
+
+    /// The backbone of `system` by this way, and the fraction of `E_g` below which a point
+    /// is at rest.
+    fn backbone(
+        self,
+        system: &BarSystem,
+        settings: HarmonicBalanceSettings,
+    ) -> Result<(ModeBranches, f64), Error> {
+        let fail_fast = || {
+            let newton = SemismoothNewton::new(NewtonOptions::fail_fast()).expect("valid options");
+            Some(Solver::Newton(newton))
+        };
+        let (method, solver) = match self {
+            Self::Grid => (
+                Method::PeriodGrid(BackboneOptions::for_mode(system, 1, 1)?),
+                fail_fast(),
+            ),
+            Self::Arclength => (
+                Way::Arclength(ArclengthBackboneOptions::for_mode(system, 1, 1)?),
+                Some(Solver::default()),
+            ),
+            Self::Energy => (
+                Way::Energy(EnergyBackboneOptions::for_mode(system, 1, 1)?),
+                fail_fast(),
+            ),
+            Self::Auto => (Method::Auto(None), None),
+        };
+        let request = Request {
+            settings,
+            method,
+            solver,
+            ..Request::new(1)
+        };
+        // The energy backbone never accepts a point at rest: its levels start at `E_g`.
+        Ok((compute(system, &request)?, TRIVIAL_ENERGY))
+    }
+}
+
+/// The backbone of `system` by `method` at `harmonics`, checking the invariants every run
+/// must keep; `verify` marches each converged point one period in time.
+fn run(system: &BarSystem, method: Way, harmonics: usize, verify: bool) -> Outcome {
     let settings = HarmonicBalanceSettings {
         harmonics,
         ..HarmonicBalanceSettings::default()
     };
-    let options = match BackboneOptions::for_mode(system, 1, 1) {
-        Ok(options) => options,
-        Err(e) => return Outcome::Refused(e.into()),
-    };
-    let solver = SemismoothNewton::new(NewtonOptions::fail_fast()).expect("valid options");
-    let request = Request {
-        settings,
-        method: Method::PeriodGrid(options),
-        solver: Some(Solver::Newton(solver)),
-        ..Request::new(1)
-    };
-    let result = compute(system, &request);
+    let result = method.backbone(system, settings);
     let drifting = drifting_bars(system);
-    let bb = match result {
+    let (bb, trivial_energy) = match result {
         Err(Error::Settings(SettingsError::Unconfined { bars })) => {
             assert_eq!(Some(bars), drifting, "the error names the drifting bars");
             return Outcome::Unconfined;
@@ -175,7 +233,7 @@ fn run(system: &BarSystem, harmonics: usize, verify: bool) -> Outcome {
         "a run without a converged point ends with a typed reason"
     );
     for p in &converged {
-        assert!(p.energy_normalized.is_finite() && p.energy_normalized > options.trivial_energy);
+        assert!(p.energy_normalized.is_finite() && p.energy_normalized > trivial_energy);
     }
     let checked = verify.then(|| {
         let problem = nonsmooth_modes::system::NonsmoothSystem::new(system, settings)
@@ -206,7 +264,7 @@ fn every_assembly_gives_a_branch_or_a_typed_reason() {
     let mut outcomes = Vec::new();
     for seed in 0..12 {
         let drawn = draw(seed);
-        let outcome = run(&drawn.system, 8, false);
+        let outcome = run(&drawn.system, Way::Grid, 8, false);
         eprintln!("{}: {outcome:?}", drawn.description);
         outcomes.push(outcome);
     }
@@ -215,6 +273,23 @@ fn every_assembly_gives_a_branch_or_a_typed_reason() {
     assert!(outcomes
         .iter()
         .any(|o| matches!(o, Outcome::Run { converged, .. } if *converged > 0)));
+}
+
+/// The energy backbone refuses the drifting assemblies of the sequence as the others do,
+/// before any solve.
+#[test]
+fn the_energy_backbone_refuses_drifting_assemblies() {
+    let mut refused = 0;
+    for seed in 0..12 {
+        let drawn = draw(seed);
+        if drifting_bars(&drawn.system).is_none() {
+            continue;
+        }
+        let outcome = run(&drawn.system, Way::Energy, 8, false);
+        assert!(matches!(outcome, Outcome::Unconfined), "{outcome:?}");
+        refused += 1;
+    }
+    assert!(refused > 0);
 }
 
 fn env_number(name: &str, default: usize) -> usize {
@@ -226,36 +301,90 @@ fn env_number(name: &str, default: usize) -> usize {
 
 /// The census of `docs/assemblies.md`: of `RANDOM_COUNT` held assemblies, how many give a
 /// branch of at least 20 converged points whose time-domain displacement defect is below
-/// 5 %, at `RANDOM_HARMONICS` harmonics.
+/// 5 %, at `RANDOM_HARMONICS` harmonics, by each method of `RANDOM_METHODS` (a comma list of
+/// `grid`, `arclength`, `energy`; default `grid`), over the seeds from `RANDOM_SEED_OFFSET`
+/// (default 0). With both `grid` and `arclength`, also the rule "arclength, and the period
+/// grid where arclength converges fewer than [`AUTO_POINTS`] points".
 #[test]
 #[ignore = "minutes; the figures of docs/assemblies.md"]
 fn random_assembly_census() {
     let count = env_number("RANDOM_COUNT", 50);
     let harmonics = env_number("RANDOM_HARMONICS", 20);
-    let (mut held, mut good, mut refused, mut unconfined) = (0, 0, 0, 0);
-    let mut seed = 0;
+    let offset = env_number("RANDOM_SEED_OFFSET", 0) as u64;
+    let names = std::env::var("RANDOM_METHODS").unwrap_or_else(|_| "grid".into());
+    let methods: Vec<Way> = names.split(',').filter_map(Way::parse).collect();
+    assert!(
+        !methods.is_empty(),
+        "RANDOM_METHODS names no method: {names}"
+    );
+    // Per method: good, converged but fewer than 20 checked, refused, no point converged.
+    let mut tally = vec![[0usize; 4]; methods.len() + 1];
+    let position = |m: Way| methods.iter().position(|&n| n == m);
+    let auto = position(Way::Arclength).zip(position(Way::Grid));
+    let (mut held, mut unconfined) = (0, 0);
+    let mut seed = offset;
     while held < count {
         let drawn = draw(seed);
         seed += 1;
-        let outcome = run(&drawn.system, harmonics, true);
-        println!("{}: {outcome:?}", drawn.description);
-        match outcome {
-            Outcome::Unconfined => unconfined += 1,
-            Outcome::Refused(e) => {
-                println!("  refused: {e}");
-                held += 1;
-                refused += 1;
-            }
-            Outcome::Run { checked, .. } => {
-                held += 1;
-                good += usize::from(checked.unwrap_or(0) >= 20);
-            }
+        println!("{}", drawn.description);
+        let mut outcomes = methods
+            .iter()
+            .map(|&method| (method, run(&drawn.system, method, harmonics, true)));
+        let Some(first) = outcomes.next() else {
+            break;
+        };
+        if matches!(first.1, Outcome::Unconfined) {
+            unconfined += 1;
+            continue;
+        }
+        held += 1;
+        let mut classes = Vec::new();
+        for (method, outcome) in std::iter::once(first).chain(outcomes) {
+            println!("  {method:?}: {outcome:?}");
+            let converged = match outcome {
+                Outcome::Run { converged, .. } => converged,
+                _ => 0,
+            };
+            let class = match outcome {
+                Outcome::Unconfined => 2,
+                Outcome::Refused(e) => {
+                    println!("    refused: {e}");
+                    2
+                }
+                Outcome::Run { checked, .. } if checked.unwrap_or(0) >= 20 => 0,
+                Outcome::Run { converged: 0, .. } => 3,
+                Outcome::Run { .. } => 1,
+            };
+            classes.push((class, converged));
+        }
+        for (k, &(class, _)) in classes.iter().enumerate() {
+            tally[k][class] += 1;
+        }
+        if let Some((arclength, grid)) = auto {
+            let chosen = if classes[arclength].1 >= AUTO_POINTS {
+                arclength
+            } else {
+                grid
+            };
+            tally[methods.len()][classes[chosen].0] += 1;
         }
     }
     println!(
-        "m = {harmonics}: {good} of {held} held assemblies give >= 20 checked points \
-         (defect < 5 %); {refused} refused with a typed reason; {unconfined} drifting \
-         assemblies refused ({seed} drawn)"
+        "m = {harmonics}, {held} held assemblies ({unconfined} drifting ones refused, seeds \
+         {offset}..{seed}):"
     );
-    assert!(good + refused <= held);
+    let mut names: Vec<String> = methods.iter().map(|m| format!("{m:?}")).collect();
+    names.push("auto (arclength, grid below 20 points)".into());
+    let rows = if auto.is_some() {
+        tally.len()
+    } else {
+        methods.len()
+    };
+    for (method, [good, few, refused, none]) in names.iter().zip(&tally).take(rows) {
+        println!(
+            "  {method}: {good} give >= 20 checked points (defect < 5 %), {few} fewer, \
+             {refused} refused with a typed reason, {none} without a converged point"
+        );
+        assert!(good + refused <= held);
+    }
 }

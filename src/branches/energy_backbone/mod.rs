@@ -10,6 +10,7 @@ use crate::branches::level::{split_frequency, EnergyLevel};
 use crate::branches::point::{BackbonePoint, PointStatus};
 use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
 use crate::error::Error;
+use crate::modal::drift::check_held;
 use crate::modal::energy::energy;
 use crate::modal::linear::{grazing_energy, grazing_energy_of, open_mode};
 use crate::solve::NonlinearSolver;
@@ -129,7 +130,8 @@ impl EnergyBackboneOptions {
 /// `docs/assemblies.md` compares it with the period grid on systems with exact solutions.
 ///
 /// # Errors
-/// Invalid settings or options, or no start
+/// Invalid settings or options, an assembly with a bar that can drift away
+/// ([`SettingsError::Unconfined`](crate::SettingsError::Unconfined)), or no start
 /// ([`SettingsError::NoStart`](crate::SettingsError::NoStart)): nothing was
 /// computed.
 pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
@@ -140,6 +142,9 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let problem = NonsmoothSystem::new(system, settings)?;
+    // A bar that can drift away has no periodic motion that touches it: refused as by the
+    // period and arclength backbones.
+    check_held(system)?;
     let grid = options.levels;
     let levels = geomspace(grid.start, grid.end, grid.steps)?;
     let (e_g, first) = grazing_energy(system)?;
