@@ -185,11 +185,11 @@ impl Way {
                 fail_fast(),
             ),
             Self::Arclength => (
-                Way::Arclength(ArclengthBackboneOptions::for_mode(system, 1, 1)?),
+                Method::Arclength(ArclengthBackboneOptions::for_mode(system, 1, 1)?),
                 Some(Solver::default()),
             ),
             Self::Energy => (
-                Way::Energy(EnergyBackboneOptions::for_mode(system, 1, 1)?),
+                Method::Energy(EnergyBackboneOptions::for_mode(system, 1, 1)?),
                 fail_fast(),
             ),
             Self::Auto => (Method::Auto(None), None),

@@ -33,10 +33,10 @@ pub struct PeriodGrid {
     pub steps: usize,
 }
 
-/// Options of [`backbone`].
+/// Options of a period-grid backbone ([`Method::PeriodGrid`](crate::branches::Method::PeriodGrid)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BackboneOptions {
-    /// Periods to visit (default [`PeriodGrid::default`]).
+    /// Periods to visit ([`PeriodGrid::for_mode`] derives them from the system).
     pub grid: PeriodGrid,
     /// Linear mode the branch starts from (1-based, default 1).
     pub mode: usize,
@@ -61,7 +61,8 @@ pub struct BackboneOptions {
     /// backbone, at the cost of about `retry_depth` extra solves on every step;
     /// `docs/performance.md` has the measured trade-off on the clamped bar. It is not the
     /// default for that cost, and because it changes the points of existing runs.
-    /// [`backbone_speculative_with`] runs it serially.
+    /// A request with [`speculation`](crate::branches::Request::speculation) runs it
+    /// serially.
     pub selection: Selection,
     /// Converged points with `E < trivial_energy * E_g` count as collapsed to rest and are
     /// not accepted (default `1e-6`).
@@ -298,26 +299,26 @@ pub(crate) fn backbone<S: NonlinearSolver>(
     Backbone::collect(|see| backbone_with(system, settings, options, solver, see))
 }
 
-/// Options of [`arclength_backbone`].
+/// Options of an arclength backbone ([`Method::Arclength`](crate::branches::Method::Arclength)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArclengthBackboneOptions {
-    /// Period at which the branch is seeded (default 3.95, the clamped bar's first mode;
-    /// [`ArclengthBackboneOptions::for_mode`] derives it and `omega_range` from any system).
+    /// Period at which the branch is seeded ([`ArclengthBackboneOptions::for_mode`] derives
+    /// it and `omega_range` from the system).
     pub start_period: f64,
-    /// The run stays inside this range of `Omega` (default `[2 pi / 3.96, 2 pi / 3.05]`).
+    /// The run stays inside this range of `Omega`.
     pub omega_range: (f64, f64),
-    /// Linear mode the branch starts from (default 1).
+    /// Linear mode the branch starts from (1-based).
     pub mode: usize,
-    /// Period multiple of the seed (default 1).
+    /// Period multiple of the seed (1 for the main branch).
     pub subharmonic: usize,
-    /// Driver options (default [`ArclengthOptions::default`]: `direction = +1`, towards
+    /// Driver options ([`ArclengthOptions::default`] in the constructors: `direction = +1`, towards
     /// higher `Omega`); their `parameter_range` is replaced by `omega_range`.
     pub arclength: ArclengthOptions,
-    /// Escape from stalls ([`EscapingArclength`]; default `Some(StallEscape::default())`, so
+    /// Escape from stalls ([`EscapingArclength`]; `Some(StallEscape::default())` in the constructors, so
     /// that internal-resonance branches do not stall the backbone; `None` follows the branch
     /// wherever it goes).
     pub escape: Option<StallEscape>,
-    /// As [`BackboneOptions::trivial_energy`] (default `1e-6`).
+    /// As [`BackboneOptions::trivial_energy`] ([`TRIVIAL_ENERGY`] in the constructors).
     pub trivial_energy: f64,
     /// Leave the branch at one of its branch points for the branch crossing there (default
     /// `None`: follow the branch seeded). The run's points are those of both branches; the

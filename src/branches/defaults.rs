@@ -50,7 +50,7 @@ pub fn linear_period(
 impl PeriodGrid {
     /// The default grid of NSM `mode` sub `subharmonic` of `system`: 181 periods from
     /// `79/80` to `61/80` of its linear period ([`linear_period`]). For the clamped bar this
-    /// is [`PeriodGrid::default`], the paper's grid 3.95 -> 3.05.
+    /// is the paper's grid 3.95 -> 3.05.
     ///
     /// # Errors
     /// See [`linear_period`].
@@ -107,8 +107,8 @@ impl BackboneOptions {
 impl ArclengthBackboneOptions {
     /// The default options for NSM `mode` sub `subharmonic` of `system`: seeded at `79/80` of
     /// its linear period ([`linear_period`]), inside the frequencies of the periods from
-    /// `99/100` to `61/80` of it. For the clamped bar these are the defaults
-    /// ([`ArclengthBackboneOptions::default`]).
+    /// `99/100` to `61/80` of it: for the clamped bar, seeded at 3.95 inside
+    /// `[2 pi / 3.96, 2 pi / 3.05]`.
     ///
     /// # Errors
     /// See [`linear_period`].

@@ -250,7 +250,7 @@ impl fmt::Display for Label {
 /// # Errors
 /// [`SettingsError::ZeroIndex`] for `order = 0`; [`SettingsError::NotPositive`] or
 /// [`SettingsError::FrequencyTooSmall`] for an `omega` that is not positive and finite or
-/// below [`MIN_FREQUENCY`](crate::modal::diagnostics::MIN_FREQUENCY); those of [`character`] for
+/// below [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY); those of [`character`] for
 /// `natural`, and [`SettingsError::Length`] for an empty `natural` when the motion is an
 /// internal resonance (there is no mode to name).
 pub fn label(

@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// Most steps of a walk across internal resonances in the period
-/// ([`energy_backbone_with`](super::energy_backbone_with)):
+/// ([`Method::Energy`](crate::branches::Method::Energy)):
 /// `T_a (1 - j / 800)` for `j = 1..=200` below the last accepted period `T_a` (steps of
 /// the paper's period grid, over a quarter of `T_a`).
 pub const ESCAPE_PERIODS: usize = 200;

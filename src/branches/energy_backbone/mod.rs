@@ -60,11 +60,10 @@ impl EnergyGrid {
     }
 }
 
-/// Options of [`energy_backbone`].
+/// Options of an energy backbone ([`Method::Energy`](crate::branches::Method::Energy)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnergyBackboneOptions {
-    /// Levels to visit (default [`EnergyGrid::default`]; [`EnergyGrid::for_mode`] for other
-    /// modes).
+    /// Levels to visit ([`EnergyGrid::for_mode`] derives them from the system).
     pub levels: EnergyGrid,
     /// Linear mode the branch starts from (1-based, among the modes of nonzero frequency;
     /// default 1).
