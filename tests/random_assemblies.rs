@@ -21,7 +21,7 @@
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
     compute, ArclengthBackboneOptions, BackboneOptions, EnergyBackboneOptions, Method,
-    ModeBranches, Request, TRIVIAL_ENERGY,
+    ModeBranches, Request, TimeDomainCheck, TRIVIAL_ENERGY,
 };
 use nonsmooth_modes::modal::drifting_bars;
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, Solver};
@@ -149,7 +149,8 @@ enum Way {
     Arclength,
     /// Sequential in the energy ([`EnergyBackboneOptions::for_mode`]), fail-fast Newton.
     Energy,
-    /// The library's choice, [`Method::Auto`], with its own solvers.
+    /// The library's choice, [`Method::Auto`], with its own solvers and the library's
+    /// time-domain check (by which it judges its period grid).
     Auto,
 }
 
@@ -194,12 +195,16 @@ impl Way {
             ),
             Self::Auto => (Method::Auto(None), None),
         };
-        let request = Request {
+        let mut request = Request {
             settings,
             method,
             solver,
             ..Request::new(1)
         };
+        // Auto judges its grid by the points that pass the time-domain check.
+        if self == Self::Auto {
+            request.check = Some(TimeDomainCheck::for_system(system));
+        }
         // The energy backbone never accepts a point at rest: its levels start at `E_g`.
         Ok((compute(system, &request)?, TRIVIAL_ENERGY))
     }

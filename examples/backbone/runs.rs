@@ -49,10 +49,10 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
                  period {t0:.6}: it is followed by pseudo-arclength from T0 (--method sequential \
                  keeps the period grid)"
             ),
-            Some(AutoChoice::GridFellShort { converged, steps }) => eprintln!(
-                "backbone: the period grid converged {converged} of {steps} steps: the branch \
-                 is followed by pseudo-arclength over its range instead (--method sequential \
-                 keeps the period grid)"
+            Some(AutoChoice::GridFellShort { good, steps }) => eprintln!(
+                "backbone: the period grid gave {good} good points of {steps} steps: the \
+                 branch is followed by pseudo-arclength over its range instead (--method \
+                 sequential keeps the period grid)"
             ),
             _ => {}
         }

@@ -12,6 +12,7 @@ use crate::branches::start::{backbone_start, BackboneStart};
 use crate::branches::subharmonic::genuine_subharmonic_backbone_with;
 use crate::continuation::{EndReason, Rejection};
 use crate::error::{Error, SettingsError};
+use crate::modal::Label;
 use crate::solve::Solver;
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
@@ -31,10 +32,12 @@ use std::ops::ControlFlow;
 ///   floating bar that must be pushed hard enough to shuttle within a period),
 ///   pseudo-arclength from the grid's first period walks the branch back and follows it
 ///   through its folds ([`ArclengthBackboneOptions::over_grid`]).
-/// - A period grid is judged before its points are shown: where it stalls or converges
-///   fewer than half its steps (its branch saturates at a period inside the grid, or it walks
-///   the truncated system's resonances), pseudo-arclength over the grid's range is run
-///   instead, and the grid's points are not returned ([`AutoChoice::GridFellShort`]).
+/// - A period grid is judged before its points are shown: where it stalls or fewer than
+///   half its steps are good (converged and, when the request asks for a time-domain check,
+///   verified), as where its branch saturates at a period inside the grid or it walks the
+///   truncated system's resonances, pseudo-arclength over the grid's range is run too, and
+///   the run with more good points is returned ([`AutoChoice::GridFellShort`] when it is
+///   arclength; the other run's points are not returned).
 ///
 /// The choice is [`ModeBranches::auto`].
 ///
@@ -79,38 +82,75 @@ pub fn compute_observed(
     let mut annotator = Annotator::new(&problem, request, observer);
     if let (Plan::Grid(options, _), Some(AutoChoice::EnteredAtGridStart)) = (&plan, auto) {
         // Auto's period grid is judged before it is shown: a grid that falls short gives
-        // way to pseudo-arclength over its range.
+        // way to pseudo-arclength over its range if that does better.
         let options = *options;
-        let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
-        let mut trial = Annotator::new(&problem, request, quiet);
         let solver = request.solver_for(&method)?;
-        let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut trial)?;
-        let converged = trial.converged();
-        if !grid_fell_short(converged, options.grid.steps, &end) {
-            let end = annotator.replay(trial.into_points(), end);
-            return Ok(annotator.finish((method, auto), e_g, end, rejected));
-        }
+        let grid = quiet_run(system, request, (plan, solver), &problem)?;
+        let steps = options.grid.steps;
+        let fell_short = grid_fell_short(grid.good, steps, &grid.end);
         let arclength = ArclengthBackboneOptions::over_grid(&options);
-        let method = Method::Arclength(arclength);
-        let auto = Some(AutoChoice::GridFellShort {
-            converged,
-            steps: options.grid.steps,
-        });
-        let solver = request.solver_for(&method)?;
-        let plan = Plan::Arclength(arclength);
-        let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
-        return Ok(annotator.finish((method, auto), e_g, end, rejected));
+        let other = Method::Arclength(arclength);
+        let tried = if fell_short {
+            let solver = request.solver_for(&other)?;
+            let plan = Plan::Arclength(arclength);
+            Some(quiet_run(system, request, (plan, solver), &problem)?)
+        } else {
+            None
+        };
+        let (run, method, auto) = match tried {
+            Some(run) if run.good > grid.good => {
+                let good = grid.good;
+                (run, other, Some(AutoChoice::GridFellShort { good, steps }))
+            }
+            _ => (grid, method, auto),
+        };
+        let end = annotator.replay(run.points, run.end);
+        return Ok(annotator.finish((method, auto), run.e_g, end, run.rejected));
     }
     let solver = request.solver_for(&method)?;
     let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
     Ok(annotator.finish((method, auto), e_g, end, rejected))
 }
 
-/// Whether a period grid of `steps` steps that converged `converged` of them and ended with
-/// `end` falls short of a backbone: it stalled, or fewer than half its steps converged (its
-/// branch left the grid's range, or the grid walks the truncated system's resonances).
-fn grid_fell_short(converged: usize, steps: usize, end: &EndReason) -> bool {
-    end.error().is_some() || 2 * converged < steps
+/// Whether a period grid of `steps` steps with `good` good points (converged, and not
+/// refuted by a time-domain check where one was asked) that ended with `end` falls short of
+/// a backbone: it stalled, or fewer than half its steps are good (its branch left the grid's
+/// range, or the grid walks the truncated system's resonances).
+fn grid_fell_short(good: usize, steps: usize, end: &EndReason) -> bool {
+    end.error().is_some() || 2 * good < steps
+}
+
+/// A run whose points were annotated but not yet shown to the user's observer.
+struct QuietRun {
+    points: Vec<BackbonePoint>,
+    e_g: f64,
+    end: EndReason,
+    rejected: usize,
+    /// Converged points not labelled [`Label::Unverified`].
+    good: usize,
+}
+
+/// Runs `plan` with `solver` on `problem`, keeping the annotated points to be judged.
+fn quiet_run(
+    system: &BarSystem,
+    request: &Request,
+    (plan, solver): (Plan, Solver),
+    problem: &NonsmoothSystem,
+) -> Result<QuietRun, Error> {
+    let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
+    let mut annotator = Annotator::new(problem, request, quiet);
+    let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
+    let points = annotator.into_points();
+    let good = (points.iter())
+        .filter(|p| p.converged && p.label != Some(Label::Unverified))
+        .count();
+    Ok(QuietRun {
+        points,
+        e_g,
+        end,
+        rejected,
+        good,
+    })
 }
 
 /// Runs `plan` with `solver`, handing every point to `annotator`; returns `E_g`, the end

@@ -65,11 +65,12 @@ pub enum AutoChoice {
     Subharmonic,
     /// The branch can be entered at the grid's first period: the period grid.
     EnteredAtGridStart,
-    /// The period grid fell short (it stalled, or fewer than half its steps converged):
-    /// pseudo-arclength over its range ran instead.
+    /// The period grid fell short (it stalled, or fewer than half its steps are good:
+    /// converged and, where a check was asked, verified), and pseudo-arclength over its
+    /// range gave more good points: its run is returned.
     GridFellShort {
-        /// Converged steps of the grid.
-        converged: usize,
+        /// Good points of the grid.
+        good: usize,
         /// Steps of the grid.
         steps: usize,
     },

@@ -6,7 +6,8 @@ use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
-use crate::modal::{character, label, natural_frequencies, nearest_mode, ContactState};
+use crate::modal::linear::{natural_frequency_values, LABEL_SCAN_PER_SPACING};
+use crate::modal::{character, label, nearest_mode, ContactState};
 use crate::solution::Solution;
 use crate::system::NonsmoothSystem;
 use crate::verify::periodicity_check;
@@ -206,15 +207,21 @@ impl<O: BackboneObserver> Annotator<O> {
             .fold(f64::INFINITY, f64::min);
         let mut changed = false;
         for _ in 0..8 {
-            let need = (named.clone())
-                .map(|f| f + nearest_mode(f, &self.natural).map_or(spacing, |(_, w)| (w - f).abs()))
-                .fold(0.0, f64::max);
+            // Beyond the list, a mode spacing further; within it, as far again as the
+            // nearest mode listed.
+            let reach = |f: f64| match nearest_mode(f, &self.natural) {
+                Some((_, w)) if f <= self.natural_up_to => f + (w - f).abs(),
+                _ => f + spacing,
+            };
+            let need = named.clone().map(reach).fold(0.0, f64::max);
             if need <= self.natural_up_to {
                 break;
             }
             let up_to = need.max(1.25 * self.natural_up_to);
-            if let Ok(modes) = natural_frequencies(system, ContactState::Open, up_to) {
-                self.natural = modes.iter().map(|m| m.omega).collect();
+            if let Ok(omegas) =
+                natural_frequency_values(system, ContactState::Open, up_to, LABEL_SCAN_PER_SPACING)
+            {
+                self.natural = omegas;
                 changed = true;
             }
             self.natural_up_to = up_to;

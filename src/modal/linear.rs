@@ -119,20 +119,49 @@ pub fn natural_frequencies(
     state: ContactState,
     omega_max: f64,
 ) -> Result<Vec<LinearMode>, SettingsError> {
+    let omegas = natural_frequency_values(system, state, omega_max, SCAN_PER_SPACING)?;
+    Ok(omegas
+        .into_iter()
+        .map(|omega| LinearMode {
+            omega,
+            shapes: null_vectors(system, omega, state),
+        })
+        .collect())
+}
+
+/// Scan samples per spacing `pi c / l` of [`natural_frequencies`].
+const SCAN_PER_SPACING: f64 = 200.0;
+
+/// Scan samples per spacing of the natural frequencies that name the modes of labels: a
+/// quarter of [`natural_frequencies`]'s, so that distinct frequencies closer than about 4 %
+/// of a bar's spacing count as one (their numbers are then one apart from a fine scan's).
+pub(crate) const LABEL_SCAN_PER_SPACING: f64 = 50.0;
+
+/// The frequencies of [`natural_frequencies`] without their shapes, scanned with
+/// `per_spacing` samples per spacing `pi c / l` (each refined to full precision).
+///
+/// # Errors
+/// See [`natural_frequencies`].
+pub(crate) fn natural_frequency_values(
+    system: &BarSystem,
+    state: ContactState,
+    omega_max: f64,
+    per_spacing: f64,
+) -> Result<Vec<f64>, SettingsError> {
     if !(omega_max.is_finite() && omega_max > 0.0) {
         return Err(SettingsError::NotPositive {
             what: "upper frequency",
             value: omega_max,
         });
     }
-    // Scan step: 1/200 of the smallest spacing pi c / l of one bar's spectrum; distinct roots
+    // Scan step: 1/per_spacing of the smallest spacing pi c / l of one bar's spectrum; distinct roots
     // closer than about two steps would merge (repeated roots are found with multiplicity).
     let spacing = system
         .bars()
         .iter()
         .map(|b| std::f64::consts::PI * b.wave_speed() / b.length())
         .fold(f64::INFINITY, f64::min);
-    let h = spacing / 200.0;
+    let h = spacing / per_spacing;
     let samples = omega_max / h;
     if samples > MAX_SCAN as f64 {
         return Err(SettingsError::ScanTooLong {
@@ -154,10 +183,7 @@ pub fn natural_frequencies(
             if omega > omega_max || matrix.singularity(omega) > 1e-8 {
                 continue;
             }
-            modes.push(LinearMode {
-                omega,
-                shapes: null_vectors(system, omega, state),
-            });
+            modes.push(omega);
         }
     }
     Ok(modes)
