@@ -79,23 +79,23 @@ pub fn compute_observed(
 ) -> Result<ModeBranches, Error> {
     let problem = NonsmoothSystem::new(system, request.settings)?;
     let (plan, method, auto) = resolve(system, request)?;
-    let mut annotator = Annotator::new(&problem, request, observer);
     if let (Plan::Grid(options, _), Some(AutoChoice::EnteredAtGridStart)) = (&plan, auto) {
         // Auto's period grid is judged before it is shown: a grid that falls short gives
         // way to pseudo-arclength over its range if that does better.
         let options = *options;
         let solver = request.solver_for(&method)?;
-        let grid = quiet_run(system, request, (plan, solver), &problem)?;
+        let (grid, problem) = quiet_run(system, request, (plan, solver), problem)?;
         let steps = options.grid.steps;
         let fell_short = grid_fell_short(grid.good, steps, &grid.end);
         let arclength = ArclengthBackboneOptions::over_grid(&options);
         let other = Method::Arclength(arclength);
-        let tried = if fell_short {
+        let (tried, problem) = if fell_short {
             let solver = request.solver_for(&other)?;
             let plan = Plan::Arclength(arclength);
-            Some(quiet_run(system, request, (plan, solver), &problem)?)
+            let (run, problem) = quiet_run(system, request, (plan, solver), problem)?;
+            (Some(run), problem)
         } else {
-            None
+            (None, problem)
         };
         let (run, method, auto) = match tried {
             Some(run) if run.good > grid.good => {
@@ -104,9 +104,11 @@ pub fn compute_observed(
             }
             _ => (grid, method, auto),
         };
+        let mut annotator = Annotator::new(problem, request, observer);
         let end = annotator.replay(run.points, run.end);
         return Ok(annotator.finish((method, auto), run.e_g, end, run.rejected));
     }
+    let mut annotator = Annotator::new(problem, request, observer);
     let solver = request.solver_for(&method)?;
     let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
     Ok(annotator.finish((method, auto), e_g, end, rejected))
@@ -130,27 +132,29 @@ struct QuietRun {
     good: usize,
 }
 
-/// Runs `plan` with `solver` on `problem`, keeping the annotated points to be judged.
+/// Runs `plan` with `solver`, keeping the points annotated on `problem` to be judged; gives
+/// the problem back.
 fn quiet_run(
     system: &BarSystem,
     request: &Request,
     (plan, solver): (Plan, Solver),
-    problem: &NonsmoothSystem,
-) -> Result<QuietRun, Error> {
+    problem: NonsmoothSystem,
+) -> Result<(QuietRun, NonsmoothSystem), Error> {
     let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
     let mut annotator = Annotator::new(problem, request, quiet);
     let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
-    let points = annotator.into_points();
+    let (points, problem) = annotator.into_parts();
     let good = (points.iter())
         .filter(|p| p.converged && p.label != Some(Label::Unverified))
         .count();
-    Ok(QuietRun {
+    let run = QuietRun {
         points,
         e_g,
         end,
         rejected,
         good,
-    })
+    };
+    Ok((run, problem))
 }
 
 /// Runs `plan` with `solver`, handing every point to `annotator`; returns `E_g`, the end

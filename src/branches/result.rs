@@ -6,7 +6,7 @@ use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
-use crate::modal::linear::{natural_frequency_values, LABEL_SCAN_PER_SPACING};
+use crate::modal::linear::{natural_frequency_values, Resolution};
 use crate::modal::{character, label, nearest_mode, ContactState};
 use crate::solution::Solution;
 use crate::system::NonsmoothSystem;
@@ -100,9 +100,9 @@ pub(crate) struct Annotator<O> {
 
 impl<O: BackboneObserver> Annotator<O> {
     /// The annotator of the points of `problem` asked by `request`.
-    pub(crate) fn new(problem: &NonsmoothSystem, request: &Request, observer: O) -> Self {
+    pub(crate) fn new(problem: NonsmoothSystem, request: &Request, observer: O) -> Self {
         Self {
-            problem: problem.clone(),
+            problem,
             check: request.check,
             order: request.subharmonic,
             observer,
@@ -153,9 +153,9 @@ impl<O: BackboneObserver> Annotator<O> {
         end
     }
 
-    /// The points kept, in order.
-    pub(crate) fn into_points(self) -> Vec<BackbonePoint> {
-        self.points
+    /// The points kept, in order, and the problem they were annotated on.
+    pub(crate) fn into_parts(self) -> (Vec<BackbonePoint>, NonsmoothSystem) {
+        (self.points, self.problem)
     }
 
     /// The converged points so far.
@@ -219,7 +219,7 @@ impl<O: BackboneObserver> Annotator<O> {
             }
             let up_to = need.max(1.25 * self.natural_up_to);
             if let Ok(omegas) =
-                natural_frequency_values(system, ContactState::Open, up_to, LABEL_SCAN_PER_SPACING)
+                natural_frequency_values(system, ContactState::Open, up_to, Resolution::LABELS)
             {
                 self.natural = omegas;
                 changed = true;

@@ -119,7 +119,7 @@ pub fn natural_frequencies(
     state: ContactState,
     omega_max: f64,
 ) -> Result<Vec<LinearMode>, SettingsError> {
-    let omegas = natural_frequency_values(system, state, omega_max, SCAN_PER_SPACING)?;
+    let omegas = natural_frequency_values(system, state, omega_max, Resolution::FULL)?;
     Ok(omegas
         .into_iter()
         .map(|omega| LinearMode {
@@ -129,16 +129,31 @@ pub fn natural_frequencies(
         .collect())
 }
 
-/// Scan samples per spacing `pi c / l` of [`natural_frequencies`].
-const SCAN_PER_SPACING: f64 = 200.0;
+/// How finely natural frequencies are located: scan samples per spacing `pi c / l` of the
+/// shortest-period bar, and the relative width at which the golden-section refinement stops.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Resolution {
+    pub per_spacing: f64,
+    pub tolerance: f64,
+}
 
-/// Scan samples per spacing of the natural frequencies that name the modes of labels: a
-/// quarter of [`natural_frequencies`]'s, so that distinct frequencies closer than about 4 %
-/// of a bar's spacing count as one (their numbers are then one apart from a fine scan's).
-pub(crate) const LABEL_SCAN_PER_SPACING: f64 = 50.0;
+impl Resolution {
+    /// [`natural_frequencies`]'s: 200 samples per spacing, refined to `1e-15`.
+    pub(crate) const FULL: Self = Self {
+        per_spacing: 200.0,
+        tolerance: 1e-15,
+    };
+    /// What naming the modes of labels needs: a quarter of the samples (distinct frequencies
+    /// closer than about 4 % of a spacing count as one, and the numbers above them are one
+    /// apart from a fine scan's) and `1e-10` relative.
+    pub(crate) const LABELS: Self = Self {
+        per_spacing: 50.0,
+        tolerance: 1e-10,
+    };
+}
 
-/// The frequencies of [`natural_frequencies`] without their shapes, scanned with
-/// `per_spacing` samples per spacing `pi c / l` (each refined to full precision).
+/// The frequencies of [`natural_frequencies`] without their shapes, located to
+/// `resolution`.
 ///
 /// # Errors
 /// See [`natural_frequencies`].
@@ -146,7 +161,7 @@ pub(crate) fn natural_frequency_values(
     system: &BarSystem,
     state: ContactState,
     omega_max: f64,
-    per_spacing: f64,
+    resolution: Resolution,
 ) -> Result<Vec<f64>, SettingsError> {
     if !(omega_max.is_finite() && omega_max > 0.0) {
         return Err(SettingsError::NotPositive {
@@ -161,7 +176,7 @@ pub(crate) fn natural_frequency_values(
         .iter()
         .map(|b| std::f64::consts::PI * b.wave_speed() / b.length())
         .fold(f64::INFINITY, f64::min);
-    let h = spacing / per_spacing;
+    let h = spacing / resolution.per_spacing;
     let samples = omega_max / h;
     if samples > MAX_SCAN as f64 {
         return Err(SettingsError::ScanTooLong {
@@ -179,7 +194,7 @@ pub(crate) fn natural_frequency_values(
     for i in 1..values.len() - 1 {
         if values[i] <= values[i - 1] && values[i] < values[i + 1] {
             let (lo, hi) = ((i as f64 - 0.5) * h, (i as f64 + 1.5) * h);
-            let omega = golden_minimum(|w| matrix.singularity(w), lo, hi);
+            let omega = golden_minimum(|w| matrix.singularity(w), (lo, hi), resolution.tolerance);
             if omega > omega_max || matrix.singularity(omega) > 1e-8 {
                 continue;
             }
@@ -203,11 +218,15 @@ pub fn rigid_body_modes(system: &BarSystem, state: ContactState) -> Option<Linea
     })
 }
 
-fn golden_minimum(mut f: impl FnMut(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+fn golden_minimum(
+    mut f: impl FnMut(f64) -> f64,
+    (mut a, mut b): (f64, f64),
+    tolerance: f64,
+) -> f64 {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
     let (mut fc, mut fd) = (f(c), f(d));
-    while (b - a) > 1e-15 * b.abs().max(1.0) {
+    while (b - a) > tolerance * b.abs().max(1.0) {
         if fc < fd {
             b = d;
             d = c;
