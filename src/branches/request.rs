@@ -188,6 +188,18 @@ impl Request {
         self
     }
 
+    /// The same request with `settings` (harmonics, samples, contact law).
+    pub fn settings(mut self, settings: HarmonicBalanceSettings) -> Self {
+        self.settings = settings;
+        self
+    }
+
+    /// The same request solved by `solver` instead of the method's own.
+    pub fn solver(mut self, solver: Solver) -> Self {
+        self.solver = Some(solver);
+        self
+    }
+
     /// The same request with every converged point checked by `check`.
     pub fn checked(mut self, check: TimeDomainCheck) -> Self {
         self.check = Some(check);
@@ -210,5 +222,42 @@ impl Request {
             }
             (None, _) => Solver::default(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::clamped_bar_with_obstacle;
+
+    /// The builders set what they name and nothing else; without a solver the method's own
+    /// runs (fail-fast Newton on a grid, full Newton otherwise).
+    #[test]
+    fn builders_set_their_fields() {
+        let system = clamped_bar_with_obstacle(1e-3).unwrap();
+        let settings = HarmonicBalanceSettings {
+            harmonics: 7,
+            ..HarmonicBalanceSettings::default()
+        };
+        let grid = Method::PeriodGrid(BackboneOptions::for_mode(&system, 1, 1).unwrap());
+        let request = Request::new(2)
+            .settings(settings)
+            .subharmonic(3)
+            .method(grid)
+            .checked(TimeDomainCheck::for_system(&system));
+        assert_eq!((request.mode, request.subharmonic), (2, 3));
+        assert_eq!(request.settings, settings);
+        assert_eq!(request.method, grid);
+        assert_eq!(request.check.unwrap().options.dt, 1.0 / 400.0);
+        let fail_fast = SemismoothNewton::new(NewtonOptions::fail_fast()).unwrap();
+        assert_eq!(
+            request.solver_for(&grid).unwrap(),
+            Solver::Newton(fail_fast)
+        );
+        let arclength =
+            Method::Arclength(ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap());
+        assert_eq!(request.solver_for(&arclength).unwrap(), Solver::default());
+        let dogleg = Solver::Dogleg(crate::solve::Dogleg::default());
+        assert_eq!(request.solver(dogleg).solver_for(&grid).unwrap(), dogleg);
     }
 }
