@@ -62,8 +62,11 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             run.end,
             run.rejected_steps
         );
-        // Every point computed is written; a run that stalled then exits non-zero.
-        if let (None, Some(e)) = (&sink.error, run.error()) {
+        // Every point computed is written; a grid or energy run that stalled then exits
+        // non-zero. An arclength run's end (a stall, a failed switch) is reported above: its
+        // points are the branch as far as it could be followed.
+        let arclength = matches!(run.method, Method::Arclength(_) | Method::Switch(..));
+        if let (None, Some(e), false) = (&sink.error, run.error(), arclength) {
             return Err(e.into());
         }
     }
