@@ -55,12 +55,10 @@ fn grid_run(
     settings: HarmonicBalanceSettings,
     options: BackboneOptions,
 ) -> Result<ModeBranches, Error> {
-    let request = Request {
-        settings,
-        method: Method::PeriodGrid(options),
-        solver: Some(Solver::default()),
-        ..Request::new(options.mode).subharmonic(options.subharmonic)
-    };
+    let method = Method::PeriodGrid(options);
+    let request = Request::for_method(method)
+        .settings(settings)
+        .solver(Solver::default());
     compute(system, &request)
 }
 

@@ -35,12 +35,10 @@ fn grid_run(
     settings: HarmonicBalanceSettings,
     options: BackboneOptions,
 ) -> ModeBranches {
-    let request = Request {
-        settings,
-        method: Method::PeriodGrid(options),
-        solver: Some(Solver::default()),
-        ..Request::new(options.mode)
-    };
+    let method = Method::PeriodGrid(options);
+    let request = Request::for_method(method)
+        .settings(settings)
+        .solver(Solver::default());
     compute(system, &request).unwrap()
 }
 

@@ -42,6 +42,17 @@ pub enum Method {
 }
 
 impl Method {
+    /// The mode and order the method's options name (`None` for [`Method::Auto`] without a
+    /// grid).
+    pub fn mode_and_order(&self) -> Option<(usize, usize)> {
+        match self {
+            Self::Auto(grid) => grid.map(|o| (o.mode, o.subharmonic)),
+            Self::PeriodGrid(o) | Self::GenuineSubharmonic(o) => Some((o.mode, o.subharmonic)),
+            Self::Arclength(o) | Self::Switch(o, _) => Some((o.mode, o.subharmonic)),
+            Self::Energy(o) => Some((o.mode, o.subharmonic)),
+        }
+    }
+
     /// A short name for tables and messages: `auto`, `period-grid`, `arclength`, `switch`,
     /// `energy` or `genuine-subharmonic`.
     pub fn name(&self) -> &'static str {
@@ -170,6 +181,13 @@ impl Request {
         }
     }
 
+    /// The request that runs `method` on the mode and order its options name (NSM 1 for
+    /// [`Method::Auto`] without a grid), so that the two cannot disagree.
+    pub fn for_method(method: Method) -> Self {
+        let (mode, order) = method.mode_and_order().unwrap_or((1, 1));
+        Self::new(mode).subharmonic(order).method(method)
+    }
+
     /// The same request with `harmonics` harmonics.
     pub fn harmonics(mut self, harmonics: usize) -> Self {
         self.settings.harmonics = harmonics;
@@ -257,6 +275,10 @@ mod tests {
         let arclength =
             Method::Arclength(ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap());
         assert_eq!(request.solver_for(&arclength).unwrap(), Solver::default());
+        let from_options = Method::PeriodGrid(BackboneOptions::for_mode(&system, 2, 3).unwrap());
+        let request_of = Request::for_method(from_options);
+        assert_eq!((request_of.mode, request_of.subharmonic), (2, 3));
+        assert_eq!(Request::for_method(Method::Auto(None)).mode, 1);
         let dogleg = Solver::Dogleg(crate::solve::Dogleg::default());
         assert_eq!(request.solver(dogleg).solver_for(&grid).unwrap(), dogleg);
     }
