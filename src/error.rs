@@ -625,6 +625,76 @@ pub enum VerifyError {
     },
 }
 
+/// Why the Floquet multipliers of a point could not be computed
+/// ([`stability`](crate::stability)).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum StabilityError {
+    /// The one-period map could not be built or marched (an unsupported condition, a grid
+    /// too large or too costly, a bad period...).
+    #[error(transparent)]
+    Verify(#[from] VerifyError),
+    /// The monodromy matrix would have more rows than the limit: its dense eigenvalue problem
+    /// costs `O(n^3)` and `8 n^2` bytes.
+    #[error(
+        "the monodromy matrix would have {dimension} rows ({cells_per_travel} cells per \
+         shortest travel time), over the limit of {limit}: use fewer cells per travel time"
+    )]
+    TooLarge {
+        /// Rows of the matrix: the cells and free end displacements of the grid.
+        dimension: usize,
+        /// The resolution asked ([`StabilityOptions::cells_per_travel`](crate::stability::StabilityOptions::cells_per_travel)).
+        cells_per_travel: f64,
+        /// [`MAX_DIMENSION`](crate::stability::MAX_DIMENSION).
+        limit: usize,
+    },
+    /// The marches of the differences and corrections would take more time steps than the
+    /// limit (seconds per point at most).
+    #[error(
+        "the stability of this point takes up to {steps:.3e} time steps of marching \
+         ({dimension} coordinates, {corrections} corrections), over the limit of {limit:.3e}: \
+         use fewer cells per travel time or fewer corrections"
+    )]
+    TooCostly {
+        /// `2 n (periods' steps) (1 + corrections)`.
+        steps: f64,
+        /// Coordinates `n`.
+        dimension: usize,
+        /// [`StabilityOptions::corrections`](crate::stability::StabilityOptions::corrections).
+        corrections: usize,
+        /// [`MAX_MARCH_STEPS`](crate::stability::MAX_MARCH_STEPS).
+        limit: f64,
+    },
+    /// An option is out of its range (named, with its value).
+    #[error("stability option {what} must be {expected}, got {value}")]
+    InvalidOption {
+        /// The option.
+        what: &'static str,
+        /// What it must be.
+        expected: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// The state is at rest: its one-period map is linear and the relative perturbation
+    /// step has no scale.
+    #[error("the state is at rest (zero norm): its stability is that of the linear system")]
+    AtRest,
+    /// The dense eigenvalue solver did not converge.
+    #[error("the eigenvalues of the {dimension} x {dimension} monodromy matrix did not converge")]
+    NoEigenvalues {
+        /// Rows of the matrix.
+        dimension: usize,
+    },
+    /// A multiplier or a matrix entry is not finite.
+    #[error("the monodromy matrix has a non-finite entry ({value}) in column {column}")]
+    NonFinite {
+        /// The column (perturbed coordinate).
+        column: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
 /// Any error of the crate.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
@@ -644,6 +714,9 @@ pub enum Error {
     /// See [`VerifyError`].
     #[error(transparent)]
     Verify(#[from] VerifyError),
+    /// See [`StabilityError`].
+    #[error(transparent)]
+    Stability(#[from] StabilityError),
 }
 
 /// A request whose buffers would exceed the memory budget

@@ -175,6 +175,7 @@ mod tests {
             time_domain: None,
             character: None,
             label: None,
+            stability: None,
         }
     }
 

@@ -87,6 +87,7 @@ pub mod plot;
 pub mod reference;
 pub mod solution;
 pub mod solve;
+pub mod stability;
 /// Proptest strategies for bars, frequencies, Helmholtz coefficients, the paper's systems and
 /// periods, for property tests of the crate's identities (feature `proptest`).
 #[cfg(feature = "proptest")]
@@ -97,5 +98,5 @@ pub mod system;
 /// impacts resolved inside the step) and the periodicity check of computed modes.
 pub mod verify;
 
-pub use error::{ContinuationError, Error, ModelError, SettingsError, SolveError};
+pub use error::{ContinuationError, Error, ModelError, SettingsError, SolveError, StabilityError};
 pub use solution::Solution;

@@ -125,6 +125,7 @@ const FLAGS: &[(&str, Value)] = &[
     ("parameter-range", Value::Range(1e-4, 5.0)),
     ("progress", Value::Switch),
     ("verify", Value::Switch),
+    ("stability", Value::Switch),
 ];
 
 /// Edge values tried for any flag that takes a value.
@@ -205,9 +206,9 @@ fn command_line(rng: &mut Rng, dir: &Path, index: usize) -> Vec<String> {
             args.push(value);
         }
     }
-    if args.iter().any(|a| a == "--verify") {
-        // Verification marches every point in time: few points keep the line cheap (later
-        // flags override earlier ones).
+    if args.iter().any(|a| a == "--verify" || a == "--stability") {
+        // Verification and stability march every point in time: few points keep the line
+        // cheap (later flags override earlier ones).
         for flag in ["--steps", "--max-steps"] {
             args.push(flag.to_string());
             args.push(rng.between(2, 8).to_string());

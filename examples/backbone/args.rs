@@ -15,7 +15,7 @@ pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--r
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI] [--switch-at N[:SIDE]]
   [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
-  [--energy-range LO:HI] [--progress] [--verify]";
+  [--energy-range LO:HI] [--progress] [--verify] [--stability]";
 
 /// Largest `--steps` and `--max-steps`.
 pub const MAX_POINTS: usize = 1_000_000;
@@ -84,6 +84,8 @@ pub struct Args {
     pub energy_range: Option<(f64, f64)>,
     pub progress: bool,
     pub verify: bool,
+    /// `--stability`: the Floquet multipliers of every converged point.
+    pub stability: bool,
 }
 
 fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
@@ -152,6 +154,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         energy_range: None,
         progress: false,
         verify: false,
+        stability: false,
     };
     let mut assembly = None;
     let mut system_given = false;
@@ -250,6 +253,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("energy-range") => a.energy_range = Some(range(&parser.value()?.string()?)?),
             Long("progress") => a.progress = true,
             Long("verify") => a.verify = true,
+            Long("stability") => a.stability = true,
             Short('h') | Long("help") => return Ok(None),
             _ => return Err(arg.unexpected()),
         }

@@ -10,7 +10,7 @@
 //!     [--selection first|lowest-energy] [--serial]
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--switch-at N[:SIDE]] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
-//!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify]
+//!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify] [--stability]
 //! ```
 //!
 //! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
@@ -47,6 +47,15 @@
 //! 1/400 of the shortest travel time, at most 10^6 steps per point) and adds the columns
 //! `periodicity_defect,displacement_defect,max_penetration` (empty, with a message, for a
 //! point it could not check).
+//!
+//! `--stability` asks the library for the Floquet multipliers of every converged point
+//! (`stability`, default options: 200 cells per shortest travel time, the state corrected to
+//! a periodic orbit of the exact map first) and adds, after every other column,
+//! `stable,max_multiplier`: `true`, `false` or `unresolved` (no periodic orbit of the map
+//! within 5 % of the point's displacement, or its trivial multipliers not found), and the
+//! largest multiplier modulus (1 when every multiplier lies within `1e-3` of the unit circle).
+//! Changes of verdict along a branch appear in `event` as `stability-lost` and
+//! `stability-gained`. Period and energy runs only; empty cells for `--parameter` runs.
 //!
 //! Last in every row, so that the columns before them keep their places:
 //! `contacts_per_period`, the number of contact intervals per period summed over the

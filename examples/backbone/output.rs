@@ -6,6 +6,7 @@ use nonsmooth_modes::branches::{BackbonePoint, PointStatus};
 use nonsmooth_modes::continuation::Event;
 use nonsmooth_modes::modal::{contact_intervals, subharmonic_share};
 use nonsmooth_modes::reference::ClampedFirstMode;
+use nonsmooth_modes::stability::Verdict;
 use nonsmooth_modes::system::NonsmoothSystem;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -14,8 +15,8 @@ pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energ
 
 /// The whole header: [`HEADER`], the `--verify` columns if `verify`, then
 /// `contacts_per_period`, `subharmonic_share` for a subharmonic order `K > 1`, and
-/// `label,branch,dominant_harmonic`.
-pub fn header(verify: bool, subharmonic: usize) -> String {
+/// `label,branch,dominant_harmonic`, then `stable,max_multiplier` if `stability`.
+pub fn header(verify: bool, subharmonic: usize, stability: bool) -> String {
     let mut header = HEADER.to_string();
     if verify {
         header.push_str(",periodicity_defect,displacement_defect,max_penetration");
@@ -25,6 +26,9 @@ pub fn header(verify: bool, subharmonic: usize) -> String {
         header.push_str(",subharmonic_share");
     }
     header.push_str(",label,branch,dominant_harmonic");
+    if stability {
+        header.push_str(",stable,max_multiplier");
+    }
     header
 }
 
@@ -48,6 +52,8 @@ pub struct Sink<'a> {
     pub progress: bool,
     /// The subharmonic order `K` of the run: `subharmonic_share` is written for `K > 1`.
     pub subharmonic: usize,
+    /// `--stability`: write `stable,max_multiplier`.
+    pub stability: bool,
 }
 
 impl Sink<'_> {
@@ -124,6 +130,30 @@ impl Sink<'_> {
         format!(",{label},{},{harmonic}", p.branch)
     }
 
+    /// `,stable,max_multiplier` of a point: `true`, `false` or `unresolved` and
+    /// `Floquet::max_multiplier`; empty for a point without multipliers (with a message when it
+    /// converged).
+    fn stability(&self, p: &BackbonePoint) -> String {
+        if !self.stability {
+            return String::new();
+        }
+        match &p.stability {
+            Some(Ok(f)) => {
+                let stable = match f.verdict {
+                    Verdict::Stable => "true",
+                    Verdict::Unstable(_) => "false",
+                    Verdict::Unresolved => "unresolved",
+                };
+                format!(",{stable},{:.10e}", f.max_multiplier)
+            }
+            Some(Err(e)) => {
+                eprintln!("backbone: no multipliers for step {}: {e}", p.step);
+                ",,".to_string()
+            }
+            None => ",,".to_string(),
+        }
+    }
+
     /// Writes the row of `p`, a point of `problem` (whose system is the one at the point's
     /// parameter value `parameter`, NaN for period runs).
     pub fn row(
@@ -146,7 +176,7 @@ impl Sink<'_> {
         let verification = self.verification(p);
         let signature = self.signature(problem, p);
         let line = format!(
-            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}{}{}",
+            "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}{}{}{}",
             p.step,
             p.period,
             p.omega,
@@ -167,6 +197,7 @@ impl Sink<'_> {
             verification,
             signature,
             Self::label(p),
+            self.stability(p),
         );
         match writeln!(self.out, "{line}") {
             Ok(()) => ControlFlow::Continue(()),

@@ -11,6 +11,7 @@ use nonsmooth_modes::branches::{
 };
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton, Solver};
+use nonsmooth_modes::stability::StabilityOptions;
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -22,7 +23,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         _ => default_periods(a)?,
     };
     let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
-    writeln!(out, "{}", header(a.verify, a.subharmonic))?;
+    writeln!(out, "{}", header(a.verify, a.subharmonic, a.stability))?;
     let mut sink = Sink {
         out,
         verify: a.verify,
@@ -34,6 +35,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         error: None,
         progress: a.progress,
         subharmonic: a.subharmonic,
+        stability: a.stability,
     };
     if a.parameter != Parameter::Omega && a.parameter != Parameter::Energy {
         run_parameter(a, t0, &mut sink)?;
@@ -129,6 +131,9 @@ fn request(
     };
     if a.verify {
         request.check = Some(TimeDomainCheck::for_system(system));
+    }
+    if a.stability {
+        request.stability = Some(StabilityOptions::default());
     }
     Ok(request)
 }

@@ -300,5 +300,6 @@ pub fn solved_point(
         time_domain: None,
         character: None,
         label: None,
+        stability: None,
     })
 }

@@ -6,6 +6,7 @@ use crate::error::{ContinuationError, SettingsError, SolveError};
 use crate::fourier::Basis;
 use crate::modal::{Character, Label};
 use crate::solution::Solution;
+use crate::stability::{Floquet, StabilityError};
 use crate::system::NonsmoothSystem;
 use crate::verify::PeriodicityReport;
 use std::f64::consts::PI;
@@ -53,6 +54,14 @@ pub struct BackbonePoint {
     /// Which branch of the mode a converged point lies on: skeleton, internal resonance,
     /// subharmonic, or unverified ([`Label`]).
     pub label: Option<Label>,
+    /// The Floquet multipliers of a converged point and its verdict, where they were asked
+    /// ([`Request::stability`](crate::branches::Request::stability)), or why they could not
+    /// be computed.
+    #[cfg_attr(
+        feature = "serde",
+        serde(serialize_with = "crate::stability::serialize_outcome")
+    )]
+    pub stability: Option<Result<Floquet, StabilityError>>,
 }
 
 impl BackbonePoint {
@@ -109,6 +118,7 @@ impl BackbonePoint {
             time_domain: None,
             character: None,
             label: None,
+            stability: None,
         }
     }
 }

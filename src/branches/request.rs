@@ -8,6 +8,7 @@ use crate::branches::switch::SwitchAt;
 use crate::continuation::Speculation;
 use crate::error::SolveError;
 use crate::solve::{NewtonOptions, SemismoothNewton, Solver};
+use crate::stability::StabilityOptions;
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use crate::verify::PeriodicityOptions;
 
@@ -163,6 +164,9 @@ pub struct Request {
     /// Check every converged point in the time domain and label those that fail it
     /// (`None`: no check; points are labelled by their harmonic content alone).
     pub check: Option<TimeDomainCheck>,
+    /// Compute the Floquet multipliers of every converged point
+    /// ([`stability`](crate::stability); `None`: no stability).
+    pub stability: Option<StabilityOptions>,
 }
 
 impl Request {
@@ -178,6 +182,7 @@ impl Request {
             solver: None,
             speculation: None,
             check: None,
+            stability: None,
         }
     }
 
@@ -221,6 +226,13 @@ impl Request {
     /// The same request with every converged point checked by `check`.
     pub fn checked(mut self, check: TimeDomainCheck) -> Self {
         self.check = Some(check);
+        self
+    }
+
+    /// The same request with the Floquet multipliers of every converged point, computed with
+    /// `options` ([`StabilityOptions::default`] for the usual grid and tolerance).
+    pub fn with_stability(mut self, options: StabilityOptions) -> Self {
+        self.stability = Some(options);
         self
     }
 

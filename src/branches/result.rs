@@ -9,6 +9,7 @@ use crate::error::{ContinuationError, SettingsError};
 use crate::modal::linear::{natural_frequency_values, Resolution};
 use crate::modal::{character, label, nearest_mode, ContactState};
 use crate::solution::Solution;
+use crate::stability::{floquet, Floquet, StabilityOptions, Verdict};
 use crate::system::NonsmoothSystem;
 use crate::verify::periodicity_check;
 use std::f64::consts::PI;
@@ -88,6 +89,10 @@ impl ModeBranches {
 pub(crate) struct Annotator<O> {
     problem: NonsmoothSystem,
     check: Option<TimeDomainCheck>,
+    stability: Option<StabilityOptions>,
+    /// The verdict of the last converged point whose multipliers were computed, and its
+    /// branch.
+    last_verdict: Option<(usize, Verdict)>,
     order: usize,
     observer: O,
     points: Vec<BackbonePoint>,
@@ -104,6 +109,8 @@ impl<O: BackboneObserver> Annotator<O> {
         Self {
             problem,
             check: request.check,
+            stability: request.stability,
+            last_verdict: None,
             order: request.subharmonic,
             observer,
             points: Vec::new(),
@@ -191,6 +198,37 @@ impl<O: BackboneObserver> Annotator<O> {
         let natural = &self.natural;
         point.label = label(&described, self.order, omega, natural, verified).ok();
         point.character = Some(described);
+        if let Some(options) = &self.stability {
+            let (system, basis) = (self.problem.system(), self.problem.basis());
+            let outcome = floquet(system, basis, &point.x, omega, options);
+            if let Ok(f) = &outcome {
+                self.stability_event(point, f);
+            }
+            point.stability = Some(outcome);
+        }
+    }
+
+    /// Adds [`Event::StabilityLost`] or [`Event::StabilityGained`] to `point` when its
+    /// verdict differs from that of the last resolved point before it on the same branch.
+    fn stability_event(&mut self, point: &mut BackbonePoint, f: &Floquet) {
+        if f.verdict == Verdict::Unresolved {
+            return;
+        }
+        if let Some((branch, before)) = self.last_verdict {
+            let event = match (before, f.verdict) {
+                (Verdict::Stable, Verdict::Unstable(crossing)) => {
+                    Some(Event::StabilityLost { crossing })
+                }
+                (Verdict::Unstable(crossing), Verdict::Stable) => {
+                    Some(Event::StabilityGained { crossing })
+                }
+                _ => None,
+            };
+            if let Some(event) = event.filter(|_| branch == point.branch) {
+                point.events.push(event);
+            }
+        }
+        self.last_verdict = Some((point.branch, f.verdict));
     }
 
     /// Extends the open-contact natural frequencies until the nearest of each frequency `f`

@@ -33,6 +33,7 @@ pub use speculative::{Speculation, SpeculationStats, Speculative};
 use crate::error::SolveError;
 use crate::linalg::DenseMatrix;
 use crate::solve::{Problem, Structured};
+use crate::stability::Crossing;
 
 /// A family of square systems `F(x, lambda) = 0` in one scalar parameter: a [`Problem`] at
 /// its current parameter, plus the parameter and the derivative in it.
@@ -195,10 +196,24 @@ pub enum Event {
         /// Whether the contact is active after the event.
         contact: bool,
     },
+    /// The point is unstable and the converged point before it on the same branch was
+    /// stable ([`stability`](crate::stability)): a multiplier left the unit circle in
+    /// between, the way `crossing` says (through `+1`: a fold or symmetry-breaking branch
+    /// point; through `-1`: a period-doubling; a complex pair: Neimark–Sacker).
+    StabilityLost {
+        /// Where the largest multiplier sits now.
+        crossing: Crossing,
+    },
+    /// The point is stable and the converged point before it on the same branch was not.
+    StabilityGained {
+        /// Where the largest multiplier of the point before sat.
+        crossing: Crossing,
+    },
 }
 
 impl Event {
-    /// A short label for tables: `fold`, `jump`, `branch-point`, `grazing+`, `grazing-`.
+    /// A short label for tables: `fold`, `jump`, `branch-point`, `grazing+`, `grazing-`,
+    /// `stability-lost`, `stability-gained`.
     pub fn label(&self) -> &'static str {
         match self {
             Event::Fold { .. } => "fold",
@@ -206,6 +221,8 @@ impl Event {
             Event::BranchPoint { .. } => "branch-point",
             Event::Grazing { contact: true, .. } => "grazing+",
             Event::Grazing { contact: false, .. } => "grazing-",
+            Event::StabilityLost { .. } => "stability-lost",
+            Event::StabilityGained { .. } => "stability-gained",
         }
     }
 }

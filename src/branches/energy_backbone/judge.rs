@@ -264,6 +264,7 @@ impl Judge {
                 time_domain: None,
                 character: None,
                 label: None,
+                stability: None,
             };
             if see(point).is_break() {
                 return Walk::Stopped;

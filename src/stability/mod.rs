@@ -1,0 +1,420 @@
+//! Floquet stability of computed modes, from the exact one-period map of the time-domain
+//! integrator.
+//!
+//! # The map
+//!
+//! The integrator of [`verify`](crate::verify) advances the two characteristic waves of
+//! every bar exactly; on its grid (a time step `dt`, `N_b` cells per bar) a state is the cell
+//! means of `u_x` and `u_t` and the displacement `u(0)` of every bar. The one-period map
+//! `P: X(0) -> X(T)` (the final waves projected back onto the cells) is **piecewise linear**:
+//! linear while the sequence of impacts and releases keeps its order, with impact instants
+//! that move continuously with the state. A periodic motion is a fixed point `P(X*) = X*`,
+//! and its **monodromy matrix** `M = dP/dX (X*)` decides whether small perturbations grow:
+//! the motion is (spectrally) stable when every eigenvalue `mu` of `M`, its Floquet
+//! multipliers, has `|mu| <= 1`.
+//!
+//! `M` is computed column by column by central differences, `(P(X* + h e_j) - P(X* - h e_j))
+//! / 2h`, with one step `h = 10^-4 |X*|_inf` for every coordinate. The coordinates are all
+//! velocities (`u_t`, `c u_x`, `c u(0) / l`), so one step suits them all; with a step
+//! proportional to the state, `M` is the same for a state and its gap scaled together (the
+//! map is positively homogeneous of degree 1 in both). Inside a region where the order of the
+//! contact events does not change, the differences are exact up to rounding and the
+//! second-order change of the impact instants; a step that moves an event across a cell
+//! boundary changes the map's piece only by `O(h)`. The multipliers are the eigenvalues of
+//! the dense `M` (`faer`).
+//!
+//! # What a conservative autonomous system implies
+//!
+//! - The time shift of the motion is a fixed direction of `M`: `M X*' = X*'`, a multiplier 1.
+//!   The family direction adds a Jordan block at 1; numerically the pair splits by about the
+//!   square root of the differences' error ([`Floquet::trivial_distance`] reports the nearest).
+//! - The map is symplectic, so multipliers come in pairs `mu`, `1 / conj(mu)`: an unstable
+//!   motion has `|mu| > 1` and `1 / |mu|` both. No conservative motion has every multiplier
+//!   strictly inside the circle, hence `max |mu| >= 1` (up to the differences' error).
+//! - The grid's cell means are an `L2` projection: where breakpoints of the waves fall inside
+//!   cells (impacts, incommensurate travel times) they pull multipliers slightly **inward**,
+//!   never outward. A commensurate grid is preferred ([`Grid::nearest`]) so that free flight
+//!   is an exact permutation of the cells, whose multipliers lie on the unit circle.
+//! - A clamped end keeps its displacement: a clamped left end's `u(0)` is no coordinate,
+//!   and a clamped right end's invariant displacement adds one exact multiplier 1, which is
+//!   removed (the nearest to 1) before the verdict.
+//!
+//! # Which state: a periodic orbit of the map, near the point
+//!
+//! The multipliers describe a motion only at a fixed point of `P`. A harmonic-balance point
+//! is not one: its strain jumps carry a Gibbs oscillation whose `L2` norm decays only like
+//! `m^-1/2`, so its state misses periodicity by 10 to 30 % in the state norm at `m = 20`
+//! on the clamped bar, while its displacement is within a few per cent. So the state is
+//! first moved to an instant where every contact is open (where the smallest relative gap
+//! is largest over one period: at an instant of closed contact the state sits on the
+//! constraint `g = 0`, where `P` is not differentiable), then **corrected** by Newton
+//! iterations on `P(X) - X = 0` with the phase condition that the correction is orthogonal
+//! to the motion's direction `X(dt) - X(0)` (the time shift, kernel of `M - I`), solved in
+//! the least-squares sense with `M` recomputed at each iterate
+//! ([`StabilityOptions::corrections`]). The verdict counts only when the corrected state is
+//! periodic (`|P(X) - X| <= 1e-8 |X|`, [`RESOLVED_DEFECT`]), its displacement within
+//! [`StabilityOptions::max_displacement_correction`] of the point's own, and the trivial
+//! pair found within the tolerance (where the differences miss it, an event with singular
+//! timing, such as a grazing impact, makes them inaccurate for every multiplier):
+//! otherwise the point is [`Verdict::Unresolved`], with the multipliers of its own state
+//! when the correction failed.
+//!
+//! The verdict is **stable** when `max |mu| <= 1 + tolerance`
+//! ([`StabilityOptions::tolerance`]).
+//!
+//! # Cost
+//!
+//! `2 n` marches of one period for `n` coordinates and a dense eigenvalue problem
+//! (`O(n^3)`) per monodromy, one more monodromy per correction. `n` is about twice the
+//! number of cells, [`StabilityOptions::cells_per_travel`] per shortest travel time
+//! `l_b / c_b`; matrices of more than [`MAX_DIMENSION`] rows are refused
+//! ([`StabilityError::TooLarge`]), and so are points whose marches would take more than
+//! [`MAX_MARCH_STEPS`] time steps ([`StabilityError::TooCostly`]). The clamped bar at 200
+//! cells takes about 0.3 s per monodromy (`cargo bench --bench stability`).
+
+mod coordinates;
+mod floquet;
+mod monodromy;
+mod shooting;
+
+pub use crate::error::StabilityError;
+pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
+
+use crate::bar::Bar;
+use crate::fourier::Basis;
+use crate::system::BarSystem;
+use crate::verify::{
+    march, Condition, Grid, MarchOptions, Model, SpringUpdate, State, VerifyError,
+};
+use coordinates::Coordinates;
+use monodromy::{Monodromy, PeriodMap};
+
+/// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
+/// `8 n^2` bytes (200 MiB).
+pub const MAX_DIMENSION: usize = 2000;
+
+/// The most time steps the marches of one point's multipliers may take in all (about 20 s;
+/// the 200-cell clamped bar takes `5e6`).
+pub const MAX_MARCH_STEPS: f64 = 5e7;
+
+/// The periodicity defect `|P(X) - X| / |X|` at which the correction stops: the rounding of
+/// one period's march is about `1e-14` of the state.
+pub const PERIODIC_DEFECT: f64 = 1e-11;
+
+/// The other steps of the differences, relative to [`StabilityOptions::relative_step`], tried
+/// in turn when the trivial pair is not found within the tolerance.
+const STEP_FACTORS: [f64; 2] = [10.0, 0.1];
+
+/// The largest periodicity defect of a corrected state whose multipliers count
+/// ([`Verdict::Unresolved`] beyond).
+pub const RESOLVED_DEFECT: f64 = 1e-8;
+
+/// Options of [`floquet`] and [`floquet_of_state`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StabilityOptions {
+    /// Cells across the bar of shortest travel time `l_b / c_b` (the grid's step is that
+    /// travel time over this; default 200). The matrix has about `2 sum_b N_b` rows.
+    pub cells_per_travel: f64,
+    /// The differences' step relative to the state's largest coordinate (default `1e-4`:
+    /// the map is linear between events, so a large step loses nothing there and keeps the
+    /// rounding of the marches, about `1e-14` of the state, far below it).
+    pub relative_step: f64,
+    /// How far outside the unit circle a multiplier may lie and the point still count as
+    /// stable (default `1e-3`): above the error of the differences, which splits the Jordan
+    /// block at 1 by up to `2e-5` on the exact clamped family (`tests/stability.rs`).
+    pub tolerance: f64,
+    /// Update of ground springs: [`SpringUpdate::Midpoint`] by default, which conserves
+    /// energy exactly, so that the grid adds no damping that would read as stability.
+    pub spring: SpringUpdate,
+    /// Chord iterations that correct the state to a periodic orbit of the grid's map before
+    /// its multipliers are computed (default 8; 0: none). A harmonic-balance point is only
+    /// near one, and the multipliers of a state that is not periodic describe no motion.
+    pub corrections: usize,
+    /// The largest change of displacement, `max |u - u0| / max |u0|`, by which the
+    /// correction may move the point's state (default `0.05`, the time-domain check's
+    /// bound): beyond, the periodic orbit found is another motion, and the verdict is
+    /// [`Verdict::Unresolved`].
+    pub max_displacement_correction: f64,
+}
+
+impl Default for StabilityOptions {
+    fn default() -> Self {
+        Self {
+            cells_per_travel: 200.0,
+            relative_step: 1e-4,
+            tolerance: 1e-3,
+            spring: SpringUpdate::Midpoint,
+            corrections: 8,
+            max_displacement_correction: 0.05,
+        }
+    }
+}
+
+impl StabilityOptions {
+    fn check(&self) -> Result<(), StabilityError> {
+        let checks = [
+            (
+                "cells_per_travel",
+                "finite and at least 1",
+                self.cells_per_travel,
+                self.cells_per_travel >= 1.0,
+            ),
+            (
+                "relative_step",
+                "positive and below 1",
+                self.relative_step,
+                self.relative_step > 0.0 && self.relative_step < 1.0,
+            ),
+            (
+                "tolerance",
+                "non-negative",
+                self.tolerance,
+                self.tolerance >= 0.0,
+            ),
+            (
+                "max_displacement_correction",
+                "non-negative",
+                self.max_displacement_correction,
+                self.max_displacement_correction >= 0.0,
+            ),
+        ];
+        for (what, expected, value, ok) in checks {
+            if !(ok && value.is_finite()) {
+                return Err(StabilityError::InvalidOption {
+                    what,
+                    expected,
+                    value,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The grid: the commensurate step nearest to the shortest travel time over
+    /// `cells_per_travel`, or that step itself when none is commensurate.
+    fn grid(&self, model: &Model) -> Result<Grid, StabilityError> {
+        let shortest = model
+            .bars()
+            .iter()
+            .map(|b: &Bar| b.length() / b.wave_speed())
+            .fold(f64::INFINITY, f64::min);
+        let dt = shortest / self.cells_per_travel;
+        let grid = match Grid::nearest(model, dt) {
+            Err(VerifyError::NoAdmissibleGrid { .. }) => Grid::new(model, dt)?,
+            other => other?,
+        };
+        let dimension: usize = (0..grid.bars()).map(|b| 2 * grid.cells(b) + 1).sum();
+        if dimension > MAX_DIMENSION {
+            return Err(StabilityError::TooLarge {
+                dimension,
+                cells_per_travel: self.cells_per_travel,
+                limit: MAX_DIMENSION,
+            });
+        }
+        Ok(grid)
+    }
+
+    /// The time step [`floquet`] would use for `system`.
+    ///
+    /// # Errors
+    /// As [`floquet`], for the grid alone.
+    pub fn dt_for(&self, system: &BarSystem) -> Result<f64, StabilityError> {
+        self.check()?;
+        Ok(self.grid(&Model::from_system(system)?)?.dt())
+    }
+}
+
+/// The Floquet multipliers of the `period`-periodic motion starting at `initial`, on
+/// `initial`'s grid (see the [module docs](self)).
+///
+/// # Errors
+/// [`StabilityError::InvalidOption`] for options out of range; [`StabilityError::TooLarge`]
+/// for a grid of more than [`MAX_DIMENSION`] coordinates; [`StabilityError::AtRest`] for a
+/// state at rest; [`StabilityError::Verify`] if a march fails (a bad period, a march too
+/// costly); [`StabilityError::NonFinite`] and [`StabilityError::NoEigenvalues`] if the
+/// matrix or its eigenvalues cannot be computed.
+pub fn floquet_of_state(
+    initial: &State,
+    period: f64,
+    options: &StabilityOptions,
+) -> Result<Floquet, StabilityError> {
+    options.check()?;
+    let coordinates = Coordinates::new(initial.model(), initial.grid());
+    if coordinates.len() > MAX_DIMENSION {
+        return Err(StabilityError::TooLarge {
+            dimension: coordinates.len(),
+            cells_per_travel: options.cells_per_travel,
+            limit: MAX_DIMENSION,
+        });
+    }
+    if !(period.is_finite() && period > 0.0) {
+        return Err(VerifyError::InvalidParameter {
+            what: "period",
+            value: period,
+        }
+        .into());
+    }
+    let steps = 2.0
+        * coordinates.len() as f64
+        * (period / initial.grid().dt()).ceil()
+        * (1.0 + options.corrections as f64 + STEP_FACTORS.len() as f64);
+    if steps.is_nan() || steps > MAX_MARCH_STEPS {
+        return Err(StabilityError::TooCostly {
+            steps,
+            dimension: coordinates.len(),
+            corrections: options.corrections,
+            limit: MAX_MARCH_STEPS,
+        });
+    }
+    let section = open_section(initial, period, options.spring)?;
+    let map = PeriodMap {
+        coordinates: &coordinates,
+        template: &section,
+        period,
+        spring: options.spring,
+    };
+    let mut base = Vec::new();
+    coordinates.of_snapshot(&section.snapshot(), &mut base);
+    let (corrected, at_corrected, at_base) = map.correct(
+        &base,
+        options.relative_step,
+        section.grid().dt(),
+        options.corrections,
+        PERIODIC_DEFECT,
+    )?;
+    let periodic = corrected.defect <= RESOLVED_DEFECT
+        && corrected.displacement_shift <= options.max_displacement_correction;
+    // A point whose correction failed keeps the multipliers of its own state: those of a
+    // partial correction depend on the path the iterations took.
+    let spurious = coordinates.spurious_unit_multipliers();
+    let multipliers_of = |monodromy: &Monodromy| -> Result<Vec<Multiplier>, StabilityError> {
+        let mut multipliers = floquet::eigenvalues(monodromy)?;
+        floquet::remove_nearest_one(&mut multipliers, spurious);
+        Ok(multipliers)
+    };
+    let mut monodromy = if periodic { at_corrected } else { at_base };
+    let mut multipliers = multipliers_of(&monodromy)?;
+    // The differences must reproduce the known multiplier 1 of the time shift. Where they
+    // miss it, a step that adds or removes a near-grazing impact made them inaccurate: a
+    // ten times larger step steps over it, a ten times smaller one stays within the piece.
+    if periodic {
+        for factor in STEP_FACTORS {
+            if floquet::trivial_pair_distance(&multipliers) <= options.tolerance {
+                break;
+            }
+            let other = map.monodromy(&corrected.x, factor * options.relative_step)?;
+            let other_multipliers = multipliers_of(&other)?;
+            if floquet::trivial_pair_distance(&other_multipliers)
+                < floquet::trivial_pair_distance(&multipliers)
+            {
+                (monodromy, multipliers) = (other, other_multipliers);
+            }
+        }
+    }
+    Ok(floquet::verdict(
+        multipliers,
+        options.tolerance,
+        monodromy.dimension,
+        initial.grid().dt(),
+        &corrected,
+        periodic,
+    ))
+}
+
+/// The state of the motion from `initial` at the instant of one period where the smallest
+/// gap (relative to the law's own gap) is largest: there every contact is open, so the
+/// one-period map is differentiable. At an instant of closed contact the state sits on the
+/// constraint `g = 0` and its perturbations that penetrate are not motions.
+fn open_section(
+    initial: &State,
+    period: f64,
+    spring: SpringUpdate,
+) -> Result<State, StabilityError> {
+    let options = MarchOptions {
+        spring,
+        snapshot_every: 0,
+    };
+    match open_instant(initial, period, spring)? {
+        t if t > 0.0 => Ok(march(initial, t, &options)?.final_state),
+        _ => Ok(initial.clone()),
+    }
+}
+
+/// The instant of one period from `initial` where the smallest relative gap is largest.
+fn open_instant(initial: &State, period: f64, spring: SpringUpdate) -> Result<f64, StabilityError> {
+    let options = MarchOptions {
+        spring,
+        snapshot_every: 0,
+    };
+    let trajectory = march(initial, period, &options)?;
+    let scales: Vec<f64> = trajectory
+        .contacts
+        .iter()
+        .map(|h| {
+            law_gap(initial.model(), h.condition)
+                .abs()
+                .max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    let widest = (0..trajectory.times.len())
+        .map(|k| {
+            let smallest = trajectory
+                .contacts
+                .iter()
+                .zip(&scales)
+                .map(|(h, s)| h.gap[k] / s)
+                .fold(f64::INFINITY, f64::min);
+            (k, smallest)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    Ok(match widest {
+        Some((k, _)) if !trajectory.contacts.is_empty() => trajectory.times[k],
+        _ => 0.0,
+    })
+}
+
+/// The gap `g0` of condition `index` (0 for a linear condition).
+fn law_gap(model: &Model, index: usize) -> f64 {
+    match model.conditions()[index] {
+        Condition::Obstacle { gap, .. } | Condition::Contact { gap, .. } => gap,
+        _ => 0.0,
+    }
+}
+
+/// The Floquet multipliers of a harmonic-balance point: the solution `x` (layout of
+/// [`NonsmoothSystem`](crate::system::NonsmoothSystem), basis `basis`) at fundamental
+/// frequency `omega`, started at `t = 0` on the grid of [`StabilityOptions`].
+///
+/// # Errors
+/// As [`floquet_of_state`], and those of [`State::from_harmonic_balance`] and
+/// [`Model::from_system`] (a condition the integrator does not model).
+pub fn floquet<B: Basis>(
+    system: &BarSystem,
+    basis: &B,
+    x: &[f64],
+    omega: f64,
+    options: &StabilityOptions,
+) -> Result<Floquet, StabilityError> {
+    options.check()?;
+    let grid = options.grid(&Model::from_system(system)?)?;
+    let initial = State::from_harmonic_balance(system, basis, x, omega, 0.0, grid.dt())?;
+    floquet_of_state(&initial, 2.0 * std::f64::consts::PI / omega, options)
+}
+
+/// Serializes a point's stability outcome: the [`Floquet`] report, or `{"error": message}`.
+#[cfg(feature = "serde")]
+pub(crate) fn serialize_outcome<S: serde::Serializer>(
+    outcome: &Option<Result<Floquet, StabilityError>>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    match outcome {
+        None => serializer.serialize_none(),
+        Some(Ok(floquet)) => serializer.serialize_some(floquet),
+        Some(Err(error)) => {
+            let mut map = serializer.serialize_map(Some(1))?;
+            map.serialize_entry("error", &error.to_string())?;
+            map.end()
+        }
+    }
+}

@@ -1,0 +1,106 @@
+//! The derivative of the exact one-period map, by central differences.
+
+use super::coordinates::Coordinates;
+use crate::error::StabilityError;
+use crate::verify::{march, MarchOptions, SpringUpdate, State};
+
+/// The monodromy matrix `M = dP/dX` of the one-period map `P` at a state, in the coordinates
+/// of [`Coordinates`], column-major.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Monodromy {
+    /// Rows (and columns).
+    pub dimension: usize,
+    /// `M[(i, j)] = entries[i + j dimension]`.
+    pub entries: Vec<f64>,
+}
+
+/// The one-period map `P` of the exact integrator, in coordinates.
+pub(crate) struct PeriodMap<'a> {
+    pub coordinates: &'a Coordinates,
+    /// Gives the model and grid.
+    pub template: &'a State,
+    pub period: f64,
+    pub spring: SpringUpdate,
+}
+
+impl PeriodMap<'_> {
+    /// `out = P(v)`.
+    pub(crate) fn apply(&self, v: &[f64], out: &mut Vec<f64>) -> Result<(), StabilityError> {
+        self.flow(v, self.period, out)
+    }
+
+    /// `out`: the coordinates of the motion from `v` after `duration`.
+    pub(crate) fn flow(
+        &self,
+        v: &[f64],
+        duration: f64,
+        out: &mut Vec<f64>,
+    ) -> Result<(), StabilityError> {
+        let state = self
+            .coordinates
+            .to_state(self.template.model(), self.template.grid(), v)?;
+        let trajectory = march(
+            &state,
+            duration,
+            &MarchOptions {
+                spring: self.spring,
+                snapshot_every: 0,
+            },
+        )?;
+        self.coordinates
+            .of_snapshot(&trajectory.final_state.snapshot(), out);
+        Ok(())
+    }
+
+    /// Column `j` of `dP/dX` at `base` by central differences of `step`, into `scratch[1]`.
+    fn column(
+        &self,
+        base: &[f64],
+        j: usize,
+        step: f64,
+        scratch: &mut [Vec<f64>; 3],
+    ) -> Result<(), StabilityError> {
+        let [v, plus, minus] = scratch;
+        v.clear();
+        v.extend_from_slice(base);
+        v[j] = base[j] + step;
+        self.apply(v, plus)?;
+        v[j] = base[j] - step;
+        self.apply(v, minus)?;
+        for (p, m) in plus.iter_mut().zip(minus.iter()) {
+            *p = (*p - m) / (2.0 * step);
+        }
+        Ok(())
+    }
+
+    /// The monodromy matrix at `base`, with the step `relative_step |X|_inf` for every
+    /// coordinate (`2 n` marches of one period).
+    ///
+    /// The step is relative to the state, so that the matrix is the same for a state and gap
+    /// scaled together (the map is positively homogeneous of degree 1 in both).
+    pub(crate) fn monodromy(
+        &self,
+        base: &[f64],
+        relative_step: f64,
+    ) -> Result<Monodromy, StabilityError> {
+        let scale = base.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if scale == 0.0 {
+            return Err(StabilityError::AtRest);
+        }
+        let step = relative_step * scale;
+        let dimension = base.len();
+        let mut entries = Vec::with_capacity(dimension * dimension);
+        let mut scratch = [Vec::new(), Vec::new(), Vec::new()];
+        for j in 0..dimension {
+            self.column(base, j, step, &mut scratch)?;
+            if let Some(value) = scratch[1].iter().find(|v| !v.is_finite()) {
+                return Err(StabilityError::NonFinite {
+                    column: j,
+                    value: *value,
+                });
+            }
+            entries.extend_from_slice(&scratch[1]);
+        }
+        Ok(Monodromy { dimension, entries })
+    }
+}

@@ -1,0 +1,187 @@
+//! Floquet stability from the exact one-period map (`nonsmooth_modes::stability`): checks
+//! that can fail, on exact motions (the clamped bar's exact first nonsmooth mode, a motion
+//! that never touches), on harmonic-balance points (gap homogeneity), and on bad input.
+
+use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
+use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::stability::{
+    floquet, floquet_of_state, StabilityError, StabilityOptions, Verdict, MAX_DIMENSION,
+};
+use nonsmooth_modes::verify::{clamped_first_mode, BarCells, Grid, Model, State};
+use std::f64::consts::PI;
+
+fn options(cells: f64) -> StabilityOptions {
+    StabilityOptions {
+        cells_per_travel: cells,
+        ..StabilityOptions::default()
+    }
+}
+
+/// The exact first mode of the clamped bar is a periodic orbit of the grid's map to
+/// rounding; its multipliers: the trivial pair at 1 found to the tolerance, none outside the
+/// circle (a stable family), and `max |mu| >= 1` (conservative).
+#[test]
+fn exact_clamped_family_is_stable_with_its_trivial_pair() {
+    for period in [3.2, 3.5, 3.8] {
+        let state = clamped_first_mode(1e-3, period, 1.0 / 200.0).unwrap();
+        let f = floquet_of_state(&state, period, &options(200.0)).unwrap();
+        assert!(f.periodicity_defect < 1e-12, "T = {period}: {f:?}");
+        assert_eq!(
+            f.verdict,
+            Verdict::Stable,
+            "T = {period}: {}",
+            f.max_modulus
+        );
+        assert!(
+            f.trivial_distance < 1e-4,
+            "T = {period}: {}",
+            f.trivial_distance
+        );
+        assert!(f.max_modulus >= 1.0 - 1e-9 && f.max_multiplier == 1.0);
+        assert_eq!(f.multipliers.len(), f.dimension);
+    }
+}
+
+/// Refining the grid from 200 to 400 cells per travel time keeps every verdict of the exact
+/// family (the issue asks for at least 95 %: here all of them).
+#[test]
+fn grid_refinement_keeps_the_verdicts() {
+    let periods = [3.1, 3.3, 3.5, 3.7, 3.9];
+    let mut same = 0;
+    for period in periods {
+        let verdict = |cells: f64| {
+            let state = clamped_first_mode(1e-3, period, 1.0 / cells).unwrap();
+            floquet_of_state(&state, period, &options(cells))
+                .unwrap()
+                .verdict
+        };
+        same += usize::from(verdict(200.0) == verdict(400.0));
+    }
+    assert!(
+        same * 100 >= 95 * periods.len(),
+        "{same} of {}",
+        periods.len()
+    );
+}
+
+/// A motion that never touches the obstacle is a motion of the linear bar: on a
+/// commensurate grid free flight permutes the cells, so every multiplier lies on the unit
+/// circle (here the period is the bar's own, 4 l / c, and the map is the identity).
+#[test]
+fn a_motion_without_contact_has_every_multiplier_on_the_circle() {
+    let model = Model::clamped_bar_with_obstacle(1.0).unwrap();
+    let grid = Grid::new(&model, 1.0 / 100.0).unwrap();
+    let n = grid.cells(0);
+    let dx = 1.0 / n as f64;
+    // u = a sin(pi x / 2) cos(pi t / 2), a << gap: first clamped-free mode at t = 0.
+    let a = 1e-3;
+    let strain = (0..n)
+        .map(|i| {
+            let (x0, x1) = (i as f64 * dx, (i + 1) as f64 * dx);
+            a * ((PI * x1 / 2.0).sin() - (PI * x0 / 2.0).sin()) / dx
+        })
+        .collect();
+    let state = State::from_cells(
+        &model,
+        &grid,
+        &[BarCells {
+            left_displacement: 0.0,
+            strain,
+            velocity: vec![0.0; n],
+        }],
+    )
+    .unwrap();
+    let f = floquet_of_state(&state, 4.0, &options(100.0)).unwrap();
+    for mu in &f.multipliers {
+        assert!((mu.modulus() - 1.0).abs() < 1e-9, "{mu:?}");
+    }
+    assert_eq!(f.verdict, Verdict::Stable);
+}
+
+/// Every quantity is homogeneous in the gap: the harmonic-balance points of gaps `1e-3` and
+/// `2e-3` at the same periods give the same verdicts and the same largest multipliers to
+/// `1e-6`, and every converged point has a finite `max_multiplier >= 1 - 1e-6`.
+#[test]
+fn verdicts_are_homogeneous_in_the_gap() {
+    let run = |gap: f64| {
+        let system = clamped_bar_with_obstacle(gap).unwrap();
+        let grid = PeriodGrid {
+            start: 3.8,
+            end: 3.4,
+            steps: 5,
+        };
+        let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
+        let request = Request::for_method(method)
+            .harmonics(20)
+            .with_stability(options(100.0));
+        compute(&system, &request).unwrap()
+    };
+    let (a, b) = (run(1e-3), run(2e-3));
+    let mut compared = 0;
+    for (p, q) in a.converged().zip(b.converged()) {
+        assert!((p.period - q.period).abs() < 1e-12);
+        let (f, g) = (
+            p.stability.clone().unwrap().unwrap(),
+            q.stability.clone().unwrap().unwrap(),
+        );
+        assert_eq!(f.verdict, g.verdict, "T = {}", p.period);
+        assert!(
+            (f.max_multiplier - g.max_multiplier).abs() <= 1e-6,
+            "T = {}: {} and {}",
+            p.period,
+            f.max_multiplier,
+            g.max_multiplier
+        );
+        assert!(f.max_multiplier.is_finite() && f.max_multiplier >= 1.0 - 1e-6);
+        compared += 1;
+    }
+    assert!(compared >= 4, "{compared} points compared");
+}
+
+/// Bad options, a state at rest and a grid too large are typed errors.
+#[test]
+fn bad_input_is_a_typed_error() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let problem = nonsmooth_modes::system::NonsmoothSystem::new(
+        &system,
+        nonsmooth_modes::system::HarmonicBalanceSettings {
+            harmonics: 4,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let basis = problem.basis();
+    let rest = vec![0.0; problem.dimension()];
+    let omega = 2.0 * PI / 3.5;
+    let bad = [
+        StabilityOptions {
+            cells_per_travel: f64::NAN,
+            ..StabilityOptions::default()
+        },
+        StabilityOptions {
+            relative_step: 0.0,
+            ..StabilityOptions::default()
+        },
+        StabilityOptions {
+            tolerance: -1.0,
+            ..StabilityOptions::default()
+        },
+        StabilityOptions {
+            max_displacement_correction: f64::INFINITY,
+            ..StabilityOptions::default()
+        },
+    ];
+    for o in bad {
+        let e = floquet(&system, basis, &rest, omega, &o).unwrap_err();
+        assert!(matches!(e, StabilityError::InvalidOption { .. }), "{e}");
+    }
+    let e = floquet(&system, basis, &rest, omega, &options(50.0)).unwrap_err();
+    assert_eq!(e, StabilityError::AtRest);
+    let e = floquet(&system, basis, &rest, omega, &options(1e5)).unwrap_err();
+    assert!(
+        matches!(e, StabilityError::TooLarge { limit, .. } if limit == MAX_DIMENSION),
+        "{e}"
+    );
+    let e = floquet(&system, basis, &rest, -1.0, &options(50.0)).unwrap_err();
+    assert!(matches!(e, StabilityError::Verify(_)), "{e}");
+}
