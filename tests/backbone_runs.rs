@@ -160,7 +160,11 @@ fn a_failed_start_search_is_bounded_and_says_why() {
     let omega = 2.0 * std::f64::consts::PI / (linear_period(&system, 1, 1).unwrap() * 0.9875);
     let ratios = START_RATIOS.len() + FLOATING_RATIOS.len();
     let amplitudes = START_AMPLITUDES.len() + FLOATING_AMPLITUDES.len();
-    let guesses = ratios * amplitudes * (1 + bars.len() * RIGID_AMPLITUDES.len());
+    // Each guess around the seed, each with each rigid-body mode added, and the closing
+    // guesses: the four gaps are closed by the seed and the three rigid-body modes in one way
+    // (one subset of four laws), at each ratio and amplitude.
+    let closing = ratios * amplitudes;
+    let guesses = ratios * amplitudes * (1 + bars.len() * RIGID_AMPLITUDES.len()) + closing;
     let request = Request {
         settings,
         solver: Some(Solver::default()),

@@ -183,7 +183,12 @@ impl Judge {
         for ratio in guesses.ratios() {
             let omega = ratio * linear.omega / self.subharmonic as f64;
             let seed = seed_from_mode(&mut self.problem, linear, self.subharmonic, omega)?;
-            let tries = guesses.around(&self.problem, (&seed, self.subharmonic), &RIGID_AMPLITUDES);
+            let tries = guesses.around(
+                &self.problem,
+                (&seed, self.subharmonic),
+                omega,
+                &RIGID_AMPLITUDES,
+            );
             if let Some(x) = self.solve_at(&solvers, tries, omega) {
                 return Ok((x, omega));
             }
