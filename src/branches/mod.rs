@@ -9,6 +9,7 @@ mod convergence;
 mod defaults;
 mod energy_backbone;
 mod escape;
+mod guesses;
 mod level;
 mod parameter;
 mod point;
