@@ -70,7 +70,7 @@
 //! `l_b / c_b`; matrices of more than [`MAX_DIMENSION`] rows are refused
 //! ([`StabilityError::TooLarge`]), and so are points whose marches would take more than
 //! [`MAX_MARCH_STEPS`] time steps ([`StabilityError::TooCostly`]). The clamped bar at 200
-//! cells takes about 0.3 s per monodromy (`cargo bench --bench stability`).
+//! cells takes about 0.2 s per monodromy (`cargo bench --bench stability`).
 
 mod coordinates;
 mod floquet;
@@ -126,7 +126,7 @@ pub struct StabilityOptions {
     /// Update of ground springs: [`SpringUpdate::Midpoint`] by default, which conserves
     /// energy exactly, so that the grid adds no damping that would read as stability.
     pub spring: SpringUpdate,
-    /// Chord iterations that correct the state to a periodic orbit of the grid's map before
+    /// Newton iterations that correct the state to a periodic orbit of the grid's map before
     /// its multipliers are computed (default 8; 0: none). A harmonic-balance point is only
     /// near one, and the multipliers of a state that is not periodic describe no motion.
     pub corrections: usize,
