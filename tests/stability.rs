@@ -42,6 +42,27 @@ fn exact_clamped_family_is_stable_with_its_trivial_pair() {
     }
 }
 
+/// The same family for a bar pressed into the obstacle (`g0 < 0`, `2 < T < 3`): stable too.
+#[test]
+fn exact_pressed_family_is_stable() {
+    for period in [2.3, 2.7] {
+        let state = clamped_first_mode(-1e-3, period, 1.0 / 200.0).unwrap();
+        let f = floquet_of_state(&state, period, &options(200.0)).unwrap();
+        assert!(f.periodicity_defect < 1e-12, "T = {period}: {f:?}");
+        assert_eq!(
+            f.verdict,
+            Verdict::Stable,
+            "T = {period}: {}",
+            f.max_modulus
+        );
+        assert!(
+            f.trivial_distance < 1e-4,
+            "T = {period}: {}",
+            f.trivial_distance
+        );
+    }
+}
+
 /// Refining the grid from 200 to 400 cells per travel time keeps every verdict of the exact
 /// family (the issue asks for at least 95 %: here all of them).
 #[test]
