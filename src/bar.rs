@@ -48,6 +48,11 @@ impl Bar {
         self.wave_speed
     }
 
+    /// Travel time `l / c` of a wave across the bar.
+    pub fn travel_time(&self) -> f64 {
+        self.length / self.wave_speed
+    }
+
     /// Axial stiffness `EA`.
     pub fn stiffness(&self) -> f64 {
         self.stiffness
@@ -62,6 +67,14 @@ impl Bar {
     pub fn wavenumber(&self, omega: f64) -> f64 {
         omega / self.wave_speed
     }
+}
+
+/// The shortest travel time `l / c` of `bars` (`+inf` for none): the time scale of grids that
+/// must resolve every bar.
+pub fn shortest_travel_time(bars: &[Bar]) -> f64 {
+    bars.iter()
+        .map(Bar::travel_time)
+        .fold(f64::INFINITY, f64::min)
 }
 
 #[cfg(test)]

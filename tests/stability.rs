@@ -7,7 +7,7 @@ use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::stability::{
     floquet, floquet_of_state, StabilityError, StabilityOptions, Verdict, MAX_DIMENSION,
 };
-use nonsmooth_modes::verify::{clamped_first_mode, BarCells, Grid, Model, State};
+use nonsmooth_modes::verify::{clamped_first_mode, Grid, Model, State};
 use std::f64::consts::PI;
 
 fn options(cells: f64) -> StabilityOptions {
@@ -17,13 +17,13 @@ fn options(cells: f64) -> StabilityOptions {
     }
 }
 
-/// The exact first mode of the clamped bar is a periodic orbit of the grid's map to
-/// rounding; its multipliers: the trivial pair at 1 found to the tolerance, none outside the
-/// circle (a stable family), and `max |mu| >= 1` (conservative).
-#[test]
-fn exact_clamped_family_is_stable_with_its_trivial_pair() {
-    for period in [3.2, 3.5, 3.8] {
-        let state = clamped_first_mode(1e-3, period, 1.0 / 200.0).unwrap();
+/// The exact first mode of the clamped bar at gap `gap` and each of `periods`, on 200 cells:
+/// a periodic orbit of the grid's map to rounding, with the trivial pair at 1 found to
+/// `1e-4`, none outside the circle (stable), `max |mu| >= 1` (conservative), and one
+/// multiplier per coordinate (no clamped right end to remove).
+fn assert_exact_family_is_stable(gap: f64, periods: &[f64]) {
+    for &period in periods {
+        let state = clamped_first_mode(gap, period, 1.0 / 200.0).unwrap();
         let f = floquet_of_state(&state, period, &options(200.0)).unwrap();
         assert!(f.periodicity_defect < 1e-12, "T = {period}: {f:?}");
         assert_eq!(
@@ -42,25 +42,16 @@ fn exact_clamped_family_is_stable_with_its_trivial_pair() {
     }
 }
 
+/// The clamped bar's exact first nonsmooth mode is stable.
+#[test]
+fn exact_clamped_family_is_stable_with_its_trivial_pair() {
+    assert_exact_family_is_stable(1e-3, &[3.2, 3.5, 3.8]);
+}
+
 /// The same family for a bar pressed into the obstacle (`g0 < 0`, `2 < T < 3`): stable too.
 #[test]
 fn exact_pressed_family_is_stable() {
-    for period in [2.3, 2.7] {
-        let state = clamped_first_mode(-1e-3, period, 1.0 / 200.0).unwrap();
-        let f = floquet_of_state(&state, period, &options(200.0)).unwrap();
-        assert!(f.periodicity_defect < 1e-12, "T = {period}: {f:?}");
-        assert_eq!(
-            f.verdict,
-            Verdict::Stable,
-            "T = {period}: {}",
-            f.max_modulus
-        );
-        assert!(
-            f.trivial_distance < 1e-4,
-            "T = {period}: {}",
-            f.trivial_distance
-        );
-    }
+    assert_exact_family_is_stable(-1e-3, &[2.3, 2.7]);
 }
 
 /// Refining the grid from 200 to 400 cells per travel time keeps every verdict of the exact
@@ -92,26 +83,9 @@ fn grid_refinement_keeps_the_verdicts() {
 fn a_motion_without_contact_has_every_multiplier_on_the_circle() {
     let model = Model::clamped_bar_with_obstacle(1.0).unwrap();
     let grid = Grid::new(&model, 1.0 / 100.0).unwrap();
-    let n = grid.cells(0);
-    let dx = 1.0 / n as f64;
     // u = a sin(pi x / 2) cos(pi t / 2), a << gap: first clamped-free mode at t = 0.
     let a = 1e-3;
-    let strain = (0..n)
-        .map(|i| {
-            let (x0, x1) = (i as f64 * dx, (i + 1) as f64 * dx);
-            a * ((PI * x1 / 2.0).sin() - (PI * x0 / 2.0).sin()) / dx
-        })
-        .collect();
-    let state = State::from_cells(
-        &model,
-        &grid,
-        &[BarCells {
-            left_displacement: 0.0,
-            strain,
-            velocity: vec![0.0; n],
-        }],
-    )
-    .unwrap();
+    let state = State::from_fields(&model, &grid, |_, x| (a * (PI * x / 2.0).sin(), 0.0)).unwrap();
     let f = floquet_of_state(&state, 4.0, &options(100.0)).unwrap();
     for mu in &f.multipliers {
         assert!((mu.modulus() - 1.0).abs() < 1e-9, "{mu:?}");

@@ -247,13 +247,13 @@ mod tests {
     use crate::modal::linear::{open_mode, seed_from_mode};
     use crate::system::{AssemblyBuilder, HarmonicBalanceSettings};
 
-    /// Clamped bar, free-free bar, clamped bar, gaps `g1` and `g2`: the free-free bar's
-    /// first mode (`omega = 0.4 pi`) is the system's first open mode.
-    fn floating_between(g1: f64, g2: f64) -> BarSystem {
+    /// A unit bar clamped at its left, a free-free unit bar of wave speed `floating_speed`,
+    /// a unit bar of wave speed `far_speed` clamped at its right, gaps `g1` and `g2`.
+    fn floating_between((g1, g2): (f64, f64), floating_speed: f64, far_speed: f64) -> BarSystem {
         let mut b = AssemblyBuilder::new();
         let a = b.add_bar(Bar::unit());
-        let f = b.add_bar(Bar::new(1.0, 0.4, 1.0).unwrap());
-        let c = b.add_bar(Bar::unit());
+        let f = b.add_bar(Bar::new(1.0, floating_speed, 1.0).unwrap());
+        let c = b.add_bar(Bar::new(1.0, far_speed, 1.0).unwrap());
         b.dirichlet(a.left()).unwrap();
         b.contact(a.right(), f.left(), g1).unwrap();
         b.contact(f.right(), c.left(), g2).unwrap();
@@ -261,38 +261,60 @@ mod tests {
         b.build().unwrap()
     }
 
-    /// The floating bar's own mode closes both gaps: offset `(g2 - g1) / 2` towards the
-    /// larger gap and amplitude `(g1 + g2) / 2`, each law just grazing.
-    #[test]
-    fn a_floating_bar_mode_is_offset_to_graze_both_neighbours() {
-        let (g1, g2) = (1e-3, 3e-3);
-        let system = floating_between(g1, g2);
+    /// What the closing guesses of `system` start from: its first open mode, which must lie
+    /// at `omega1`, seeded at the first start ratio on 4 harmonics.
+    struct Closing {
+        problem: NonsmoothSystem,
+        seed: Vec<f64>,
+        omega: f64,
+        guesses: StartGuesses,
+        ways: Vec<(f64, Vec<f64>)>,
+    }
+
+    fn closing_of(system: &BarSystem, omega1: f64) -> Closing {
         let settings = HarmonicBalanceSettings {
             harmonics: 4,
             ..HarmonicBalanceSettings::default()
         };
-        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
-        let mode = open_mode(&system, 1).unwrap();
-        assert!((mode.omega - 0.4 * std::f64::consts::PI).abs() < 1e-9);
+        let mut problem = NonsmoothSystem::new(system, settings).unwrap();
+        let mode = open_mode(system, 1).unwrap();
+        assert!((mode.omega - omega1).abs() < 1e-9, "{}", mode.omega);
         let omega = mode.omega * START_RATIOS[0];
         let seed = seed_from_mode(&mut problem, &mode, 1, omega).unwrap();
-        let guesses = StartGuesses::new(&system);
+        let guesses = StartGuesses::new(system);
         assert!(guesses.floating());
         let ways = guesses.closing(&problem, (&seed, 1), omega);
         assert_eq!(ways.len(), 1, "{ways:?}");
-        let (s, d) = &ways[0];
+        Closing {
+            problem,
+            seed,
+            omega,
+            guesses,
+            ways,
+        }
+    }
+
+    /// The floating bar's own mode (the first open mode, `omega = 0.4 pi`) closes both gaps:
+    /// offset `(g2 - g1) / 2` towards the larger gap and amplitude `(g1 + g2) / 2`, each law
+    /// just grazing.
+    #[test]
+    fn a_floating_bar_mode_is_offset_to_graze_both_neighbours() {
+        let (g1, g2) = (1e-3, 3e-3);
+        let system = floating_between((g1, g2), 0.4, 1.0);
+        let mut c = closing_of(&system, 0.4 * std::f64::consts::PI);
+        let (s, d) = &c.ways[0];
         // The seed grazes the nearer gap `g1` alone: scaled by `s` it swings by `(g1+g2)/2`
         // (exactly so at the mode's frequency; its ends swing by slightly different
         // amounts off it).
         assert!((s - 2.0).abs() < 1e-2, "{s}");
         // The floating bar's offset (its translation, whichever sign the basis has).
-        let offset = d[0] * guesses.rigid[0][2];
+        let offset = d[0] * c.guesses.rigid[0][2];
         assert!((offset - 0.5 * (g2 - g1)).abs() < 1e-2 * g1, "{offset}");
         // And the guesses built on it penetrate both gaps by the closing depth.
-        let tries = guesses.around(&problem, (&seed, 1), omega, &[]);
-        let closing = &tries[tries.len() - guesses.amplitudes().len()];
+        let tries = c.guesses.around(&c.problem, (&c.seed, 1), c.omega, &[]);
+        let closing = &tries[tries.len() - c.guesses.amplitudes().len()];
         for l in 0..2 {
-            let gap = problem.gap_history(closing, omega, l);
+            let gap = c.problem.gap_history(closing, c.omega, l);
             let least = gap.iter().copied().fold(f64::INFINITY, f64::min);
             let g0 = [g1, g2][l];
             assert!(
@@ -302,37 +324,17 @@ mod tests {
         }
     }
 
-    /// A held bar's mode with the floating bar packed against the far neighbour: the
-    /// amplitude closes both gaps.
+    /// A held bar's mode (the first open mode is the clamped-free bar's, at `pi / 2`) with
+    /// the floating bar packed against the far neighbour: the amplitude closes both gaps.
     #[test]
     fn a_held_bar_mode_packs_the_floating_bar_against_the_far_side() {
         let (g1, g2) = (2e-3, 1e-3);
-        let mut b = AssemblyBuilder::new();
-        let a = b.add_bar(Bar::unit());
-        let f = b.add_bar(Bar::new(1.0, 3.0, 1.0).unwrap());
-        let c = b.add_bar(Bar::new(1.0, 2.0, 1.0).unwrap());
-        b.dirichlet(a.left()).unwrap();
-        b.contact(a.right(), f.left(), g1).unwrap();
-        b.contact(f.right(), c.left(), g2).unwrap();
-        b.dirichlet(c.right()).unwrap();
-        let system = b.build().unwrap();
-        let settings = HarmonicBalanceSettings {
-            harmonics: 4,
-            ..HarmonicBalanceSettings::default()
-        };
-        let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
-        // The first open mode is the clamped-free bar `a`'s, at `pi / 2`.
-        let mode = open_mode(&system, 1).unwrap();
-        assert!((mode.omega - 0.5 * std::f64::consts::PI).abs() < 1e-9);
-        let omega = mode.omega * START_RATIOS[0];
-        let seed = seed_from_mode(&mut problem, &mode, 1, omega).unwrap();
-        let guesses = StartGuesses::new(&system);
-        let ways = guesses.closing(&problem, (&seed, 1), omega);
-        assert_eq!(ways.len(), 1, "{ways:?}");
-        let (s, d) = &ways[0];
+        let system = floating_between((g1, g2), 3.0, 2.0);
+        let c = closing_of(&system, 0.5 * std::f64::consts::PI);
+        let (s, d) = &c.ways[0];
         // The seed grazes `g1`; closing `g1 + g2` takes `1.5` times it.
         assert!((s - 1.5).abs() < 1e-9, "{s}");
-        let offset = d[0] * guesses.rigid[0][2];
+        let offset = d[0] * c.guesses.rigid[0][2];
         assert!((offset - g2).abs() < 1e-9 * g2, "{offset}");
     }
 }

@@ -2,6 +2,7 @@
 //! many harmonics, by which method, with which solver, and whether every point is checked in
 //! the time domain.
 
+use crate::bar::shortest_travel_time;
 use crate::branches::backbone::{ArclengthBackboneOptions, BackboneOptions};
 use crate::branches::energy_backbone::EnergyBackboneOptions;
 use crate::branches::switch::SwitchAt;
@@ -127,11 +128,7 @@ impl TimeDomainCheck {
     /// grid adjusted to commensurate cells where one is near, one period,
     /// [`Self::MAX_DISPLACEMENT_DEFECT`] and [`Self::MAX_STEPS`].
     pub fn for_system(system: &BarSystem) -> Self {
-        let travel = system
-            .bars()
-            .iter()
-            .map(|b| b.length() / b.wave_speed())
-            .fold(f64::INFINITY, f64::min);
+        let travel = shortest_travel_time(system.bars());
         Self {
             options: PeriodicityOptions {
                 dt: travel / Self::CELLS_PER_TRAVEL,

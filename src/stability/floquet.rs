@@ -3,7 +3,6 @@
 use super::monodromy::Monodromy;
 use super::shooting::Corrected;
 use crate::error::StabilityError;
-use faer::Mat;
 
 /// A Floquet multiplier `mu = re + i im`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,9 +20,9 @@ impl Multiplier {
         self.re.hypot(self.im)
     }
 
-    /// `|mu - z|` for `z = re + i im`.
-    fn distance_to(&self, re: f64, im: f64) -> f64 {
-        (self.re - re).hypot(self.im - im)
+    /// `|mu - 1|`.
+    fn distance_to_one(&self) -> f64 {
+        (self.re - 1.0).hypot(self.im)
     }
 }
 
@@ -118,9 +117,8 @@ pub struct Floquet {
 
 /// The eigenvalues of `monodromy`, largest modulus first.
 pub(crate) fn eigenvalues(monodromy: &Monodromy) -> Result<Vec<Multiplier>, StabilityError> {
-    let n = monodromy.dimension;
-    let matrix = Mat::<f64>::from_fn(n, n, |i, j| monodromy.entries[i + j * n]);
-    let values = matrix
+    let n = monodromy.nrows();
+    let values = monodromy
         .eigenvalues()
         .map_err(|_| StabilityError::NoEigenvalues { dimension: n })?;
     let mut multipliers: Vec<Multiplier> = values
@@ -131,32 +129,31 @@ pub(crate) fn eigenvalues(monodromy: &Monodromy) -> Result<Vec<Multiplier>, Stab
     Ok(multipliers)
 }
 
+/// The indices of `multipliers`, nearest 1 first.
+fn nearest_one(multipliers: &[Multiplier]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..multipliers.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (a, b) = (&multipliers[a], &multipliers[b]);
+        a.distance_to_one().total_cmp(&b.distance_to_one())
+    });
+    order
+}
+
 /// Removes the `count` multipliers nearest 1 (exact invariants of the coordinates, not of
 /// the motion).
 pub(crate) fn remove_nearest_one(multipliers: &mut Vec<Multiplier>, count: usize) {
-    for _ in 0..count {
-        let nearest = multipliers
-            .iter()
-            .enumerate()
-            .min_by(|a, b| {
-                a.1.distance_to(1.0, 0.0)
-                    .total_cmp(&b.1.distance_to(1.0, 0.0))
-            })
-            .map(|(i, _)| i);
-        if let Some(i) = nearest {
-            multipliers.remove(i);
-        }
+    let mut removed: Vec<usize> = nearest_one(multipliers).into_iter().take(count).collect();
+    removed.sort_unstable_by(|a, b| b.cmp(a));
+    for i in removed {
+        multipliers.remove(i);
     }
 }
 
 /// The larger `|mu - 1|` of the two multipliers nearest 1 (`inf` without two).
 pub(crate) fn trivial_pair_distance(multipliers: &[Multiplier]) -> f64 {
-    let mut d: Vec<f64> = multipliers
-        .iter()
-        .map(|m| m.distance_to(1.0, 0.0))
-        .collect();
-    d.sort_by(f64::total_cmp);
-    d.get(1).copied().unwrap_or(f64::INFINITY)
+    nearest_one(multipliers)
+        .get(1)
+        .map_or(f64::INFINITY, |&i| multipliers[i].distance_to_one())
 }
 
 /// Sets the two multipliers nearest 1 to exactly 1 when both lie within `tolerance` of it:
@@ -166,17 +163,10 @@ pub(crate) fn trivial_pair_distance(multipliers: &[Multiplier]) -> f64 {
 /// the larger of their distances to 1 (`inf` without two multipliers), and keeps the list
 /// sorted by decreasing modulus.
 fn snap_trivial_pair(multipliers: &mut [Multiplier], tolerance: f64) -> f64 {
-    let mut order: Vec<usize> = (0..multipliers.len()).collect();
-    order.sort_by(|&a, &b| {
-        let (a, b) = (&multipliers[a], &multipliers[b]);
-        a.distance_to(1.0, 0.0).total_cmp(&b.distance_to(1.0, 0.0))
-    });
-    let [first, second, ..] = order[..] else {
+    let [first, second, ..] = nearest_one(multipliers)[..] else {
         return f64::INFINITY;
     };
-    let distance = multipliers[first]
-        .distance_to(1.0, 0.0)
-        .max(multipliers[second].distance_to(1.0, 0.0));
+    let distance = multipliers[second].distance_to_one();
     if distance <= tolerance {
         for i in [first, second] {
             multipliers[i] = Multiplier { re: 1.0, im: 0.0 };

@@ -80,7 +80,7 @@ mod shooting;
 pub use crate::error::StabilityError;
 pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
 
-use crate::bar::Bar;
+use crate::bar::shortest_travel_time;
 use crate::fourier::Basis;
 use crate::system::BarSystem;
 use crate::verify::{
@@ -193,34 +193,8 @@ impl StabilityOptions {
     /// The grid: the commensurate step nearest to the shortest travel time over
     /// `cells_per_travel`, or that step itself when none is commensurate.
     fn grid(&self, model: &Model) -> Result<Grid, StabilityError> {
-        let shortest = model
-            .bars()
-            .iter()
-            .map(|b: &Bar| b.length() / b.wave_speed())
-            .fold(f64::INFINITY, f64::min);
-        let dt = shortest / self.cells_per_travel;
-        let grid = match Grid::nearest(model, dt) {
-            Err(VerifyError::NoAdmissibleGrid { .. }) => Grid::new(model, dt)?,
-            other => other?,
-        };
-        let dimension: usize = (0..grid.bars()).map(|b| 2 * grid.cells(b) + 1).sum();
-        if dimension > MAX_DIMENSION {
-            return Err(StabilityError::TooLarge {
-                dimension,
-                cells_per_travel: self.cells_per_travel,
-                limit: MAX_DIMENSION,
-            });
-        }
-        Ok(grid)
-    }
-
-    /// The time step [`floquet`] would use for `system`.
-    ///
-    /// # Errors
-    /// As [`floquet`], for the grid alone.
-    pub fn dt_for(&self, system: &BarSystem) -> Result<f64, StabilityError> {
-        self.check()?;
-        Ok(self.grid(&Model::from_system(system)?)?.dt())
+        let dt = shortest_travel_time(model.bars()) / self.cells_per_travel;
+        Ok(Grid::nearest_or_new(model, dt)?)
     }
 }
 
@@ -292,8 +266,10 @@ pub fn floquet_of_state(
         floquet::remove_nearest_one(&mut multipliers, spurious);
         Ok(multipliers)
     };
-    let mut monodromy = if periodic { at_corrected } else { at_base };
-    let mut multipliers = multipliers_of(&monodromy)?;
+    let mut multipliers = match at_corrected {
+        Some(at_corrected) if periodic => multipliers_of(&at_corrected)?,
+        _ => multipliers_of(&at_base)?,
+    };
     // The differences must reproduce the known multiplier 1 of the time shift. Where they
     // miss it, a step that adds or removes a near-grazing impact made them inaccurate: a
     // ten times larger step steps over it, a ten times smaller one stays within the piece.
@@ -303,18 +279,17 @@ pub fn floquet_of_state(
                 break;
             }
             let other = map.monodromy(&corrected.x, factor * options.relative_step)?;
-            let other_multipliers = multipliers_of(&other)?;
-            if floquet::trivial_pair_distance(&other_multipliers)
-                < floquet::trivial_pair_distance(&multipliers)
+            let other = multipliers_of(&other)?;
+            if floquet::trivial_pair_distance(&other) < floquet::trivial_pair_distance(&multipliers)
             {
-                (monodromy, multipliers) = (other, other_multipliers);
+                multipliers = other;
             }
         }
     }
     Ok(floquet::verdict(
         multipliers,
         options.tolerance,
-        monodromy.dimension,
+        coordinates.len(),
         initial.grid().dt(),
         &corrected,
         periodic,

@@ -3,16 +3,11 @@
 use super::coordinates::Coordinates;
 use crate::error::StabilityError;
 use crate::verify::{march, MarchOptions, SpringUpdate, State};
+use faer::Mat;
 
 /// The monodromy matrix `M = dP/dX` of the one-period map `P` at a state, in the coordinates
-/// of [`Coordinates`], column-major.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Monodromy {
-    /// Rows (and columns).
-    pub dimension: usize,
-    /// `M[(i, j)] = entries[i + j dimension]`.
-    pub entries: Vec<f64>,
-}
+/// of [`Coordinates`].
+pub(crate) type Monodromy = Mat<f64>;
 
 /// The one-period map `P` of the exact integrator, in coordinates.
 pub(crate) struct PeriodMap<'a> {
@@ -88,10 +83,10 @@ impl PeriodMap<'_> {
             return Err(StabilityError::AtRest);
         }
         let step = relative_step * scale;
-        let dimension = base.len();
-        let mut entries = Vec::with_capacity(dimension * dimension);
+        let n = base.len();
+        let mut matrix = Mat::<f64>::zeros(n, n);
         let mut scratch = [Vec::new(), Vec::new(), Vec::new()];
-        for j in 0..dimension {
+        for j in 0..n {
             self.column(base, j, step, &mut scratch)?;
             if let Some(value) = scratch[1].iter().find(|v| !v.is_finite()) {
                 return Err(StabilityError::NonFinite {
@@ -99,8 +94,10 @@ impl PeriodMap<'_> {
                     value: *value,
                 });
             }
-            entries.extend_from_slice(&scratch[1]);
+            for (i, value) in scratch[1].iter().enumerate() {
+                matrix[(i, j)] = *value;
+            }
         }
-        Ok(Monodromy { dimension, entries })
+        Ok(matrix)
     }
 }

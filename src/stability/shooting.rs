@@ -2,6 +2,7 @@
 
 use super::monodromy::{Monodromy, PeriodMap};
 use crate::error::StabilityError;
+use crate::solve::norm;
 use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;
 
@@ -22,10 +23,6 @@ pub(crate) struct Corrected {
     pub iterations: usize,
 }
 
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|a| a * a).sum::<f64>().sqrt()
-}
-
 /// `|P(x) - x|` and the residual `P(x) - x` itself.
 fn residual(map: &PeriodMap, x: &[f64], out: &mut Vec<f64>) -> Result<f64, StabilityError> {
     map.apply(x, out)?;
@@ -43,7 +40,8 @@ impl PeriodMap<'_> {
     /// on the fixed point once the events are in the right order. The step `a` halves until
     /// the defect decreases (three times at most); the iterations stop below `tolerance`,
     /// after `max_iterations`, or when no step decreases the defect. Returns the best state
-    /// with the monodromy there, and the monodromy at `base`.
+    /// with the monodromy there (`None` when no iteration moved it), and the monodromy at
+    /// `base`.
     pub(crate) fn correct(
         &self,
         base: &[f64],
@@ -51,7 +49,7 @@ impl PeriodMap<'_> {
         dt: f64,
         max_iterations: usize,
         tolerance: f64,
-    ) -> Result<(Corrected, Monodromy, Monodromy), StabilityError> {
+    ) -> Result<(Corrected, Option<Monodromy>, Monodromy), StabilityError> {
         let x0_norm = norm(base);
         let mut r = Vec::new();
         let initial_defect = residual(self, base, &mut r)? / x0_norm;
@@ -64,7 +62,7 @@ impl PeriodMap<'_> {
             iterations: 0,
         };
         let at_base = self.monodromy(base, relative_step)?;
-        let mut monodromy = at_base.clone();
+        let mut latest: Option<Monodromy> = None;
         let mut trial_r = Vec::new();
         let mut direction = Vec::new();
         for iteration in 1..=max_iterations {
@@ -72,11 +70,12 @@ impl PeriodMap<'_> {
                 break;
             }
             let x = &best.x;
-            let n = monodromy.dimension;
+            let monodromy = latest.as_ref().unwrap_or(&at_base);
+            let n = monodromy.nrows();
             self.flow(x, dt, &mut direction)?;
             let bordered = Mat::<f64>::from_fn(n + 1, n, |i, j| {
                 if i < n {
-                    monodromy.entries[i + j * n] - if i == j { 1.0 } else { 0.0 }
+                    monodromy[(i, j)] - if i == j { 1.0 } else { 0.0 }
                 } else {
                     direction[j] - x[j]
                 }
@@ -101,7 +100,7 @@ impl PeriodMap<'_> {
             };
             std::mem::swap(&mut r, &mut trial_r);
             let change: Vec<f64> = x.iter().zip(base).map(|(a, b)| a - b).collect();
-            monodromy = self.monodromy(&x, relative_step)?;
+            latest = Some(self.monodromy(&x, relative_step)?);
             best = Corrected {
                 shift: norm(&change) / x0_norm,
                 displacement_shift: self.coordinates.displacement_distance(&x, base),
@@ -111,6 +110,6 @@ impl PeriodMap<'_> {
                 iterations: iteration,
             };
         }
-        Ok((best, monodromy, at_base))
+        Ok((best, latest, at_base))
     }
 }

@@ -2,7 +2,6 @@
 
 use super::wave::Resolution;
 use super::{Model, VerifyError};
-use crate::bar::Bar;
 use crate::fourier::check_memory;
 
 /// Relative tolerance under which `l / (c dt)` counts as an integer.
@@ -67,11 +66,6 @@ fn check_dt(dt: f64) -> Result<f64, VerifyError> {
     }
 }
 
-/// The travel time `l / c` of a wave across `bar`.
-fn travel_time(bar: &Bar) -> f64 {
-    bar.length() / bar.wave_speed()
-}
-
 /// `l / (c dt)`, snapped to the nearest integer when within tolerance of it.
 fn steps_of(travel_time: f64, dt: f64) -> f64 {
     let ratio = travel_time / dt;
@@ -98,7 +92,7 @@ impl Grid {
         let dt = check_dt(dt)?;
         let mut steps = Vec::with_capacity(model.bars().len());
         for (b, bar) in model.bars().iter().enumerate() {
-            let travel_time = travel_time(bar);
+            let travel_time = bar.travel_time();
             let nu = steps_of(travel_time, dt);
             if nu < 1.0 {
                 return Err(VerifyError::NonMatchingGrid {
@@ -129,8 +123,8 @@ impl Grid {
     pub fn nearest(model: &Model, dt: f64) -> Result<Self, VerifyError> {
         let dt = check_dt(dt)?;
         // The cells at `dt` bound the candidates' counts (a tiny `dt` overflows them).
-        check_cells(model.bars().iter().map(|bar| travel_time(bar) / dt).sum())?;
-        let tau = travel_time(&model.bars()[0]);
+        check_cells(model.bars().iter().map(|bar| bar.travel_time() / dt).sum())?;
+        let tau = model.bars()[0].travel_time();
         let low = (tau / (2.0 * dt)).floor().max(1.0) as usize;
         let high = ((2.0 * tau / dt).ceil() as usize).max(low);
         let mut best: Option<Grid> = None;
@@ -149,6 +143,18 @@ impl Grid {
             low: tau / high as f64,
             high: tau / low as f64,
         })
+    }
+
+    /// [`Grid::nearest`] where some step near `dt` is commensurate, [`Grid::new`] at `dt`
+    /// itself where none is.
+    ///
+    /// # Errors
+    /// Those of [`Grid::new`].
+    pub fn nearest_or_new(model: &Model, dt: f64) -> Result<Self, VerifyError> {
+        match Self::nearest(model, dt) {
+            Err(VerifyError::NoAdmissibleGrid { .. }) => Self::new(model, dt),
+            other => other,
+        }
     }
 
     /// The time step `dt`.

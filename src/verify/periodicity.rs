@@ -243,10 +243,7 @@ pub fn periodicity_check<B: Basis>(
 ) -> Result<PeriodicityReport, VerifyError> {
     let model = Model::from_system(system)?;
     let grid = if options.adjust_grid {
-        match Grid::nearest(&model, options.dt) {
-            Err(VerifyError::NoAdmissibleGrid { .. }) => Grid::new(&model, options.dt)?,
-            other => other?,
-        }
+        Grid::nearest_or_new(&model, options.dt)?
     } else {
         Grid::new(&model, options.dt)?
     };

@@ -5,6 +5,7 @@
 //! read the per-harmonic rows of one frequency and write into buffers they are handed: they
 //! keep nothing between calls, so the same inputs give the same outputs bit for bit.
 
+use crate::bar::Bar;
 use crate::bc::LawSamples;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{check_memory, Basis, CosineBasis};
@@ -186,7 +187,7 @@ impl<B: Basis> Discretization<B> {
     /// `MAX_PHASE / (m max_b(l_b / c_b))`.
     pub fn max_frequency(&self) -> f64 {
         let slowest = (self.system.bars().iter())
-            .map(|b| b.length() / b.wave_speed())
+            .map(Bar::travel_time)
             .fold(0.0, f64::max);
         MAX_PHASE / (self.basis.harmonics().max(1) as f64 * slowest)
     }
