@@ -133,6 +133,44 @@ fn verdicts_are_homogeneous_in_the_gap() {
     assert!(compared >= 4, "{compared} points compared");
 }
 
+/// A verdict counts only for a periodic orbit near the point: every resolved point's
+/// correction keeps its energy and displacement within the options' bounds, and with a zero
+/// energy bound every point whose correction changed the energy is unresolved.
+#[test]
+fn a_verdict_belongs_to_an_orbit_with_the_points_energy() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let grid = PeriodGrid {
+        start: 3.8,
+        end: 3.4,
+        steps: 5,
+    };
+    let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
+    let result = compute(&system, &Request::for_method(method).harmonics(20)).unwrap();
+    let basis = result.problem().basis();
+    let (default, strict) = (
+        options(100.0),
+        StabilityOptions {
+            max_energy_correction: 0.0,
+            ..options(100.0)
+        },
+    );
+    let mut resolved = 0;
+    for p in result.converged() {
+        let f = floquet(&system, basis, &p.x, p.omega, &default).unwrap();
+        if f.verdict != Verdict::Unresolved {
+            resolved += 1;
+            assert!(f.periodicity_defect <= 1e-8, "T = {}: {f:?}", p.period);
+            assert!(f.energy_correction.abs() <= default.max_energy_correction);
+            assert!(f.displacement_correction <= default.max_displacement_correction);
+        }
+        let g = floquet(&system, basis, &p.x, p.omega, &strict).unwrap();
+        if g.energy_correction != 0.0 {
+            assert_eq!(g.verdict, Verdict::Unresolved, "T = {}", p.period);
+        }
+    }
+    assert!(resolved >= 2, "{resolved} resolved");
+}
+
 /// Bad options, a state at rest and a grid too large are typed errors.
 #[test]
 fn bad_input_is_a_typed_error() {
@@ -163,6 +201,10 @@ fn bad_input_is_a_typed_error() {
         },
         StabilityOptions {
             max_displacement_correction: f64::INFINITY,
+            ..StabilityOptions::default()
+        },
+        StabilityOptions {
+            max_energy_correction: f64::NAN,
             ..StabilityOptions::default()
         },
     ];

@@ -37,6 +37,7 @@ mod helpers;
 mod lines;
 mod map;
 mod snapshots;
+mod stability;
 mod types;
 
 pub use helpers::{
@@ -44,6 +45,7 @@ pub use helpers::{
     plot_space_time, plot_xy, space_time_panel, ENERGY_LABEL, FREQUENCY_LABEL,
 };
 pub use snapshots::{snapshots_panel, PlacedBar, Placement};
+pub use stability::stability_series;
 pub use types::{
     Figure, LegendPosition, LineKind, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
     SpaceTimeField, PALETTE,

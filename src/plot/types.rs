@@ -24,6 +24,8 @@ pub const PALETTE: [Rgb; 8] = [
 impl Rgb {
     /// Black.
     pub const BLACK: Rgb = Rgb(0, 0, 0);
+    /// White.
+    pub const WHITE: Rgb = Rgb(255, 255, 255);
 
     /// The same colour for the drawing backend.
     pub(super) fn color(self) -> RGBColor {

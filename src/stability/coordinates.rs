@@ -114,6 +114,13 @@ impl Coordinates {
         }
     }
 
+    /// The energy of the state `v` (on `template`'s model and grid).
+    pub(crate) fn energy(&self, template: &State, v: &[f64]) -> Result<f64, VerifyError> {
+        Ok(self
+            .to_state(template.model(), template.grid(), v)?
+            .energy())
+    }
+
     /// The state of the coordinates `v`.
     pub(crate) fn to_state(
         &self,

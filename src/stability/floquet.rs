@@ -64,6 +64,15 @@ pub enum Verdict {
 }
 
 impl Verdict {
+    /// `Some(true)` when stable, `Some(false)` when unstable, `None` when unresolved.
+    pub fn stable(&self) -> Option<bool> {
+        match self {
+            Verdict::Stable => Some(true),
+            Verdict::Unstable(_) => Some(false),
+            Verdict::Unresolved => None,
+        }
+    }
+
     /// `stable`, `unstable` or `unresolved`.
     pub fn name(&self) -> &'static str {
         match self {
@@ -101,6 +110,11 @@ pub struct Floquet {
     pub dimension: usize,
     /// The time step of the grid.
     pub dt: f64,
+    /// The period of the one-period map. For a harmonic-balance point
+    /// ([`floquet`](super::floquet)), the point's own rounded to a whole number of steps of a grid
+    /// chosen to make the rounding small (`|change| < 1e-4` of the period on the clamped
+    /// bar at 200 cells).
+    pub period: f64,
     /// How periodic the state was on the grid before its correction: `|P(X) - X| / |X|` in
     /// coordinates.
     pub initial_defect: f64,
@@ -113,6 +127,8 @@ pub struct Floquet {
     /// displacement (the state norm also counts the strain's Gibbs oscillation, which
     /// decays only like `m^-1/2` with the harmonics).
     pub displacement_correction: f64,
+    /// `(E - E0) / E0`: how far the correction moved the energy (on the grid).
+    pub energy_correction: f64,
 }
 
 /// The eigenvalues of `monodromy`, largest modulus first.
@@ -186,6 +202,7 @@ pub(crate) fn verdict(
     tolerance: f64,
     dimension: usize,
     dt: f64,
+    period: f64,
     corrected: &Corrected,
     periodic: bool,
 ) -> Floquet {
@@ -221,5 +238,7 @@ pub(crate) fn verdict(
         periodicity_defect: corrected.defect,
         correction: corrected.shift,
         displacement_correction: corrected.displacement_shift,
+        energy_correction: corrected.energy_change,
+        period,
     }
 }

@@ -48,16 +48,23 @@
 //! first moved to an instant where every contact is open (where the smallest relative gap
 //! is largest over one period: at an instant of closed contact the state sits on the
 //! constraint `g = 0`, where `P` is not differentiable), then **corrected** by Newton
-//! iterations on `P(X) - X = 0` with the phase condition that the correction is orthogonal
-//! to the motion's direction `X(dt) - X(0)` (the time shift, kernel of `M - I`), solved in
-//! the least-squares sense with `M` recomputed at each iterate
-//! ([`StabilityOptions::corrections`]). The verdict counts only when the corrected state is
-//! periodic (`|P(X) - X| <= 1e-8 |X|`, [`RESOLVED_DEFECT`]), its displacement within
-//! [`StabilityOptions::max_displacement_correction`] of the point's own, and the trivial
-//! pair found within the tolerance (where the differences miss it, an event with singular
-//! timing, such as a grazing impact, makes them inaccurate for every multiplier):
-//! otherwise the point is [`Verdict::Unresolved`], with the multipliers of its own state
-//! when the correction failed.
+//! iterations on `P(X) - X = 0`, with `M` recomputed at each iterate
+//! ([`StabilityOptions::corrections`]). Each step is the **minimum-norm** solution of
+//! `(M - I) d = X - P(X)` over the singular values above `1e-4` of the largest: `M - I` is
+//! singular along the time shift and nearly so along the family direction and, on a
+//! commensurate grid, along every wave that free flight carries back onto itself over the
+//! period; a step that moves along them changes the motion instead of correcting it (the
+//! minimum-norm step is orthogonal to the time shift, so no phase condition is needed).
+//! The verdict counts only when the corrected state is periodic (`|P(X) - X| <= 1e-8 |X|`,
+//! [`RESOLVED_DEFECT`]), its displacement within
+//! [`StabilityOptions::max_displacement_correction`] and its energy within
+//! [`StabilityOptions::max_energy_correction`] of the point's own (a harmonic-balance point's
+//! energy is accurate where its state is not: at a fixed period the exact map has several
+//! periodic orbits near the point, and one with 10 % more energy in high harmonics is
+//! another motion), and the trivial pair found within the tolerance (where the differences
+//! miss it, an event with singular timing, such as a grazing impact, makes them inaccurate
+//! for every multiplier): otherwise the point is [`Verdict::Unresolved`], with the
+//! multipliers of its own state when the correction failed.
 //!
 //! The verdict is **stable** when `max |mu| <= 1 + tolerance`
 //! ([`StabilityOptions::tolerance`]).
@@ -65,7 +72,8 @@
 //! # Cost
 //!
 //! `2 n` marches of one period for `n` coordinates and a dense eigenvalue problem
-//! (`O(n^3)`) per monodromy, one more monodromy per correction. `n` is about twice the
+//! (`O(n^3)`) per monodromy, one more monodromy and a singular value decomposition per
+//! correction. `n` is about twice the
 //! number of cells, [`StabilityOptions::cells_per_travel`] per shortest travel time
 //! `l_b / c_b`; matrices of more than [`MAX_DIMENSION`] rows are refused
 //! ([`StabilityError::TooLarge`]), and so are points whose marches would take more than
@@ -82,12 +90,14 @@ pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
 
 use crate::bar::shortest_travel_time;
 use crate::fourier::Basis;
+use crate::modal::inputs::check_frequency;
 use crate::system::BarSystem;
 use crate::verify::{
     march, Condition, Grid, MarchOptions, Model, SpringUpdate, State, VerifyError,
 };
 use coordinates::Coordinates;
 use monodromy::{Monodromy, PeriodMap};
+use std::f64::consts::PI;
 
 /// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
 /// `8 n^2` bytes (200 MiB).
@@ -135,6 +145,13 @@ pub struct StabilityOptions {
     /// bound): beyond, the periodic orbit found is another motion, and the verdict is
     /// [`Verdict::Unresolved`].
     pub max_displacement_correction: f64,
+    /// The largest relative change of energy, `|E - E0| / E0`, by which the correction may
+    /// move the point's state (default `0.05`). The energy of a harmonic-balance point is
+    /// accurate where its state is not (the strain's Gibbs oscillation), so a periodic orbit
+    /// with another energy is another motion, even with nearly the same displacement: at a
+    /// fixed period, the correction can add energy in high harmonics. Beyond, the verdict is
+    /// [`Verdict::Unresolved`].
+    pub max_energy_correction: f64,
 }
 
 impl Default for StabilityOptions {
@@ -146,6 +163,7 @@ impl Default for StabilityOptions {
             spring: SpringUpdate::Midpoint,
             corrections: 8,
             max_displacement_correction: 0.05,
+            max_energy_correction: 0.05,
         }
     }
 }
@@ -167,15 +185,21 @@ impl StabilityOptions {
             ),
             (
                 "tolerance",
-                "non-negative",
+                "finite and non-negative",
                 self.tolerance,
                 self.tolerance >= 0.0,
             ),
             (
                 "max_displacement_correction",
-                "non-negative",
+                "finite and non-negative",
                 self.max_displacement_correction,
                 self.max_displacement_correction >= 0.0,
+            ),
+            (
+                "max_energy_correction",
+                "finite and non-negative",
+                self.max_energy_correction,
+                self.max_energy_correction >= 0.0,
             ),
         ];
         for (what, expected, value, ok) in checks {
@@ -190,11 +214,36 @@ impl StabilityOptions {
         Ok(())
     }
 
-    /// The grid: the commensurate step nearest to the shortest travel time over
-    /// `cells_per_travel`, or that step itself when none is commensurate.
-    fn grid(&self, model: &Model) -> Result<Grid, StabilityError> {
-        let dt = shortest_travel_time(model.bars()) / self.cells_per_travel;
-        Ok(Grid::nearest_or_new(model, dt)?)
+    /// The grid of a motion of period `period`, and the period rounded to a whole number of
+    /// its steps. The step is the commensurate one nearest to the shortest travel time over
+    /// `k` cells (that step itself when none is commensurate), for the `k` between
+    /// `cells_per_travel` and a quarter more that brings the period nearest a whole number
+    /// of steps: a period that ends between two steps ends with a fractional step, whose
+    /// projection onto the cells blurs the map (on the clamped bar, no period of
+    /// `785.5` steps gets a verdict where one of `786` does).
+    fn grid(&self, model: &Model, period: f64) -> Result<(Grid, f64), StabilityError> {
+        let travel = shortest_travel_time(model.bars());
+        let first = self.cells_per_travel.ceil() as usize;
+        let candidate = |k: usize| -> Result<(Grid, f64, f64), StabilityError> {
+            let grid = Grid::nearest_or_new(model, travel / k as f64)?;
+            let steps = (period / grid.dt()).round().max(1.0);
+            let miss = (period - steps * grid.dt()).abs();
+            Ok((grid, steps, miss))
+        };
+        let mut best = candidate(first)?;
+        check_dimension(&Coordinates::new(model, &best.0), self.cells_per_travel)?;
+        for k in first + 1..=(1.25 * first as f64).ceil() as usize {
+            if best.2 <= 1e-12 * period {
+                break;
+            }
+            let next = candidate(k)?;
+            if next.2 < best.2 {
+                best = next;
+            }
+        }
+        let (grid, steps, _) = best;
+        let period = steps * grid.dt();
+        Ok((grid, period))
     }
 }
 
@@ -214,13 +263,7 @@ pub fn floquet_of_state(
 ) -> Result<Floquet, StabilityError> {
     options.check()?;
     let coordinates = Coordinates::new(initial.model(), initial.grid());
-    if coordinates.len() > MAX_DIMENSION {
-        return Err(StabilityError::TooLarge {
-            dimension: coordinates.len(),
-            cells_per_travel: options.cells_per_travel,
-            limit: MAX_DIMENSION,
-        });
-    }
+    check_dimension(&coordinates, options.cells_per_travel)?;
     if !(period.is_finite() && period > 0.0) {
         return Err(VerifyError::InvalidParameter {
             what: "period",
@@ -252,12 +295,12 @@ pub fn floquet_of_state(
     let (corrected, at_corrected, at_base) = map.correct(
         &base,
         options.relative_step,
-        section.grid().dt(),
         options.corrections,
         PERIODIC_DEFECT,
     )?;
     let periodic = corrected.defect <= RESOLVED_DEFECT
-        && corrected.displacement_shift <= options.max_displacement_correction;
+        && corrected.displacement_shift <= options.max_displacement_correction
+        && corrected.energy_change.abs() <= options.max_energy_correction;
     // A point whose correction failed keeps the multipliers of its own state: those of a
     // partial correction depend on the path the iterations took.
     let spurious = coordinates.spurious_unit_multipliers();
@@ -291,9 +334,22 @@ pub fn floquet_of_state(
         options.tolerance,
         coordinates.len(),
         initial.grid().dt(),
+        period,
         &corrected,
         periodic,
     ))
+}
+
+/// [`StabilityError::TooLarge`] for more than [`MAX_DIMENSION`] coordinates.
+fn check_dimension(coordinates: &Coordinates, cells_per_travel: f64) -> Result<(), StabilityError> {
+    if coordinates.len() > MAX_DIMENSION {
+        return Err(StabilityError::TooLarge {
+            dimension: coordinates.len(),
+            cells_per_travel,
+            limit: MAX_DIMENSION,
+        });
+    }
+    Ok(())
 }
 
 /// The state of the motion from `initial` at the instant of one period where the smallest
@@ -371,9 +427,16 @@ pub fn floquet<B: Basis>(
     options: &StabilityOptions,
 ) -> Result<Floquet, StabilityError> {
     options.check()?;
-    let grid = options.grid(&Model::from_system(system)?)?;
+    if check_frequency(omega).is_err() {
+        return Err(VerifyError::InvalidParameter {
+            what: "fundamental frequency omega",
+            value: omega,
+        }
+        .into());
+    }
+    let (grid, period) = options.grid(&Model::from_system(system)?, 2.0 * PI / omega)?;
     let initial = State::from_harmonic_balance(system, basis, x, omega, 0.0, grid.dt())?;
-    floquet_of_state(&initial, 2.0 * std::f64::consts::PI / omega, options)
+    floquet_of_state(&initial, period, options)
 }
 
 /// Serializes a point's stability outcome: the [`Floquet`] report, or `{"error": message}`.

@@ -3,8 +3,14 @@
 use super::monodromy::{Monodromy, PeriodMap};
 use crate::error::StabilityError;
 use crate::solve::norm;
-use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;
+
+/// Singular values of the correction's matrix below this fraction of the largest are not
+/// inverted. Their directions are those `M - I` (nearly) annihilates besides the time shift:
+/// the family direction, and waves that free flight carries back onto themselves over the
+/// period (on a commensurate grid, every wave whose period divides it). Moving along them
+/// does not reduce the defect; it changes the motion.
+const SINGULAR_CUTOFF: f64 = 1e-4;
 
 /// A state corrected towards `P(X) = X`.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,12 +21,32 @@ pub(crate) struct Corrected {
     pub initial_defect: f64,
     /// `|P(x) - x| / |x|` after.
     pub defect: f64,
+    /// `(E(x) - E(x0)) / E(x0)`: how far the correction moved the energy.
+    pub energy_change: f64,
     /// `|x - x0| / |x0|`: how far the correction moved the state.
     pub shift: f64,
     /// `max |u - u0| / max |u0|` over the nodes: how far it moved the displacement.
     pub displacement_shift: f64,
     /// Chord iterations taken.
     pub iterations: usize,
+}
+
+/// The minimum-norm solution of `a d = b` over the singular values of `a` above
+/// [`SINGULAR_CUTOFF`] of the largest.
+fn truncated_solve(a: &Mat<f64>, b: &[f64]) -> Result<Vec<f64>, StabilityError> {
+    let svd = a.thin_svd().map_err(|_| StabilityError::NoEigenvalues {
+        dimension: a.nrows(),
+    })?;
+    let (u, s, v) = (svd.U(), svd.S(), svd.V());
+    let largest = (0..s.dim()).map(|k| s[k]).fold(0.0, f64::max);
+    let mut d = vec![0.0; a.ncols()];
+    for k in (0..s.dim()).filter(|&k| s[k] > SINGULAR_CUTOFF * largest) {
+        let c = (0..a.nrows()).map(|i| u[(i, k)] * b[i]).sum::<f64>() / s[k];
+        for (j, dj) in d.iter_mut().enumerate() {
+            *dj += c * v[(j, k)];
+        }
+    }
+    Ok(d)
 }
 
 /// `|P(x) - x|` and the residual `P(x) - x` itself.
@@ -33,30 +59,33 @@ fn residual(map: &PeriodMap, x: &[f64], out: &mut Vec<f64>) -> Result<f64, Stabi
 }
 
 impl PeriodMap<'_> {
-    /// Newton iterations `x <- x + a d`, `[M - I; w^T] d = [x - P(x); 0]` in the
-    /// least-squares sense, with the monodromy `M` at the current state and `w` the direction
-    /// of the motion (`X(dt) - X(0)`, which removes the time shift, the kernel of `M - I`).
-    /// The map is linear while the order of the contact events holds, so an iteration lands
-    /// on the fixed point once the events are in the right order. The step `a` halves until
-    /// the defect decreases (three times at most); the iterations stop below `tolerance`,
-    /// after `max_iterations`, or when no step decreases the defect. Returns the best state
-    /// with the monodromy there (`None` when no iteration moved it), and the monodromy at
-    /// `base`.
+    /// Newton iterations `x <- x + a d`, `(M - I) d = x - P(x)`, with the monodromy `M` at
+    /// the current state. `d` is the minimum-norm solution over the singular values above
+    /// [`SINGULAR_CUTOFF`]: the correction moves the state as little as it can, and not
+    /// along the directions `M - I` leaves (nearly) singular. The time shift is one of them
+    /// (`M X' = X'`), so the step is orthogonal to it without a phase condition; a bordered
+    /// phase row, tried, reached orbits of the right energy less often. The map is linear
+    /// while the order of the contact events holds, so an iteration lands on the fixed point
+    /// once the events are in the right order. The step `a` halves until the defect
+    /// decreases (three times at most); the iterations stop below `tolerance`, after
+    /// `max_iterations`, or when no step decreases the defect. Returns the best state with
+    /// the monodromy there (`None` when no iteration moved it), and the monodromy at `base`.
     pub(crate) fn correct(
         &self,
         base: &[f64],
         relative_step: f64,
-        dt: f64,
         max_iterations: usize,
         tolerance: f64,
     ) -> Result<(Corrected, Option<Monodromy>, Monodromy), StabilityError> {
         let x0_norm = norm(base);
+        let energy = self.coordinates.energy(self.template, base)?;
         let mut r = Vec::new();
         let initial_defect = residual(self, base, &mut r)? / x0_norm;
         let mut best = Corrected {
             x: base.to_vec(),
             initial_defect,
             defect: initial_defect,
+            energy_change: 0.0,
             shift: 0.0,
             displacement_shift: 0.0,
             iterations: 0,
@@ -64,7 +93,6 @@ impl PeriodMap<'_> {
         let at_base = self.monodromy(base, relative_step)?;
         let mut latest: Option<Monodromy> = None;
         let mut trial_r = Vec::new();
-        let mut direction = Vec::new();
         for iteration in 1..=max_iterations {
             if best.defect <= tolerance {
                 break;
@@ -72,20 +100,14 @@ impl PeriodMap<'_> {
             let x = &best.x;
             let monodromy = latest.as_ref().unwrap_or(&at_base);
             let n = monodromy.nrows();
-            self.flow(x, dt, &mut direction)?;
-            let bordered = Mat::<f64>::from_fn(n + 1, n, |i, j| {
-                if i < n {
-                    monodromy[(i, j)] - if i == j { 1.0 } else { 0.0 }
-                } else {
-                    direction[j] - x[j]
-                }
-            });
-            let rhs = Mat::<f64>::from_fn(n + 1, 1, |i, _| if i < n { -r[i] } else { 0.0 });
-            let d = bordered.qr().solve_lstsq(&rhs);
+            let step_matrix =
+                Mat::<f64>::from_fn(n, n, |i, j| monodromy[(i, j)] - f64::from(u8::from(i == j)));
+            let rhs: Vec<f64> = r.iter().map(|v| -v).collect();
+            let d = truncated_solve(&step_matrix, &rhs)?;
             let mut accepted = None;
             let mut a = 1.0;
             for _ in 0..4 {
-                let trial: Vec<f64> = (0..n).map(|i| x[i] + a * d[(i, 0)]).collect();
+                let trial: Vec<f64> = (0..n).map(|i| x[i] + a * d[i]).collect();
                 if trial.iter().all(|v| v.is_finite()) {
                     let defect = residual(self, &trial, &mut trial_r)? / norm(&trial);
                     if defect < best.defect {
@@ -104,6 +126,7 @@ impl PeriodMap<'_> {
             best = Corrected {
                 shift: norm(&change) / x0_norm,
                 displacement_shift: self.coordinates.displacement_distance(&x, base),
+                energy_change: (self.coordinates.energy(self.template, &x)? - energy) / energy,
                 x,
                 initial_defect,
                 defect,
