@@ -170,7 +170,6 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
         start.push(omega);
         // The segment's first point is its start, a solution already judged.
         judge.forget_reference();
-        let mut accept = judge.clone();
         let mut driver = Sequential::new(
             EnergyLevel::new(problem.clone(), e_g)?,
             &solver,
@@ -178,9 +177,9 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
             values,
             seq_options,
         )?
-        .with_acceptance(move |y, _| {
+        .with_acceptance(|y, _| {
             let (x, omega) = split_frequency(y);
-            accept.accepts(x, omega)
+            judge.accepts(x, omega)
         });
         let mut segment = Segment::default();
         let branch = driver.run(&mut |step: &Step| {
@@ -199,6 +198,8 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
             }
             segment.flow()
         });
+        // The driver's acceptance test borrows the judge: give it back before the walk.
+        drop(driver);
         offset += segment.points;
         let (true, false, Some(last)) = (segment.escaping, segment.stopped, segment.last_accepted)
         else {

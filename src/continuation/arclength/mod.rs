@@ -45,7 +45,7 @@ use bordered::{BorderScratch, Bordered, Metric};
 use branching::Bracket;
 
 /// Pseudo-arclength continuation driver, generic over the problem and the corrector.
-pub struct Arclength<P, S> {
+pub struct Arclength<'a, P, S> {
     problem: P,
     solver: S,
     options: ArclengthOptions,
@@ -63,7 +63,7 @@ pub struct Arclength<P, S> {
     done: bool,
     /// Rejected steps so far.
     rejections: usize,
-    accept: Option<Acceptance>,
+    accept: Option<Acceptance<'a>>,
     border: BorderScratch,
     /// The sign of `det [J, F_lambda; t^T W]` at the current point (`None` when not watched
     /// or exactly singular).
@@ -72,7 +72,7 @@ pub struct Arclength<P, S> {
     bracket: Option<Bracket>,
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
+impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
     /// Starts from a solution `x0` at `lambda0` (it is corrected at fixed `lambda0` first;
     /// the first [`Arclength::step`] returns that corrected start as step 0).
     ///
@@ -153,8 +153,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     }
 
     /// Adds a test every accepted point must pass (for instance "not the state of rest"); a
-    /// failing corrected point is rejected like a solver failure.
-    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'static) -> Self {
+    /// failing corrected point is rejected like a solver failure. The test may borrow from
+    /// the caller (the system it measures energies with) for the driver's lifetime `'a`.
+    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'a) -> Self {
         self.accept = Some(Box::new(accept));
         self
     }
@@ -522,7 +523,7 @@ fn check_start(
     Ok(())
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<P, S> {
+impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<'_, P, S> {
     type Item = Result<Point, ContinuationError>;
 
     /// The accepted points (rejections are retried internally); then, if the run failed
