@@ -1,6 +1,7 @@
 //! Pseudo-arclength continuation with step-size control and event detection.
 //!
-//! The branch is followed in `y = (x, lambda)` with the scaled inner product
+//! The branch is followed in `y = (x, lambda)` (the [`augmented`] layout, parameter last)
+//! with the scaled inner product
 //! `<a, b>_W = sum_i a_i b_i / s_x^2 + a_lambda b_lambda / s_lambda^2`, so that a step `ds`
 //! measures the relative change of the whole state (end values are of the order of the gap
 //! `g0` while `Omega` is of order 1). From an accepted point `y_k` with unit tangent `t_k`:
@@ -34,6 +35,7 @@ mod options;
 
 pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
 
+use super::augmented;
 use super::driver::{next_point, run_with, Acceptance};
 use super::{
     Branch, ContinuationProblem, EndReason, Event, Observer, Point, RejectReason, Rejection, Step,
@@ -118,8 +120,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
                 lambda_w: 1.0 / (b * b),
             },
         };
-        let mut y = x;
-        y.push(lambda0);
+        let y = augmented::join(x, lambda0);
         let mut seed = vec![0.0; n + 1];
         seed[n] = options.direction;
         let mut driver = Self {
@@ -188,8 +189,8 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         &self.options
     }
 
-    /// The current point `y = (x, lambda)`: the last accepted point (the corrected start
-    /// before any step). Rejected steps never change it.
+    /// The current point `y = (x, lambda)` ([`augmented`] layout): the last accepted point
+    /// (the corrected start before any step). Rejected steps never change it.
     pub fn state(&self) -> &[f64] {
         &self.y
     }
@@ -247,11 +248,11 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
     pub fn restart_from(&mut self, x: Vec<f64>, lambda: f64) -> Result<Point, ContinuationError> {
         let n = self.problem.dimension();
         check_start(&x, n, lambda, "restart parameter")?;
-        let mut y = x;
+        let mut x = x;
         let info = self
-            .solve_at(&mut y, lambda)
+            .solve_at(&mut x, lambda)
             .map_err(ContinuationError::Start)?;
-        y.push(lambda);
+        let y = augmented::join(x, lambda);
         let mut seed = vec![0.0; n + 1];
         seed[n] = self.options.direction;
         let tangent = self
@@ -285,9 +286,8 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
 
     /// The active sets of the problem at the current point.
     fn active_set(&mut self) -> Option<Vec<usize>> {
-        let n = self.problem.dimension();
-        self.problem.set_parameter(self.y[n]);
-        let x = &self.y[..n];
+        let (x, lambda) = augmented::split(&self.y)?;
+        self.problem.set_parameter(lambda);
         self.problem.structure().and_then(|s| s.active_set(x))
     }
 
