@@ -775,7 +775,7 @@ fn solver_options_validate_and_read_back() {
     }
 }
 
-type Driver = Sequential<NonsmoothSystem, SemismoothNewton>;
+type Driver = Sequential<'static, NonsmoothSystem, SemismoothNewton>;
 
 #[test]
 fn bad_continuation_ranges() {

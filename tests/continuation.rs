@@ -411,7 +411,7 @@ const PAPER_GRID: PeriodGrid = PeriodGrid {
 
 /// The points of `driver` stepped with [`Speculative::step`] to the end, and its stats.
 fn speculative_points<P, S>(
-    driver: Sequential<P, S>,
+    driver: Sequential<'_, P, S>,
     speculation: nonsmooth_modes::continuation::Speculation,
 ) -> (Vec<Point>, nonsmooth_modes::continuation::SpeculationStats)
 where
@@ -504,7 +504,7 @@ fn reported(mut step: impl FnMut() -> Step) -> Vec<Point> {
 
 /// [`reported`] of a driver run with `step`.
 fn run_points<P: ContinuationProblem, S: nonsmooth_modes::solve::NonlinearSolver>(
-    mut driver: Sequential<P, S>,
+    mut driver: Sequential<'_, P, S>,
 ) -> Vec<Point> {
     reported(|| driver.step())
 }

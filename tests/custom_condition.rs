@@ -361,7 +361,6 @@ fn compliant_backbone(
     let basis = problem.basis().clone();
     let seed = branch_seed(&mut problem, 1, 1, 2.0 * PI / periods[0]).unwrap();
     let start: Vec<f64> = seed.iter().map(|s| seed_scale * s).collect();
-    let (accept_system, accept_basis) = (system.clone(), basis.clone());
     let driver = Sequential::new(
         PeriodParametrised::new(problem),
         SemismoothNewton::default(),
@@ -370,9 +369,7 @@ fn compliant_backbone(
         SequentialOptions::default(),
     )
     .unwrap()
-    .with_acceptance(move |x, t| {
-        energy(&accept_system, &accept_basis, x, 2.0 * PI / t) > 1e-6 * e_g
-    });
+    .with_acceptance(|x, t| energy(&system, &basis, x, 2.0 * PI / t) > 1e-6 * e_g);
     // Converged points and the last iterates of failed steps alike.
     let mut driver = driver;
     std::iter::from_fn(|| match driver.step() {

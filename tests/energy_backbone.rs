@@ -4,11 +4,11 @@
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
-    compute, compute_observed, split_frequency, ArclengthBackboneOptions, AutoChoice,
-    BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid, EnergyLevel, Method,
-    ModeBranches, PeriodGrid, PointStatus, Request, FLOATING_RETRY_DEPTH,
+    compute, compute_observed, ArclengthBackboneOptions, AutoChoice, BackboneOptions,
+    BackbonePoint, EnergyBackboneOptions, EnergyGrid, EnergyLevel, Method, ModeBranches,
+    PeriodGrid, PointStatus, Request, FLOATING_RETRY_DEPTH,
 };
-use nonsmooth_modes::continuation::{geomspace, ContinuationProblem};
+use nonsmooth_modes::continuation::{augmented, geomspace, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
@@ -72,10 +72,10 @@ fn level_problem_and_point(system: &BarSystem, level: f64) -> (EnergyLevel, Vec<
     let (e_g, _) = grazing_energy(system).unwrap();
     let omega = 1.02 * 2.0 * PI / 4.0;
     let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
-    let mut y: Vec<f64> = (seed.iter().enumerate())
+    let x: Vec<f64> = (seed.iter().enumerate())
         .map(|(i, s)| 1.4 * s + 1e-5 * (((7 * i) % 11) as f64 - 5.0))
         .collect();
-    y.push(omega);
+    let y = augmented::join(x, omega);
     let mut level_problem = EnergyLevel::new(problem, e_g).unwrap();
     level_problem.set_parameter(level);
     (level_problem, y)
@@ -184,12 +184,12 @@ fn energy_levels_must_be_positive() {
     assert!(EnergyLevel::new(problem, f64::NAN).is_err());
 }
 
-/// `split_frequency` is the layout of an energy-level problem's unknowns.
+/// `augmented::split` reads the layout of an energy-level problem's unknowns.
 #[test]
 fn energy_level_unknowns_end_with_the_frequency() {
     let system = clamped_bar_with_obstacle(GAP).unwrap();
     let (problem, y) = level_problem_and_point(&system, 1.0);
-    let (x, omega) = split_frequency(&y);
+    let (x, omega) = augmented::split(&y).unwrap();
     assert_eq!(x.len() + 1, problem.dimension());
     assert_eq!(omega, y[y.len() - 1]);
     let e = energy(&system, problem.inner().basis(), x, omega);

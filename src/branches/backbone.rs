@@ -19,7 +19,6 @@ use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
-use std::rc::Rc;
 
 /// `steps` equispaced periods from `start` to `end` (both included).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -126,7 +125,7 @@ pub(crate) fn backbone_with<S: NonlinearSolver>(
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
-    let run = |mut driver: Sequential<_, S>, see: &mut dyn Observer| driver.run(see);
+    let run = |mut driver: Sequential<'_, _, S>, see: &mut dyn Observer| driver.run(see);
     drive_backbone(system, settings, (options, None), solver, run, observer)
 }
 
@@ -146,7 +145,7 @@ pub(crate) fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'sta
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
-    let run = |driver: Sequential<_, S>, see: &mut dyn Observer| {
+    let run = |driver: Sequential<'_, _, S>, see: &mut dyn Observer| {
         Speculative::new(driver, speculation).run(see)
     };
     drive_backbone(system, settings, (options, None), solver, run, observer)
@@ -171,7 +170,7 @@ pub(crate) fn backbone_from<S: NonlinearSolver + Clone + Send + 'static>(
     solver: S,
     observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
-    let run = |mut driver: Sequential<_, S>, see: &mut dyn Observer| match speculation {
+    let run = |mut driver: Sequential<'_, _, S>, see: &mut dyn Observer| match speculation {
         Some(speculation) => Speculative::new(driver, speculation).run(see),
         None => driver.run(see),
     };
@@ -192,7 +191,10 @@ fn drive_backbone<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     (options, start): (&BackboneOptions, Option<BackboneStart>),
     solver: S,
-    run: impl FnOnce(Sequential<PeriodParametrised<NonsmoothSystem>, S>, &mut dyn Observer) -> Branch,
+    run: impl FnOnce(
+        Sequential<'_, PeriodParametrised<NonsmoothSystem>, S>,
+        &mut dyn Observer,
+    ) -> Branch,
     mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
@@ -234,13 +236,9 @@ fn drive_backbone<S: NonlinearSolver>(
     };
     let seq_options = options.sequential();
     // The acceptance test computes each converged point's energy; the observer reuses it.
-    let last_energy = Rc::new(RefCell::new((Vec::new(), f64::NAN, f64::NAN)));
-    let accepted_energy = Rc::clone(&last_energy);
-    let accept_system = system.clone();
-    let accept_basis = basis.clone();
     // The measure of `Selection::LowestMeasure` is called right after the acceptance test
     // took the same point: it reuses the energy the test computed.
-    let measured_energy = Rc::clone(&last_energy);
+    let last_energy = RefCell::new((Vec::new(), f64::NAN, f64::NAN));
     let driver = Sequential::new(
         PeriodParametrised::new(problem),
         solver,
@@ -248,16 +246,16 @@ fn drive_backbone<S: NonlinearSolver>(
         values,
         seq_options,
     )?
-    .with_acceptance(move |x, period| {
-        let e = energy(&accept_system, &accept_basis, x, 2.0 * PI / period);
-        let mut last = accepted_energy.borrow_mut();
+    .with_acceptance(|x, period| {
+        let e = energy(system, &basis, x, 2.0 * PI / period);
+        let mut last = last_energy.borrow_mut();
         last.0.clear();
         last.0.extend_from_slice(x);
         (last.1, last.2) = (period, e);
         e > floor
     })
-    .with_measure(move |x, period| {
-        let last = measured_energy.borrow();
+    .with_measure(|x, period| {
+        let last = last_energy.borrow();
         if last.1 == period && last.0 == x {
             last.2
         } else {
@@ -442,9 +440,8 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         arclength,
         (options.escape, floor),
     );
-    let (accept_system, accept_basis) = (system.clone(), basis.clone());
     let driver = Arclength::new(problem, solver, start, omega0, arclength)?
-        .with_acceptance(move |x, omega| energy(&accept_system, &accept_basis, x, omega) > floor);
+        .with_acceptance(|x, omega| energy(system, &basis, x, omega) > floor);
     let offset = walked.len();
     let backbone_point = |p: &Point, offset: usize| {
         let e = energy(system, &basis, &p.x, p.parameter);

@@ -89,8 +89,8 @@ impl StallEscape {
 /// distance jumped over the driver's step size, and `iterations` those of the fixed-parameter
 /// solve plus the correction. The driver's starting point (step 0) does not count towards the
 /// window.
-pub struct EscapingArclength<P, S> {
-    driver: Arclength<P, S>,
+pub struct EscapingArclength<'a, P, S> {
+    driver: Arclength<'a, P, S>,
     escape: StallEscape,
     /// Recent accepted points `(lambda, x)`, at most `2 window` of them.
     history: VecDeque<(f64, Vec<f64>)>,
@@ -101,12 +101,15 @@ pub struct EscapingArclength<P, S> {
     done: bool,
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
+impl<'a, P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<'a, P, S> {
     /// Runs `driver` (its options, acceptance test and progress so far) with `escape`.
     ///
     /// # Errors
     /// Invalid `escape` options ([`StallEscape::validate`]).
-    pub fn new(driver: Arclength<P, S>, escape: StallEscape) -> Result<Self, ContinuationError> {
+    pub fn new(
+        driver: Arclength<'a, P, S>,
+        escape: StallEscape,
+    ) -> Result<Self, ContinuationError> {
         escape.validate()?;
         Ok(Self {
             driver,
@@ -119,12 +122,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
     }
 
     /// The driver.
-    pub fn driver(&self) -> &Arclength<P, S> {
+    pub fn driver(&self) -> &Arclength<'a, P, S> {
         &self.driver
     }
 
     /// The driver, giving up the escape.
-    pub fn into_driver(self) -> Arclength<P, S> {
+    pub fn into_driver(self) -> Arclength<'a, P, S> {
         self.driver
     }
 
@@ -288,7 +291,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> EscapingArclength<P, S> {
     }
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for EscapingArclength<P, S> {
+impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for EscapingArclength<'_, P, S> {
     type Item = Result<Point, ContinuationError>;
 
     /// The accepted points, jumps included; then, if the run failed
@@ -337,12 +340,12 @@ mod tests {
         }
     }
 
-    fn driver(max_steps: usize) -> Arclength<Hyperbola, SemismoothNewton> {
+    fn driver(max_steps: usize) -> Arclength<'static, Hyperbola, SemismoothNewton> {
         driver_to(1.5, max_steps)
     }
 
     /// The driver on the hyperbola inside `[-1, hi]`.
-    fn driver_to(hi: f64, max_steps: usize) -> Arclength<Hyperbola, SemismoothNewton> {
+    fn driver_to(hi: f64, max_steps: usize) -> Arclength<'static, Hyperbola, SemismoothNewton> {
         let options = ArclengthOptions {
             parameter_range: (-1.0, hi),
             scale: ArclengthScale::Fixed(1.0, 1.0),

@@ -1,7 +1,8 @@
 //! Nonsmooth modes at a prescribed energy: the harmonic-balance system with the frequency as
 //! an unknown and the energy as the parameter.
 //!
-//! The unknowns are `y = (x, Omega)` and the equations
+//! The unknowns are `y = (x, Omega)`, the frequency last as the parameter of every bordered
+//! system ([`augmented`]), and the equations
 //!
 //! ```text
 //! F(x; Omega) = 0                         harmonic balance (NonsmoothSystem)
@@ -17,7 +18,7 @@
 //! `s (dE/dx, dE/dOmega) / (lambda E_g)`; its structured solve is the bordering algorithm on
 //! `F`'s condensed solve.
 
-use crate::continuation::{fill_bordered, solve_bordered, ContinuationProblem};
+use crate::continuation::{augmented, fill_bordered, solve_bordered, ContinuationProblem};
 use crate::error::{ContinuationError, Error};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::DenseMatrix;
@@ -25,19 +26,10 @@ use crate::modal::energy::{energy, energy_frequency_derivative, energy_gradient}
 use crate::solve::{Problem, SingularStep, Structured};
 use crate::system::NonsmoothSystem;
 
-/// The unknowns `x` and the frequency `Omega` of the unknowns `y = (x, Omega)` of an
-/// [`EnergyLevel`].
-///
-/// # Panics
-/// If `y` is empty.
-pub fn split_frequency(y: &[f64]) -> (&[f64], f64) {
-    let (omega, x) = y.split_last().expect("y holds at least the frequency");
-    (x, *omega)
-}
-
 /// A [`NonsmoothSystem`] at a prescribed energy level `lambda = E / E_g`: a
 /// [`ContinuationProblem`] in `lambda` whose unknowns are `y = (x, Omega)` (the system's
-/// unknowns, then the fundamental frequency).
+/// unknowns, then the fundamental frequency: [`augmented::split`] and [`augmented::join`]
+/// read and write them).
 #[derive(Debug, Clone)]
 pub struct EnergyLevel<B: Basis = CosineBasis> {
     inner: NonsmoothSystem<B>,
@@ -96,9 +88,10 @@ impl<B: Basis> EnergyLevel<B> {
         self.level * self.grazing_energy
     }
 
-    /// Moves the inner system to the frequency of `y` and returns `(x, Omega)`.
+    /// Moves the inner system to the frequency of `y` and returns `(x, Omega)` (an empty `y`
+    /// is no unknowns at a NaN frequency: a non-finite residual).
     fn at<'y>(&mut self, y: &'y [f64]) -> (&'y [f64], f64) {
-        let (x, omega) = split_frequency(y);
+        let (x, omega) = augmented::split_or_nan(y);
         self.inner.set_parameter(omega);
         (x, omega)
     }

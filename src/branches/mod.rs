@@ -31,7 +31,7 @@ pub use energy_backbone::{
     SLOPE_COLLAPSE, SLOPE_MEMORY,
 };
 pub use escape::{EscapingArclength, StallEscape};
-pub use level::{split_frequency, EnergyLevel};
+pub use level::EnergyLevel;
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
 pub use request::{AutoChoice, Method, Request, TimeDomainCheck};

@@ -393,9 +393,9 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
         max_rejections: options.max_rejections.min(defaults.max_rejections),
         ..options
     };
-    let (system, basis) = (problem.system().clone(), problem.basis().clone());
+    let (system, basis) = (problem.system(), problem.basis());
     let driver = match Arclength::new(problem.clone(), solver, x.to_vec(), from, walk) {
-        Ok(driver) => driver.with_acceptance(move |y, at| energy(&system, &basis, y, at) > floor),
+        Ok(driver) => driver.with_acceptance(|y, at| energy(system, basis, y, at) > floor),
         Err(_) => return (Vec::new(), 0),
     };
     let mut go_on = |_: &Step| ControlFlow::Continue(());

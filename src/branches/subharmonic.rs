@@ -209,8 +209,6 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
     let omega = 2.0 * PI / values[0];
     problem.set_parameter(omega);
     let basis = problem.basis().clone();
-    let accept_system = system.clone();
-    let accept_basis = basis.clone();
     let mut driver = Sequential::new(
         PeriodParametrised::new(problem),
         &solver,
@@ -218,11 +216,10 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
         values,
         options.sequential(),
     )?
-    .with_acceptance(move |x, period| {
+    .with_acceptance(|x, period| {
         let omega = 2.0 * PI / period;
-        energy(&accept_system, &accept_basis, x, omega) > floor
-            && subharmonic_share(&accept_system, &accept_basis, x, omega, k)
-                .is_ok_and(|s| s >= GENUINE_SHARE)
+        energy(system, &basis, x, omega) > floor
+            && subharmonic_share(system, &basis, x, omega, k).is_ok_and(|s| s >= GENUINE_SHARE)
     });
     let branch = driver.run(&mut |step: &Step| {
         let Some(p) = step.point() else {

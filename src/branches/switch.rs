@@ -20,12 +20,12 @@ pub struct SwitchAt {
 }
 
 /// The arclength driver of a backbone, with or without the stall escape.
-pub(crate) enum Runner<P, S> {
-    Plain(Arclength<P, S>),
-    Escaping(EscapingArclength<P, S>),
+pub(crate) enum Runner<'a, P, S> {
+    Plain(Arclength<'a, P, S>),
+    Escaping(EscapingArclength<'a, P, S>),
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Runner<P, S> {
+impl<P: ContinuationProblem, S: NonlinearSolver> Runner<'_, P, S> {
     fn run(&mut self, observer: &mut (impl Observer + ?Sized)) -> Branch {
         match self {
             Self::Plain(d) => d.run(observer),

@@ -189,8 +189,9 @@ impl<F: FnMut(&Step) -> ControlFlow<()>> Observer for F {
     }
 }
 
-/// A test that a converged solution `(x, lambda)` belongs to the branch.
-pub(super) type Acceptance = Box<dyn FnMut(&[f64], f64) -> bool>;
+/// A test that a converged solution `(x, lambda)` belongs to the branch. It lives as long as
+/// the driver's lifetime `'a`, so it may borrow what the caller owns (the system, a judge).
+pub(super) type Acceptance<'a> = Box<dyn FnMut(&[f64], f64) -> bool + 'a>;
 
 /// Steps `driver` with `step` until the run ends or `observer` stops it, collecting the
 /// branch. `stop` records an observer's stop in the driver, so that later steps report it.

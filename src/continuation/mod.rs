@@ -13,9 +13,14 @@
 //! reason is always set, and the [`Observer`] (any closure `FnMut(&Step) -> ControlFlow<()>`)
 //! sees every step, accepted or rejected, and may stop the run.
 //!
+//! Bordered systems (the pseudo-arclength corrector, an
+//! [`EnergyLevel`](crate::branches::EnergyLevel)) store their unknowns as `y = (x, parameter)`,
+//! the parameter last: [`augmented`] reads and writes that layout.
+//!
 //! [`ContinuationError`]: crate::ContinuationError
 
 mod arclength;
+pub mod augmented;
 mod bordering;
 mod driver;
 mod progress;

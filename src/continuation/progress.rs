@@ -18,24 +18,24 @@ pub fn quiet<T: ?Sized>(_: &T) -> ControlFlow<()> {
 ///
 /// let mut progress = Progress::new(10, Vec::new()).with_measure("|x|", |p| p.x[0].abs());
 /// ```
-pub struct Progress<W: Write> {
+pub struct Progress<'a, W: Write> {
     every: usize,
     writer: W,
-    measure: Option<(&'static str, Measure)>,
+    measure: Option<(&'static str, Measure<'a>)>,
     accepted: usize,
 }
 
-/// A column computed from each point.
-type Measure = Box<dyn FnMut(&Point) -> f64>;
+/// A column computed from each point (it may borrow from the caller for the lifetime `'a`).
+type Measure<'a> = Box<dyn FnMut(&Point) -> f64 + 'a>;
 
-impl Progress<std::io::Stderr> {
+impl Progress<'_, std::io::Stderr> {
     /// Every `every` accepted points, to standard error.
     pub fn stderr(every: usize) -> Self {
         Self::new(every, std::io::stderr())
     }
 }
 
-impl<W: Write> Progress<W> {
+impl<'a, W: Write> Progress<'a, W> {
     /// Every `every` accepted points (at least 1), to `writer`.
     pub fn new(every: usize, writer: W) -> Self {
         Self {
@@ -46,11 +46,12 @@ impl<W: Write> Progress<W> {
         }
     }
 
-    /// Adds a column computed from each point (an energy, an amplitude...).
+    /// Adds a column computed from each point (an energy, an amplitude...); it may borrow
+    /// from the caller (the system it measures energies with) for the lifetime `'a`.
     pub fn with_measure(
         mut self,
         name: &'static str,
-        measure: impl FnMut(&Point) -> f64 + 'static,
+        measure: impl FnMut(&Point) -> f64 + 'a,
     ) -> Self {
         self.measure = Some((name, Box::new(measure)));
         self
@@ -84,7 +85,7 @@ impl<W: Write> Progress<W> {
     }
 }
 
-impl<W: Write> Observer for Progress<W> {
+impl<W: Write> Observer for Progress<'_, W> {
     fn observe(&mut self, step: &Step) -> ControlFlow<()> {
         match step {
             Step::Accepted(p) => self.point(p),

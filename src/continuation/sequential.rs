@@ -84,7 +84,7 @@ impl Default for SequentialOptions {
 /// [`Selection::LowestMeasure`] and a measure, from all of them, keeping the lowest measure).
 /// Failed steps are reported ([`Step::Rejected`], with the solver's last iterate as a point)
 /// and skipped; the next step starts again from the last converged solution.
-pub struct Sequential<P, S> {
+pub struct Sequential<'a, P, S> {
     pub(super) problem: P,
     pub(super) solver: S,
     values: Vec<f64>,
@@ -99,8 +99,8 @@ pub struct Sequential<P, S> {
     finished: Option<EndReason>,
     /// Whether the iterator has handed out the end.
     done: bool,
-    pub(super) accept: Option<Acceptance>,
-    measure: Option<Measure>,
+    pub(super) accept: Option<Acceptance<'a>>,
+    measure: Option<Measure<'a>>,
 }
 
 /// One solve of a step: where it ended, how, and from which start.
@@ -121,12 +121,12 @@ impl Attempt {
 }
 
 /// A scalar ranking accepted solutions `(x, lambda)` for [`Selection::LowestMeasure`].
-type Measure = Box<dyn FnMut(&[f64], f64) -> f64>;
+type Measure<'a> = Box<dyn FnMut(&[f64], f64) -> f64 + 'a>;
 
 /// Whether a solve's outcome joins the branch: it converged and the acceptance test (if any)
 /// takes the solution.
 pub(super) fn accepts(
-    accept: &mut Option<Acceptance>,
+    accept: &mut Option<Acceptance<'_>>,
     result: &Result<SolveInfo, SolveError>,
     x: &[f64],
     lambda: f64,
@@ -138,7 +138,7 @@ pub(super) fn accepts(
     }
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
+impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     /// A driver visiting `values` in order from the guess `start`.
     ///
     /// # Errors
@@ -197,8 +197,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
 
     /// Adds a test a converged solution must pass to join the branch (for instance "not the
     /// state of rest"). A rejected point is reported with `converged = false` and no error,
-    /// and counts as a failure.
-    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'static) -> Self {
+    /// and counts as a failure. The test may borrow from the caller (the system it measures
+    /// energies with): it lives as long as the driver's lifetime `'a`.
+    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'a) -> Self {
         self.accept = Some(Box::new(accept));
         self
     }
@@ -206,8 +207,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     /// Sets the measure [`Selection::LowestMeasure`] minimises over a step's accepted
     /// solutions (for a backbone, the energy). It is called once per accepted solution, right
     /// after the acceptance test took it (so it may reuse what the test computed), and only
-    /// with [`Selection::LowestMeasure`]. A NaN measure ranks last.
-    pub fn with_measure(mut self, measure: impl FnMut(&[f64], f64) -> f64 + 'static) -> Self {
+    /// with [`Selection::LowestMeasure`]. A NaN measure ranks last. Like the acceptance test,
+    /// it may borrow from the caller for the driver's lifetime `'a`.
+    pub fn with_measure(mut self, measure: impl FnMut(&[f64], f64) -> f64 + 'a) -> Self {
         self.measure = Some(Box::new(measure));
         self
     }
@@ -475,7 +477,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Sequential<P, S> {
     }
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<P, S> {
+impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<'_, P, S> {
     type Item = Result<Point, ContinuationError>;
 
     /// The converged points; then, if the run stalled, its error; then `None`.

@@ -183,8 +183,14 @@ impl std::fmt::Debug for Worker {
 ///
 /// It has the drivers' shape: [`Speculative::step`], [`Speculative::run`] and an iterator of
 /// `Result<Point, ContinuationError>`.
-pub struct Speculative<P, S> {
-    driver: Sequential<P, S>,
+///
+/// The problem and the solver must be `Clone + Send + 'static`: the worker thread is spawned
+/// with clones of them ([`std::thread::spawn`] takes only `'static` data) and outlives any
+/// one step. The acceptance test and the measure stay on the caller's thread (the driver
+/// judges the worker's solutions itself), so they may borrow for the driver's lifetime `'a`
+/// like those of [`Sequential`].
+pub struct Speculative<'a, P, S> {
+    driver: Sequential<'a, P, S>,
     speculation: Speculation,
     /// The thread of speculative retries (started on first use).
     worker: Option<Worker>,
@@ -193,9 +199,9 @@ pub struct Speculative<P, S> {
     done: bool,
 }
 
-impl<P, S> Speculative<P, S> {
+impl<'a, P, S> Speculative<'a, P, S> {
     /// `driver` with speculative retries as `speculation` says.
-    pub fn new(driver: Sequential<P, S>, speculation: Speculation) -> Self {
+    pub fn new(driver: Sequential<'a, P, S>, speculation: Speculation) -> Self {
         Self {
             driver,
             speculation,
@@ -211,12 +217,12 @@ impl<P, S> Speculative<P, S> {
     }
 
     /// The serial driver underneath (its problem, its last converged point).
-    pub fn driver_mut(&mut self) -> &mut Sequential<P, S> {
+    pub fn driver_mut(&mut self) -> &mut Sequential<'a, P, S> {
         &mut self.driver
     }
 }
 
-impl<P, S> Speculative<P, S>
+impl<P, S> Speculative<'_, P, S>
 where
     P: ContinuationProblem + Clone + Send + 'static,
     S: NonlinearSolver + Clone + Send + 'static,
@@ -324,7 +330,7 @@ where
     }
 }
 
-impl<P, S> Iterator for Speculative<P, S>
+impl<P, S> Iterator for Speculative<'_, P, S>
 where
     P: ContinuationProblem + Clone + Send + 'static,
     S: NonlinearSolver + Clone + Send + 'static,

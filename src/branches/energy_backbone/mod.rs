@@ -6,9 +6,11 @@ pub(crate) mod judge;
 use judge::{Judge, Walk};
 pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY};
 
-use crate::branches::level::{split_frequency, EnergyLevel};
+use crate::branches::level::EnergyLevel;
 use crate::branches::point::{BackbonePoint, PointStatus};
-use crate::continuation::{geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step};
+use crate::continuation::{
+    augmented, geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step,
+};
 use crate::error::Error;
 use crate::modal::drift::check_held;
 use crate::modal::energy::energy;
@@ -166,11 +168,9 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
         let values: Vec<f64> = std::iter::once(level)
             .chain(levels.iter().copied().filter(|&l| l > level))
             .collect();
-        let mut start = x.clone();
-        start.push(omega);
+        let start = augmented::join(x.clone(), omega);
         // The segment's first point is its start, a solution already judged.
         judge.forget_reference();
-        let mut accept = judge.clone();
         let mut driver = Sequential::new(
             EnergyLevel::new(problem.clone(), e_g)?,
             &solver,
@@ -178,16 +178,17 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
             values,
             seq_options,
         )?
-        .with_acceptance(move |y, _| {
-            let (x, omega) = split_frequency(y);
-            accept.accepts(x, omega)
+        .with_acceptance(|y, _| {
+            augmented::split(y).is_some_and(|(x, omega)| judge.accepts(x, omega))
         });
         let mut segment = Segment::default();
         let branch = driver.run(&mut |step: &Step| {
             let Some(p) = step.point() else {
                 return ControlFlow::Continue(());
             };
-            let (x, omega) = split_frequency(&p.x);
+            let Some((x, omega)) = augmented::split(&p.x) else {
+                return ControlFlow::Continue(());
+            };
             let e = energy(system, problem.basis(), x, omega);
             let status = PointStatus::refused_as(p, PointStatus::Rejected);
             let mut point = BackbonePoint::from_parts(p, (x, omega), e, e_g, status);
@@ -199,6 +200,8 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
             }
             segment.flow()
         });
+        // The driver's acceptance test borrows the judge: give it back before the walk.
+        drop(driver);
         offset += segment.points;
         let (true, false, Some(last)) = (segment.escaping, segment.stopped, segment.last_accepted)
         else {

@@ -1,13 +1,14 @@
 //! The bordered corrector system of the pseudo-arclength driver, its bordering solve, and the
 //! diagonal metric of the scaled norm on `y = (x, lambda)`.
 
+use crate::continuation::augmented;
 use crate::continuation::bordering::{fill_bordered, solve_bordered};
 use crate::continuation::ContinuationProblem;
 use crate::linalg::DenseMatrix;
 use crate::solve::{residual_scale, Problem, SingularStep, Structured};
 
 /// The bordered corrector system `[F(x, lambda); s <t, y - y_p>_W]` as a [`Problem`] in
-/// `y = (x, lambda)`, with `s` the residual scale of the problem.
+/// `y = (x, lambda)` (the [`augmented`] layout), with `s` the residual scale of the problem.
 ///
 /// Its structured solve is the bordering algorithm ([`solve_bordered`]) on the problem's own
 /// structured solve, with the border row `(c, d)`; where `J` alone is singular (a fold) or
@@ -52,12 +53,13 @@ impl<'a, P: ContinuationProblem + ?Sized> Bordered<'a, P> {
         }
     }
 
-    /// Moves the problem to the parameter of `y` and returns the unknowns of `y`.
+    /// Moves the problem to the parameter of `y` and returns the unknowns of `y`
+    /// ([`augmented`] layout).
     fn at<'y>(&mut self, y: &'y [f64]) -> &'y [f64] {
-        let n = self.problem.dimension();
-        self.problem.set_parameter(y[n]);
+        let (x, lambda) = augmented::split_or_nan(y);
+        self.problem.set_parameter(lambda);
         self.scale = residual_scale(self.problem);
-        &y[..n]
+        x
     }
 }
 

@@ -37,7 +37,7 @@ impl Bracket {
     }
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
+impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<'_, P, S> {
     /// The dense bordered matrix `[J, F_lambda; s t^T W]` at `y` (`s > 0` the residual scale).
     fn bordered_matrix(&mut self, y: &[f64], tangent: &[f64]) -> DenseMatrix {
         let mut matrix = DenseMatrix::default();

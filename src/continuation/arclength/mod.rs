@@ -1,6 +1,7 @@
 //! Pseudo-arclength continuation with step-size control and event detection.
 //!
-//! The branch is followed in `y = (x, lambda)` with the scaled inner product
+//! The branch is followed in `y = (x, lambda)` (the [`augmented`] layout, parameter last)
+//! with the scaled inner product
 //! `<a, b>_W = sum_i a_i b_i / s_x^2 + a_lambda b_lambda / s_lambda^2`, so that a step `ds`
 //! measures the relative change of the whole state (end values are of the order of the gap
 //! `g0` while `Omega` is of order 1). From an accepted point `y_k` with unit tangent `t_k`:
@@ -34,6 +35,7 @@ mod options;
 
 pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
 
+use super::augmented;
 use super::driver::{next_point, run_with, Acceptance};
 use super::{
     Branch, ContinuationProblem, EndReason, Event, Observer, Point, RejectReason, Rejection, Step,
@@ -45,7 +47,7 @@ use bordered::{BorderScratch, Bordered, Metric};
 use branching::Bracket;
 
 /// Pseudo-arclength continuation driver, generic over the problem and the corrector.
-pub struct Arclength<P, S> {
+pub struct Arclength<'a, P, S> {
     problem: P,
     solver: S,
     options: ArclengthOptions,
@@ -63,7 +65,7 @@ pub struct Arclength<P, S> {
     done: bool,
     /// Rejected steps so far.
     rejections: usize,
-    accept: Option<Acceptance>,
+    accept: Option<Acceptance<'a>>,
     border: BorderScratch,
     /// The sign of `det [J, F_lambda; t^T W]` at the current point (`None` when not watched
     /// or exactly singular).
@@ -72,7 +74,7 @@ pub struct Arclength<P, S> {
     bracket: Option<Bracket>,
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
+impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
     /// Starts from a solution `x0` at `lambda0` (it is corrected at fixed `lambda0` first;
     /// the first [`Arclength::step`] returns that corrected start as step 0).
     ///
@@ -118,8 +120,7 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
                 lambda_w: 1.0 / (b * b),
             },
         };
-        let mut y = x;
-        y.push(lambda0);
+        let y = augmented::join(x, lambda0);
         let mut seed = vec![0.0; n + 1];
         seed[n] = options.direction;
         let mut driver = Self {
@@ -153,8 +154,9 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     }
 
     /// Adds a test every accepted point must pass (for instance "not the state of rest"); a
-    /// failing corrected point is rejected like a solver failure.
-    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'static) -> Self {
+    /// failing corrected point is rejected like a solver failure. The test may borrow from
+    /// the caller (the system it measures energies with) for the driver's lifetime `'a`.
+    pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'a) -> Self {
         self.accept = Some(Box::new(accept));
         self
     }
@@ -187,8 +189,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
         &self.options
     }
 
-    /// The current point `y = (x, lambda)`: the last accepted point (the corrected start
-    /// before any step). Rejected steps never change it.
+    /// The current point `y = (x, lambda)` ([`augmented`] layout): the last accepted point
+    /// (the corrected start before any step). Rejected steps never change it.
     pub fn state(&self) -> &[f64] {
         &self.y
     }
@@ -246,11 +248,11 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
     pub fn restart_from(&mut self, x: Vec<f64>, lambda: f64) -> Result<Point, ContinuationError> {
         let n = self.problem.dimension();
         check_start(&x, n, lambda, "restart parameter")?;
-        let mut y = x;
+        let mut x = x;
         let info = self
-            .solve_at(&mut y, lambda)
+            .solve_at(&mut x, lambda)
             .map_err(ContinuationError::Start)?;
-        y.push(lambda);
+        let y = augmented::join(x, lambda);
         let mut seed = vec![0.0; n + 1];
         seed[n] = self.options.direction;
         let tangent = self
@@ -284,9 +286,8 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<P, S> {
 
     /// The active sets of the problem at the current point.
     fn active_set(&mut self) -> Option<Vec<usize>> {
-        let n = self.problem.dimension();
-        self.problem.set_parameter(self.y[n]);
-        let x = &self.y[..n];
+        let (x, lambda) = augmented::split(&self.y)?;
+        self.problem.set_parameter(lambda);
         self.problem.structure().and_then(|s| s.active_set(x))
     }
 
@@ -522,7 +523,7 @@ fn check_start(
     Ok(())
 }
 
-impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<P, S> {
+impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Arclength<'_, P, S> {
     type Item = Result<Point, ContinuationError>;
 
     /// The accepted points (rejections are retried internally); then, if the run failed

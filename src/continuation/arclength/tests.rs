@@ -34,7 +34,7 @@ impl ContinuationProblem for Circle {
 }
 
 /// A driver on the circle from `x = 0.9` at `lambda = 0` (corrected to `x = 1`).
-fn on_the_circle(options: ArclengthOptions) -> Arclength<Circle, SemismoothNewton> {
+fn on_the_circle(options: ArclengthOptions) -> Arclength<'static, Circle, SemismoothNewton> {
     Arclength::new(
         Circle { lambda: 0.0 },
         SemismoothNewton::default(),
@@ -290,7 +290,7 @@ impl ContinuationProblem for Pitchfork {
 }
 
 /// A driver on the trivial branch of [`Pitchfork`] from `lambda = -1`.
-fn on_the_trivial_branch(branch_points: bool) -> Arclength<Pitchfork, SemismoothNewton> {
+fn on_the_trivial_branch(branch_points: bool) -> Arclength<'static, Pitchfork, SemismoothNewton> {
     let options = ArclengthOptions {
         ds: 0.05,
         ds_max: 0.1,
@@ -311,7 +311,7 @@ fn on_the_trivial_branch(branch_points: bool) -> Arclength<Pitchfork, Semismooth
 
 /// [`on_the_trivial_branch`] stepped until the accepted point that reports the branch point
 /// (returned with it).
-fn at_the_pitchfork() -> (Arclength<Pitchfork, SemismoothNewton>, Point) {
+fn at_the_pitchfork() -> (Arclength<'static, Pitchfork, SemismoothNewton>, Point) {
     let mut driver = on_the_trivial_branch(true);
     for _ in 0..100 {
         match driver.step() {

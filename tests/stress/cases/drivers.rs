@@ -110,10 +110,10 @@ macro_rules! driver {
         }
     };
 }
-driver!(Sequential<P, S>);
-driver!(Speculative<P, S>);
-driver!(Arclength<P, S>);
-driver!(EscapingArclength<P, S>);
+driver!(Sequential<'_, P, S>);
+driver!(Speculative<'_, P, S>);
+driver!(Arclength<'_, P, S>);
+driver!(EscapingArclength<'_, P, S>);
 
 /// Drives `driver` one of three ways and checks its points and that the run ends with a
 /// reason consistent with how it was driven; `bounded` says whether its options alone end it.
