@@ -19,8 +19,8 @@
 use nonsmooth_modes::branches::{compute, BackbonePoint, Request};
 use nonsmooth_modes::io::write_columns_csv;
 use nonsmooth_modes::plot::{
-    backbone_panel, render_svg, stability_series, Figure, LinePanel, Rgb, Series, FREQUENCY_LABEL,
-    PALETTE,
+    backbone_panel, render_svg, stability_series, Figure, LegendPosition, LinePanel, Rgb, Series,
+    FREQUENCY_LABEL, PALETTE,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::stability::StabilityOptions;
@@ -75,7 +75,12 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         .collect();
     let multipliers = LinePanel {
         series: stability_series("NSM1", PALETTE[0], &moduli),
-        ..LinePanel::new("largest multiplier modulus (points with a verdict)", FREQUENCY_LABEL, "max |mu|")
+        legend: LegendPosition::UpperRight,
+        ..LinePanel::new(
+            "largest multiplier modulus (points with a verdict)",
+            FREQUENCY_LABEL,
+            "max |mu|",
+        )
     };
     let figure = Figure::new(
         "Stability of the clamped bar's first nonsmooth mode (harmonic balance, m = 20)",

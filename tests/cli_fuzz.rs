@@ -410,6 +410,12 @@ fn newest(path: &Path) -> SystemTime {
 /// The `backbone` binary of this test's profile; fails the test if it is missing or older
 /// than its sources.
 fn backbone_binary() -> PathBuf {
+    example_binary("backbone", "examples/backbone")
+}
+
+/// The binary of example `name` of this test's profile; fails the test if it is missing or
+/// older than `source` (a file or folder), `src` or `Cargo.toml`.
+fn example_binary(name: &str, source: &str) -> PathBuf {
     let exe = std::env::current_exe().expect("the test's own path");
     // The test is `<target>/<profile>/deps/cli_fuzz-<hash>`.
     let profile = exe
@@ -418,7 +424,7 @@ fn backbone_binary() -> PathBuf {
         .expect("the test lives in <target>/<profile>/deps");
     let binary = profile
         .join("examples")
-        .join(format!("backbone{}", std::env::consts::EXE_SUFFIX));
+        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
     let release = if profile.ends_with("release") {
         " --release"
     } else {
@@ -428,19 +434,19 @@ fn backbone_binary() -> PathBuf {
         .and_then(|m| m.modified())
         .unwrap_or_else(|e| {
             panic!(
-                "the backbone example is not built ({}: {e}): run `cargo build{release} \
-                 --example backbone` first",
+                "the {name} example is not built ({}: {e}): run `cargo build{release} \
+                 --all-features --example {name}` first",
                 binary.display()
             )
         });
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sources = ["examples/backbone", "src", "Cargo.toml"]
+    let sources = [source, "src", "Cargo.toml"]
         .iter()
         .map(|p| newest(&root.join(p)))
         .fold(SystemTime::UNIX_EPOCH, SystemTime::max);
     assert!(
         built >= sources,
-        "{} is older than its sources: run `cargo build{release} --example backbone` first",
+        "{} is older than its sources: run `cargo build{release} --all-features --example {name}` first",
         binary.display()
     );
     binary
@@ -510,4 +516,28 @@ fn fuzz_long() {
         from_env("CLI_FUZZ_LINES", LONG_LINES),
         from_env("CLI_FUZZ_SEED", 0x1000_5eed),
     );
+}
+
+/// The `gallery` example refuses what it does not know before any computation: an unknown
+/// argument or `--out` without a folder exit with 2 and the usage, a folder that cannot be
+/// created with 1 and the reason; none panics.
+#[cfg(feature = "plot")]
+#[test]
+fn gallery_refuses_bad_arguments() {
+    let binary = example_binary("gallery", "examples/gallery.rs");
+    let cases: [(&[&str], i32, &str); 3] = [
+        (&["--bogus"], 2, "usage: gallery"),
+        (&["--out"], 2, "usage: gallery"),
+        (&["--out", "/dev/null/inside", "--quick"], 1, "gallery:"),
+    ];
+    for (args, code, message) in cases {
+        let output = Command::new(&binary)
+            .args(args)
+            .output()
+            .expect("spawn the gallery example");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(code), "{args:?}: {stderr}");
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
 }
