@@ -2,6 +2,7 @@
 
 use crate::bar::Bar;
 use crate::error::{ModelError, SettingsError};
+use crate::fourier::frequency_of_period;
 use crate::system::{AssemblyBuilder, BarSystem};
 use std::f64::consts::PI;
 
@@ -198,7 +199,7 @@ impl ClampedFirstMode {
     /// # Panics
     /// If `2 (harmonics + 1)` values overflow `usize` (or do not fit in memory).
     pub fn unknowns(&self, harmonics: usize) -> Vec<f64> {
-        let omega = 2.0 * PI / self.period;
+        let omega = frequency_of_period(self.period);
         let len = (harmonics.checked_add(1))
             .and_then(|n| n.checked_mul(2))
             .expect("ClampedFirstMode::unknowns: 2 (harmonics + 1) overflows usize");

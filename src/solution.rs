@@ -3,6 +3,7 @@
 //!
 //! ```
 //! use nonsmooth_modes::continuation::ContinuationProblem;
+//! use nonsmooth_modes::fourier::frequency_of_period;
 //! use nonsmooth_modes::modal::branch_seed;
 //! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 //! use nonsmooth_modes::solution::Solution;
@@ -12,7 +13,7 @@
 //! let system = clamped_bar_with_obstacle(1e-3)?;
 //! let settings = HarmonicBalanceSettings { harmonics: 10, ..Default::default() };
 //! let mut problem = NonsmoothSystem::new(&system, settings)?;
-//! let omega = 2.0 * std::f64::consts::PI / 3.6;
+//! let omega = frequency_of_period(3.6);
 //! let mut x = branch_seed(&mut problem, 1, 1, omega)?;
 //! problem.set_parameter(omega);
 //! SemismoothNewton::default().solve(&mut problem, &mut x)?;
@@ -25,7 +26,7 @@
 
 use crate::bar::EndRef;
 use crate::error::SettingsError;
-use crate::fourier::{Basis, CosineBasis};
+use crate::fourier::{period_of_frequency, Basis, CosineBasis};
 use crate::modal::diagnostics::{
     checked_displacement_grid, checked_end_history, diagnose, law_history, EndHistory, FieldGrid,
     LawHistory, PointDiagnostics,
@@ -87,7 +88,7 @@ impl<'a, B: Basis> Solution<'a, B> {
 
     /// The period `T = 2 pi / Omega`.
     pub fn period(&self) -> f64 {
-        2.0 * std::f64::consts::PI / self.omega
+        period_of_frequency(self.omega)
     }
 
     /// The mechanical energy `E` at `t = 0` (formulation §7).

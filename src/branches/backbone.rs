@@ -2,7 +2,7 @@
 //! period, with energies normalised by the first grazing energy.
 
 use crate::branches::escape::{EscapingArclength, StallEscape};
-use crate::branches::point::{Backbone, BackbonePoint};
+use crate::branches::point::{Backbone, BackbonePoint, PointStatus, Timescale};
 use crate::branches::start::{
     check_trivial_energy, grazing_and_seed, usable_start, walk_back, BackboneStart,
 };
@@ -12,12 +12,12 @@ use crate::continuation::{
     Predictor, Rejection, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
 };
 use crate::error::{ContinuationError, Error};
+use crate::fourier::frequency_of_period;
 use crate::modal::energy::energy;
 use crate::modal::inputs::check_frequency_of;
 use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
-use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// `steps` equispaced periods from `start` to `end` (both included).
@@ -123,7 +123,7 @@ pub(crate) fn backbone_with<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
-    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let run = |mut driver: Sequential<'_, _, S>, see: &mut dyn Observer| driver.run(see);
     drive_backbone(system, settings, (options, None), solver, run, observer)
@@ -143,7 +143,7 @@ pub(crate) fn backbone_speculative_with<S: NonlinearSolver + Clone + Send + 'sta
     options: &BackboneOptions,
     speculation: Speculation,
     solver: S,
-    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let run = |driver: Sequential<'_, _, S>, see: &mut dyn Observer| {
         Speculative::new(driver, speculation).run(see)
@@ -168,7 +168,7 @@ pub(crate) fn backbone_from<S: NonlinearSolver + Clone + Send + 'static>(
     start: BackboneStart,
     speculation: Option<Speculation>,
     solver: S,
-    observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let run = |mut driver: Sequential<'_, _, S>, see: &mut dyn Observer| match speculation {
         Some(speculation) => Speculative::new(driver, speculation).run(see),
@@ -195,7 +195,7 @@ fn drive_backbone<S: NonlinearSolver>(
         Sequential<'_, PeriodParametrised<NonsmoothSystem>, S>,
         &mut dyn Observer,
     ) -> Branch,
-    mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    mut observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
     let grid = options.grid;
@@ -210,15 +210,11 @@ fn drive_backbone<S: NonlinearSolver>(
     }
     check_trivial_energy(options.trivial_energy)?;
     for v in [grid.start, grid.end] {
-        check_frequency_of(&problem, 2.0 * PI / v)?;
+        check_frequency_of(&problem, frequency_of_period(v))?;
     }
     let values = linspace(grid.start, grid.end, grid.steps)?;
-    let (e_g, seed) = grazing_and_seed(
-        &mut problem,
-        options.mode,
-        options.subharmonic,
-        2.0 * PI / grid.start,
-    )?;
+    let first = frequency_of_period(grid.start);
+    let (e_g, seed) = grazing_and_seed(&mut problem, options.mode, options.subharmonic, first)?;
     let basis = problem.basis().clone();
     let floor = options.trivial_energy * e_g;
     // Where no start is found near the first period, the grid itself searches on from the
@@ -228,17 +224,18 @@ fn drive_backbone<S: NonlinearSolver>(
         Some(given) => (given.x, None),
         None => {
             let guess = (seed.clone(), options.subharmonic);
-            match usable_start(&mut problem, &solver, guess, 2.0 * PI / grid.start, floor) {
+            match usable_start(&mut problem, &solver, guess, first, floor) {
                 Ok((x, _)) => (x, None),
                 Err(e) => (seed, Some(e)),
             }
         }
     };
     let seq_options = options.sequential();
-    // The acceptance test computes each converged point's energy; the observer reuses it.
-    // The measure of `Selection::LowestMeasure` is called right after the acceptance test
-    // took the same point: it reuses the energy the test computed.
-    let last_energy = RefCell::new((Vec::new(), f64::NAN, f64::NAN));
+    // The driver's parameter is the period: the acceptance test derives each converged
+    // point's frequency from it (once) and computes its energy; the observer reuses both for
+    // the point it builds. The measure of `Selection::LowestMeasure` is called right after
+    // the acceptance test took the same point: it reuses the energy the test computed.
+    let last_energy = RefCell::new(Taken::default());
     let driver = Sequential::new(
         PeriodParametrised::new(problem),
         solver,
@@ -247,20 +244,16 @@ fn drive_backbone<S: NonlinearSolver>(
         seq_options,
     )?
     .with_acceptance(|x, period| {
-        let e = energy(system, &basis, x, 2.0 * PI / period);
-        let mut last = last_energy.borrow_mut();
-        last.0.clear();
-        last.0.extend_from_slice(x);
-        (last.1, last.2) = (period, e);
+        let time = Timescale::of_period(period);
+        let e = energy(system, &basis, x, time.omega);
+        last_energy.borrow_mut().keep(x, time, e);
         e > floor
     })
     .with_measure(|x, period| {
-        let last = last_energy.borrow();
-        if last.1 == period && last.0 == x {
-            last.2
-        } else {
-            f64::NAN
-        }
+        last_energy
+            .borrow()
+            .energy_of(x, period)
+            .unwrap_or(f64::NAN)
     });
     // Converged points and the solver's last iterates of failed steps alike.
     let mut entered = false;
@@ -269,17 +262,59 @@ fn drive_backbone<S: NonlinearSolver>(
             return ControlFlow::Continue(());
         };
         entered |= p.converged;
-        let omega = 2.0 * PI / p.parameter;
-        let known = {
-            let last = last_energy.borrow();
-            (last.1 == p.parameter && last.0 == p.x).then_some(last.2)
-        };
-        let e = known.unwrap_or_else(|| energy(system, &basis, &p.x, omega));
-        observer(&BackbonePoint::from_point(p, omega, e, e_g))
+        let known = last_energy.borrow().time_and_energy(&p.x, p.parameter);
+        let (time, e) = known.unwrap_or_else(|| {
+            let time = Timescale::of_period(p.parameter);
+            (time, energy(system, &basis, &p.x, time.omega))
+        });
+        let status = PointStatus::of(p);
+        observer(BackbonePoint::from_parts(p, (&p.x, time), e, e_g, status))
     });
     match not_found {
         Some(e) if !entered => Err(e.into()),
         _ => Ok((e_g, branch.end)),
+    }
+}
+
+/// The last solution a period grid's acceptance test took: its unknowns (copied into a
+/// buffer kept from step to step), time scale and energy, for the observer and the measure
+/// to reuse instead of computing them again.
+struct Taken {
+    x: Vec<f64>,
+    time: Timescale,
+    energy: f64,
+}
+
+impl Default for Taken {
+    fn default() -> Self {
+        let time = Timescale {
+            period: f64::NAN,
+            omega: f64::NAN,
+        };
+        Self {
+            x: Vec::new(),
+            time,
+            energy: f64::NAN,
+        }
+    }
+}
+
+impl Taken {
+    /// Keeps `(x, time)` and its energy.
+    fn keep(&mut self, x: &[f64], time: Timescale, energy: f64) {
+        self.x.clear();
+        self.x.extend_from_slice(x);
+        (self.time, self.energy) = (time, energy);
+    }
+
+    /// The time scale and energy kept, if they are those of `x` at `period`.
+    fn time_and_energy(&self, x: &[f64], period: f64) -> Option<(Timescale, f64)> {
+        (self.time.period == period && self.x == x).then_some((self.time, self.energy))
+    }
+
+    /// The energy kept, if it is that of `x` at `period`.
+    fn energy_of(&self, x: &[f64], period: f64) -> Option<f64> {
+        self.time_and_energy(x, period).map(|(_, e)| e)
     }
 }
 
@@ -330,7 +365,7 @@ impl ArclengthBackboneOptions {
     /// first period's end (so that the walk back to the first period ends beyond it).
     pub fn over_grid(options: &BackboneOptions) -> Self {
         let PeriodGrid { start, end, .. } = options.grid;
-        let (first, last) = (2.0 * PI / start, 2.0 * PI / end);
+        let (first, last) = (frequency_of_period(start), frequency_of_period(end));
         let range = if first <= last {
             (first * 0.999, last)
         } else {
@@ -387,6 +422,17 @@ impl<F: FnMut(&BackbonePoint) -> ControlFlow<()>> BackboneObserver for F {
     }
 }
 
+/// What an arclength backbone hands its points and rejected steps to inside the crate: as
+/// [`BackboneObserver`], but each point by value, so that a receiver that keeps the points
+/// (the annotator of [`compute`](crate::branches::compute)) does not copy them.
+pub(crate) trait PointSink {
+    /// Called with every accepted point.
+    fn point(&mut self, point: BackbonePoint) -> ControlFlow<()>;
+
+    /// Called with every rejected step.
+    fn rejected(&mut self, rejection: &Rejection) -> ControlFlow<()>;
+}
+
 /// [`arclength_backbone`] whose observer sees every accepted point and every rejected step,
 /// and may stop the run on either
 /// ([`EndReason::StoppedByObserver`](crate::continuation::EndReason::StoppedByObserver)).
@@ -398,7 +444,7 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &ArclengthBackboneOptions,
     solver: S,
-    mut observer: impl BackboneObserver,
+    mut observer: impl PointSink,
 ) -> Result<(f64, Branch), Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
     if !(options.start_period.is_finite() && options.start_period > 0.0) {
@@ -408,7 +454,9 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         }
         .into());
     }
-    let omega0 = 2.0 * PI / options.start_period;
+    // The driver's parameter is the frequency: the asked start period is converted once.
+    let asked = frequency_of_period(options.start_period);
+    let omega0 = asked;
     let (lo, hi) = options.omega_range;
     if hi.is_finite() {
         check_frequency_of(&problem, hi.max(lo))?;
@@ -436,7 +484,7 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         &problem,
         &solver,
         (&start, omega0),
-        2.0 * PI / options.start_period,
+        asked,
         arclength,
         (options.escape, floor),
     );
@@ -449,23 +497,23 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         point.step += offset;
         point
     };
-    for (k, p) in walked.iter().enumerate() {
-        if observer.point(&backbone_point(p, 0)).is_break() {
-            let points = walked[..=k].to_vec();
-            let end = EndReason::StoppedByObserver;
-            let rejections = walk_rejections;
-            return Ok((
-                e_g,
-                Branch {
-                    points,
-                    rejections,
-                    end,
-                },
-            ));
-        }
+    let stopped_at = (walked.iter()).position(|p| observer.point(backbone_point(p, 0)).is_break());
+    if let Some(k) = stopped_at {
+        let mut points = walked;
+        points.truncate(k + 1);
+        let end = EndReason::StoppedByObserver;
+        let rejections = walk_rejections;
+        return Ok((
+            e_g,
+            Branch {
+                points,
+                rejections,
+                end,
+            },
+        ));
     }
     let mut see = |step: &Step| match step {
-        Step::Accepted(p) => observer.point(&backbone_point(p, offset)),
+        Step::Accepted(p) => observer.point(backbone_point(p, offset)),
         Step::Rejected(r) => observer.rejected(r),
         Step::Finished(_) => ControlFlow::Continue(()),
     };

@@ -2,7 +2,7 @@
 
 use crate::branches::backbone::{
     arclength_backbone_observed, backbone_from, backbone_speculative_with, backbone_with,
-    ArclengthBackboneOptions, BackboneObserver, BackboneOptions,
+    ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PointSink,
 };
 use crate::branches::energy_backbone::{energy_backbone_with, EnergyBackboneOptions};
 use crate::branches::point::BackbonePoint;
@@ -12,10 +12,10 @@ use crate::branches::start::{backbone_start, BackboneStart};
 use crate::branches::subharmonic::genuine_subharmonic_backbone_with;
 use crate::continuation::{EndReason, Rejection};
 use crate::error::{Error, SettingsError};
+use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::modal::Label;
 use crate::solve::Solver;
 use crate::system::{BarSystem, NonsmoothSystem};
-use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// Computes the branch of NSM `request.mode` sub `request.subharmonic` of `system` by
@@ -168,7 +168,7 @@ fn run_plan<O: BackboneObserver>(
 ) -> Result<(f64, EndReason, usize), Error> {
     let settings = request.settings;
     let spec = request.speculation;
-    let see = |p: &BackbonePoint| annotator.point(p);
+    let see = |p: BackbonePoint| annotator.point(p);
     Ok(match plan {
         Plan::Grid(options, Some(start)) => {
             let (e_g, end) = backbone_from(system, settings, &options, start, spec, solver, see)?;
@@ -208,12 +208,12 @@ fn run_plan<O: BackboneObserver>(
     })
 }
 
-/// An observer that hands what it sees to the annotator (the arclength backbone takes its
-/// observer by value).
+/// A sink that hands what it receives to the annotator (the arclength backbone takes its
+/// sink by value).
 struct Forward<'a, O>(&'a mut Annotator<O>);
 
-impl<O: BackboneObserver> BackboneObserver for Forward<'_, O> {
-    fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()> {
+impl<O: BackboneObserver> PointSink for Forward<'_, O> {
+    fn point(&mut self, point: BackbonePoint) -> ControlFlow<()> {
         self.0.point(point)
     }
     fn rejected(&mut self, rejection: &Rejection) -> ControlFlow<()> {
@@ -306,7 +306,7 @@ fn auto(
             choice,
         ));
     }
-    let first = 2.0 * PI / grid.grid.start;
+    let first = frequency_of_period(grid.grid.start);
     let solver = request.solver_for(&Method::PeriodGrid(grid))?;
     let settings = request.settings;
     let floor = grid.trivial_energy;
@@ -332,7 +332,7 @@ fn auto(
         ));
     }
     let options = ArclengthBackboneOptions::over_grid(&grid);
-    let entered_at = 2.0 * PI / start.omega;
+    let entered_at = period_of_frequency(start.omega);
     Ok((
         Plan::Arclength(options),
         Method::Arclength(options),

@@ -13,9 +13,9 @@
 use crate::branches::backbone::{ArclengthBackboneOptions, BackboneOptions, PeriodGrid};
 use crate::branches::start::StartGuesses;
 use crate::error::SettingsError;
+use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::modal::linear::open_mode;
 use crate::system::BarSystem;
-use std::f64::consts::PI;
 
 /// Start of the default grid, as a fraction `(numerator, denominator)` of the linear period.
 const START: (f64, f64) = (79.0, 80.0);
@@ -44,7 +44,7 @@ pub fn linear_period(
         });
     }
     let omega = open_mode(system, mode)?.omega;
-    Ok(subharmonic as f64 * round_significant(2.0 * PI / omega, 6))
+    Ok(subharmonic as f64 * round_significant(period_of_frequency(omega), 6))
 }
 
 impl PeriodGrid {
@@ -119,8 +119,8 @@ impl ArclengthBackboneOptions {
     ) -> Result<Self, SettingsError> {
         let period = linear_period(system, mode, subharmonic)?;
         let range = (
-            2.0 * PI / fraction(period, ARCLENGTH_START),
-            2.0 * PI / fraction(period, END),
+            frequency_of_period(fraction(period, ARCLENGTH_START)),
+            frequency_of_period(fraction(period, END)),
         );
         let start = fraction(period, START);
         Ok(Self::seeded_at(start, range, (mode, subharmonic)))
@@ -155,6 +155,7 @@ fn round_significant(x: f64, digits: i32) -> f64 {
 mod tests {
     use super::*;
     use crate::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
+    use std::f64::consts::PI;
 
     /// The clamped bar's derived defaults are the paper's grid and the arclength defaults,
     /// bit for bit.

@@ -3,13 +3,12 @@
 
 use crate::continuation::{EndReason, Event, Point};
 use crate::error::{ContinuationError, SettingsError, SolveError};
-use crate::fourier::Basis;
+use crate::fourier::{frequency_of_period, period_of_frequency, Basis};
 use crate::modal::{Character, Label};
 use crate::solution::Solution;
 use crate::stability::{Floquet, StabilityError};
 use crate::system::NonsmoothSystem;
 use crate::verify::PeriodicityReport;
-use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// One point of a backbone.
@@ -77,19 +76,22 @@ impl BackbonePoint {
         Solution::new(problem, &self.x, self.omega)
     }
 
-    /// The backbone view of a continuation point at fundamental frequency `omega`, with its
-    /// energy `energy` and the grazing energy `e_g` used for normalisation.
+    /// The backbone view of a continuation point at fundamental frequency `omega` (its period
+    /// derived from it), with its energy `energy` and the grazing energy `e_g` used for
+    /// normalisation.
     pub fn from_point(p: &Point, omega: f64, energy: f64, e_g: f64) -> Self {
-        Self::from_parts(p, (&p.x, omega), energy, e_g, PointStatus::of(p))
+        let time = Timescale::of_frequency(omega);
+        Self::from_parts(p, (&p.x, time), energy, e_g, PointStatus::of(p))
     }
 
-    /// The backbone view of a continuation point whose unknowns, `x` at `omega`, are given
-    /// apart from it (a point of an energy-level problem holds `(x, Omega)`), with its status.
-    /// A converged point whose energy or `E / E_g` is not finite becomes
+    /// The backbone view of a continuation point whose unknowns, `x` at the period and
+    /// frequency `time`, are given apart from it (a point of an energy-level problem holds
+    /// `(x, Omega)`), with its status. Its unknowns are copied once, here: the point stays
+    /// the driver's. A converged point whose energy or `E / E_g` is not finite becomes
     /// [`PointStatus::NonFiniteEnergy`], not converged.
     pub(crate) fn from_parts(
         p: &Point,
-        (x, omega): (&[f64], f64),
+        (x, time): (&[f64], Timescale),
         energy: f64,
         e_g: f64,
         status: PointStatus,
@@ -103,8 +105,8 @@ impl BackbonePoint {
         };
         Self {
             step: p.step,
-            period: 2.0 * PI / omega,
-            omega,
+            period: time.period,
+            omega: time.omega,
             energy,
             energy_normalized,
             converged: status == PointStatus::Converged,
@@ -120,6 +122,33 @@ impl BackbonePoint {
             label: None,
             stability: None,
         }
+    }
+}
+
+/// The period `T` and fundamental frequency `Omega` of a point: the one its driver holds as
+/// its parameter, kept as it is, and the other derived from it once
+/// ([`frequency_of_period`], [`period_of_frequency`]): a point's period and frequency never
+/// come from a round trip `T -> Omega -> T`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Timescale {
+    /// Period `T`.
+    pub period: f64,
+    /// Fundamental angular frequency `Omega = 2 pi / T`.
+    pub omega: f64,
+}
+
+impl Timescale {
+    /// The time scale of a driver continuing in the period (a period grid).
+    pub(crate) fn of_period(period: f64) -> Self {
+        let omega = frequency_of_period(period);
+        Self { period, omega }
+    }
+
+    /// The time scale of a driver continuing in the frequency (pseudo-arclength, an energy
+    /// level, a system parameter at fixed frequency).
+    pub(crate) fn of_frequency(omega: f64) -> Self {
+        let period = period_of_frequency(omega);
+        Self { period, omega }
     }
 }
 
@@ -195,15 +224,16 @@ pub struct Backbone {
 
 impl Backbone {
     /// Collects every point a backbone driver hands to its observer: `run` is called with
-    /// an observer that keeps them all and returns the driver's `(E_g, end reason)`.
+    /// an observer that keeps them all (moved in, not copied) and returns the driver's
+    /// `(E_g, end reason)`.
     pub(crate) fn collect<E>(
         run: impl FnOnce(
-            &mut dyn FnMut(&BackbonePoint) -> ControlFlow<()>,
+            &mut dyn FnMut(BackbonePoint) -> ControlFlow<()>,
         ) -> Result<(f64, EndReason), E>,
     ) -> Result<Self, E> {
         let mut points = Vec::new();
-        let (grazing_energy, end) = run(&mut |p: &BackbonePoint| {
-            points.push(p.clone());
+        let (grazing_energy, end) = run(&mut |p: BackbonePoint| {
+            points.push(p);
             ControlFlow::Continue(())
         })?;
         Ok(Self {

@@ -121,9 +121,8 @@ impl<O: BackboneObserver> Annotator<O> {
         }
     }
 
-    /// Annotates `point`, keeps it and shows it to the observer.
-    pub(crate) fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()> {
-        let mut point = point.clone();
+    /// Annotates `point`, shows it to the observer and keeps it (moved in, not copied).
+    pub(crate) fn point(&mut self, mut point: BackbonePoint) -> ControlFlow<()> {
         // A jump (the stall escape, a corrector that lands far from its prediction, a switch
         // onto a crossing branch) leaves the branch followed so far.
         let jumped = point.events.iter().any(|e| matches!(e, Event::Jump { .. }));
@@ -187,7 +186,7 @@ impl<O: BackboneObserver> Annotator<O> {
         let verified = self.check.map(|check| {
             let (system, basis) = (self.problem.system(), self.problem.basis());
             let options = &check.options;
-            let steps = 2.0 * PI / omega / options.dt * options.periods as f64;
+            let steps = point.period / options.dt * options.periods as f64;
             point.time_domain = (steps <= check.max_steps)
                 .then(|| periodicity_check(system, basis, x, omega, options).ok())
                 .flatten();

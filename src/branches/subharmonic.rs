@@ -16,18 +16,17 @@
 //! off the multiples of `K` ([`subharmonic_share`]) is at least [`GENUINE_SHARE`].
 
 use crate::branches::backbone::{backbone_with, BackboneOptions};
-use crate::branches::point::{BackbonePoint, PointStatus};
+use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
 use crate::continuation::{
     linspace, ContinuationProblem, EndReason, PeriodParametrised, Sequential, Step,
 };
 use crate::error::{ContinuationError, Error};
-use crate::fourier::Basis;
+use crate::fourier::{frequency_of_period, Basis};
 use crate::linalg::{DenseMatrix, Lu};
 use crate::modal::energy::energy;
 use crate::modal::signature::subharmonic_share;
 use crate::solve::{NonlinearSolver, Problem};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
-use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// Least share of the time-averaged energy off the multiples of `K` for a motion to count as
@@ -170,7 +169,7 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &BackboneOptions,
     solver: S,
-    mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    mut observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let k = options.subharmonic;
     if k < 2 {
@@ -184,18 +183,21 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
     let mut switched: Option<(Vec<f64>, usize)> = None;
     let mut floor = f64::NAN;
     let mut stopped = false;
-    let (e_g, end) = backbone_with(system, settings, options, &solver, |p| {
+    let (e_g, end) = backbone_with(system, settings, options, &solver, |p: BackbonePoint| {
+        // A converged point is tried off the subspace before it is moved to the observer
+        // (the observer keeps it; its unknowns are not copied). If the observer stops the
+        // run, the switch found is not taken.
+        let left = p.converged.then(|| {
+            floor = options.trivial_energy * p.energy / p.energy_normalized;
+            leave_subspace(&mut problem, &solver, (&p.x, p.omega), k, floor).map(|y| (y, p.step))
+        });
         if observer(p).is_break() {
             stopped = true;
             return ControlFlow::Break(());
         }
-        if !p.converged {
-            return ControlFlow::Continue(());
-        }
-        floor = options.trivial_energy * p.energy / p.energy_normalized;
-        match leave_subspace(&mut problem, &solver, (&p.x, p.omega), k, floor) {
-            Some(y) => {
-                switched = Some((y, p.step));
+        match left.flatten() {
+            Some(found) => {
+                switched = Some(found);
                 ControlFlow::Break(())
             }
             None => ControlFlow::Continue(()),
@@ -206,7 +208,7 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
     };
     let grid = options.grid;
     let values = linspace(grid.start, grid.end, grid.steps)?.split_off(at);
-    let omega = 2.0 * PI / values[0];
+    let omega = frequency_of_period(values[0]);
     problem.set_parameter(omega);
     let basis = problem.basis().clone();
     let mut driver = Sequential::new(
@@ -217,7 +219,7 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
         options.sequential(),
     )?
     .with_acceptance(|x, period| {
-        let omega = 2.0 * PI / period;
+        let omega = frequency_of_period(period);
         energy(system, &basis, x, omega) > floor
             && subharmonic_share(system, &basis, x, omega, k).is_ok_and(|s| s >= GENUINE_SHARE)
     });
@@ -225,17 +227,17 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
         let Some(p) = step.point() else {
             return ControlFlow::Continue(());
         };
-        let omega = 2.0 * PI / p.parameter;
-        let e = energy(system, &basis, &p.x, omega);
+        let time = Timescale::of_period(p.parameter);
+        let e = energy(system, &basis, &p.x, time.omega);
         let refused = if e > floor {
             PointStatus::Rejected
         } else {
             PointStatus::CollapsedToRest
         };
         let status = PointStatus::refused_as(p, refused);
-        let mut point = BackbonePoint::from_parts(p, (&p.x, omega), e, e_g, status);
+        let mut point = BackbonePoint::from_parts(p, (&p.x, time), e, e_g, status);
         point.step += at + 1;
-        observer(&point)
+        observer(point)
     });
     Ok((e_g, branch.end))
 }

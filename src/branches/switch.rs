@@ -85,9 +85,12 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Runner<'_, P, S> {
         };
         match self.switch_branch(at.side) {
             Ok(point) => {
-                let step = Step::Accepted(point.clone());
-                first.points.push(point);
-                if observer(&step).is_break() {
+                let step = Step::Accepted(point);
+                let flow = observer(&step);
+                if let Step::Accepted(point) = step {
+                    first.points.push(point);
+                }
+                if flow.is_break() {
                     first.end = EndReason::StoppedByObserver;
                     return Ok(first);
                 }

@@ -36,6 +36,7 @@ pub use sequential::{geomspace, linspace, Predictor, Selection, Sequential, Sequ
 pub use speculative::{Speculation, SpeculationStats, Speculative};
 
 use crate::error::SolveError;
+use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::linalg::DenseMatrix;
 use crate::solve::{Problem, Structured};
 use crate::stability::Crossing;
@@ -73,7 +74,8 @@ impl<P: ContinuationProblem + ?Sized> ContinuationProblem for &mut P {
 
 /// A problem in an angular frequency `Omega`, continued in the period `T = 2 pi / Omega`
 /// instead (chain rule `dF/dT = -(2 pi / T^2) dF/dOmega`). The parameter of its points is the
-/// period.
+/// period, and the frequency of the problem is derived from it once per parameter
+/// ([`frequency_of_period`]).
 #[derive(Debug, Clone)]
 pub struct PeriodParametrised<P> {
     inner: P,
@@ -83,7 +85,7 @@ pub struct PeriodParametrised<P> {
 impl<P: ContinuationProblem> PeriodParametrised<P> {
     /// `inner` continued in the period (starting at the period of its current frequency).
     pub fn new(inner: P) -> Self {
-        let period = period_of(inner.parameter());
+        let period = period_of_frequency(inner.parameter());
         Self { inner, period }
     }
 
@@ -101,11 +103,6 @@ impl<P: ContinuationProblem> PeriodParametrised<P> {
     pub fn into_inner(self) -> P {
         self.inner
     }
-}
-
-/// `2 pi / v`: a period from an angular frequency and back.
-fn period_of(v: f64) -> f64 {
-    2.0 * std::f64::consts::PI / v
 }
 
 impl<P: ContinuationProblem> Problem for PeriodParametrised<P> {
@@ -129,7 +126,7 @@ impl<P: ContinuationProblem> ContinuationProblem for PeriodParametrised<P> {
     }
     fn set_parameter(&mut self, period: f64) {
         self.period = period;
-        self.inner.set_parameter(period_of(period));
+        self.inner.set_parameter(frequency_of_period(period));
     }
     fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
         self.inner.parameter_derivative(x, df);

@@ -69,6 +69,33 @@ fn over_budget(what: &'static str, doubles: f64) -> OverBudget {
 /// of samples held by the caller.
 const BASIS_DOUBLES_PER_SAMPLE: f64 = 16.0;
 
+/// The fundamental angular frequency `Omega = 2 pi / T` of a motion of period `T`: the
+/// frequency at which a basis's `2 pi`-periodic functions `phi_i(Omega t)` repeat every `T`.
+///
+/// The crate's one conversion from a period to a frequency, and [`period_of_frequency`]
+/// the one back (the same formula): each quantity along a computation is kept as the
+/// continuation parameter holds it and the other derived once from it, never converted
+/// back and forth (a round trip `T -> Omega -> T` may move `T` by one unit in the last
+/// place). Both are `2 pi / v` rounded once, so `2.0 * PI / v` and `TAU / v` give the same
+/// bits.
+///
+/// ```
+/// use nonsmooth_modes::fourier::{frequency_of_period, period_of_frequency};
+/// use std::f64::consts::PI;
+///
+/// assert_eq!(frequency_of_period(2.0), PI);
+/// assert_eq!(period_of_frequency(PI), 2.0);
+/// ```
+pub const fn frequency_of_period(period: f64) -> f64 {
+    2.0 * std::f64::consts::PI / period
+}
+
+/// The period `T = 2 pi / Omega` of a motion of fundamental angular frequency `Omega`: the
+/// inverse of [`frequency_of_period`] (the same formula, rounded once).
+pub const fn period_of_frequency(omega: f64) -> f64 {
+    2.0 * std::f64::consts::PI / omega
+}
+
 /// A finite real basis of `2 pi`-periodic functions `phi_i(theta)`, with a grid of `N`
 /// equispaced samples `theta_k = 2 pi k / N` on which residuals are projected (Riemann sum).
 ///

@@ -7,7 +7,7 @@
 
 use crate::bar::{End, EndRef};
 use crate::error::SettingsError;
-use crate::fourier::{check_memory, Basis};
+use crate::fourier::{check_memory, period_of_frequency, Basis};
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
 use crate::modal::inputs::{check_finite, check_motion};
@@ -107,7 +107,7 @@ fn fill_end_history<B: Basis>(
         End::Left => 0.0,
         End::Right => bar.length(),
     };
-    let period = 2.0 * PI / omega;
+    let period = period_of_frequency(omega);
     let (mut phi, mut dphi) = (vec![0.0; basis.len()], vec![0.0; basis.len()]);
     for k in 0..samples {
         let t = period * k as f64 / samples as f64;
@@ -220,7 +220,7 @@ fn fill_displacement_grid<B: Basis>(
 ) -> FieldGrid {
     let fields = FieldEvaluator::new(system, basis, x, omega);
     let l = system.bars()[bar].length();
-    let period = 2.0 * PI / omega;
+    let period = period_of_frequency(omega);
     let spacing = (positions.max(2) - 1) as f64;
     g.position
         .extend((0..positions).map(|i| l * i as f64 / spacing));
@@ -303,7 +303,7 @@ pub fn law_history<B: Basis>(
         .unzip();
     let (g0, f0) = (law_ref.gap().offset, law_ref.force().offset);
     let mut phi = vec![0.0; basis.len()];
-    let period = 2.0 * PI / omega;
+    let period = period_of_frequency(omega);
     for k in 0..samples {
         let t = period * k as f64 / samples as f64;
         basis.functions_at(omega * t, &mut phi);
@@ -370,7 +370,7 @@ pub fn diagnose<B: Basis>(
             bytes: grid * std::mem::size_of::<f64>() as f64,
         },
     )?;
-    let period = 2.0 * PI / omega;
+    let period = period_of_frequency(omega);
     let mut residual_norm = Vec::with_capacity(problem.system().contact_count());
     let (mut max_penetration, mut min_contact_force) = (0.0_f64, f64::INFINITY);
     for law in 0..problem.system().contact_count() {

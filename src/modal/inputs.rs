@@ -3,15 +3,14 @@
 //! One module, so that every entry point refuses the same inputs with the same errors.
 
 use crate::error::SettingsError;
-use crate::fourier::Basis;
+use crate::fourier::{frequency_of_period, Basis};
 use crate::system::NonsmoothSystem;
-use std::f64::consts::PI;
 
 /// The smallest fundamental frequency `Omega` accepted by the post-processing (about
 /// `3.5e-308`): `2 pi / f64::MAX`, rounded up so that the period `2 pi / Omega` is finite.
 /// It is a normal `f64`, so every frequency at or above it is too (a subnormal one has lost
 /// precision).
-pub const MIN_FREQUENCY: f64 = 2.0 * PI / f64::MAX * (1.0 + 4.0 * f64::EPSILON);
+pub const MIN_FREQUENCY: f64 = frequency_of_period(f64::MAX) * (1.0 + 4.0 * f64::EPSILON);
 
 /// Checks a fundamental frequency: positive and finite ([`SettingsError::NotPositive`]) and
 /// at least [`MIN_FREQUENCY`] ([`SettingsError::FrequencyTooSmall`]).

@@ -89,7 +89,7 @@ pub use crate::error::StabilityError;
 pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
 
 use crate::bar::shortest_travel_time;
-use crate::fourier::Basis;
+use crate::fourier::{period_of_frequency, Basis};
 use crate::modal::inputs::check_frequency;
 use crate::system::BarSystem;
 use crate::verify::{
@@ -97,7 +97,6 @@ use crate::verify::{
 };
 use coordinates::Coordinates;
 use monodromy::{Monodromy, PeriodMap};
-use std::f64::consts::PI;
 
 /// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
 /// `8 n^2` bytes (200 MiB).
@@ -434,7 +433,7 @@ pub fn floquet<B: Basis>(
         }
         .into());
     }
-    let (grid, period) = options.grid(&Model::from_system(system)?, 2.0 * PI / omega)?;
+    let (grid, period) = options.grid(&Model::from_system(system)?, period_of_frequency(omega))?;
     let initial = State::from_harmonic_balance(system, basis, x, omega, 0.0, grid.dt())?;
     floquet_of_state(&initial, period, options)
 }

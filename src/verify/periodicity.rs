@@ -1,7 +1,7 @@
 //! Periodicity defect of a computed periodic orbit.
 
 use super::{march, Grid, MarchOptions, Model, SpringUpdate, State, VerifyError};
-use crate::fourier::Basis;
+use crate::fourier::{period_of_frequency, Basis};
 use crate::system::BarSystem;
 
 /// Options of [`periodicity_check`] and [`periodicity_of_state`].
@@ -248,5 +248,5 @@ pub fn periodicity_check<B: Basis>(
         Grid::new(&model, options.dt)?
     };
     let initial = State::from_harmonic_balance(system, basis, x, omega, 0.0, grid.dt())?;
-    periodicity_of_state(&initial, 2.0 * std::f64::consts::PI / omega, options)
+    periodicity_of_state(&initial, period_of_frequency(omega), options)
 }

@@ -1,16 +1,16 @@
 //! What makes a motion a point of an energy backbone, and the solves at fixed frequency
 //! that start a branch and jump its internal resonances.
 
-use crate::branches::point::{BackbonePoint, PointStatus};
+use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
 use crate::branches::start::{first_solution, StartGuesses, Tally, RIGID_AMPLITUDES};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
+use crate::fourier::period_of_frequency;
 use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
 use crate::modal::signature::harmonic_energies;
 use crate::solve::{NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
-use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// Most steps of a walk across internal resonances in the period
@@ -132,7 +132,7 @@ impl Judge {
         let Some((energies, level)) = verdict else {
             return false;
         };
-        let accepted = self.slopes.step(2.0 * PI / omega, level);
+        let accepted = self.slopes.step(period_of_frequency(omega), level);
         if accepted {
             self.reference = Some(energies);
         }
@@ -219,12 +219,14 @@ impl Judge {
     ) -> Walk {
         let judge = (self.grazing_energy, self.subharmonic);
         let start = self.level(x, omega);
-        let period = 2.0 * PI / omega;
+        // The walk steps in the period: each step's frequency is derived from its period once.
+        let period = period_of_frequency(omega);
         let mut last = (x.to_vec(), start);
         let mut energies = self.reference.clone();
         let mut calm = 0;
         for j in 1..=ESCAPE_PERIODS {
-            let omega = 2.0 * PI / (period * (1.0 - j as f64 / 800.0));
+            let time = Timescale::of_period(period * (1.0 - j as f64 / 800.0));
+            let omega = time.omega;
             let mut y = last.0.clone();
             self.problem.set_parameter(omega);
             let solved = solver.solve(&mut self.problem, &mut y);
@@ -254,7 +256,7 @@ impl Judge {
             }
             let point = BackbonePoint {
                 step: 0,
-                period: 2.0 * PI / omega,
+                period: time.period,
                 omega,
                 energy: level * self.grazing_energy,
                 energy_normalized: level,

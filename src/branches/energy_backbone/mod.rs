@@ -7,7 +7,7 @@ use judge::{Judge, Walk};
 pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOPE_MEMORY};
 
 use crate::branches::level::EnergyLevel;
-use crate::branches::point::{BackbonePoint, PointStatus};
+use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
 use crate::continuation::{
     augmented, geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step,
 };
@@ -140,7 +140,7 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
     settings: HarmonicBalanceSettings,
     options: &EnergyBackboneOptions,
     solver: S,
-    mut observer: impl FnMut(&BackbonePoint) -> ControlFlow<()>,
+    mut observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
     let problem = NonsmoothSystem::new(system, settings)?;
     // A bar that can drift away has no periodic motion that touches it: refused as by the
@@ -191,10 +191,11 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
             };
             let e = energy(system, problem.basis(), x, omega);
             let status = PointStatus::refused_as(p, PointStatus::Rejected);
-            let mut point = BackbonePoint::from_parts(p, (x, omega), e, e_g, status);
+            let time = Timescale::of_frequency(omega);
+            let mut point = BackbonePoint::from_parts(p, (x, time), e, e_g, status);
             point.step += offset;
             segment.see(&point);
-            if observer(&point).is_break() {
+            if observer(point).is_break() {
                 segment.stopped = true;
                 return ControlFlow::Break(());
             }
@@ -211,7 +212,7 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
         let walked = judge.walk(&solver, (&last.0, last.1), grid.end, |mut point| {
             point.step += offset;
             offset += 1;
-            observer(&point)
+            observer(point)
         });
         match walked {
             Walk::Resume(x_new, omega_new) => (x, omega) = (x_new, omega_new),

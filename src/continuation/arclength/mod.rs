@@ -412,7 +412,10 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
             _ => None,
         };
         let direction = secant.unwrap_or_else(|| self.tangent.clone());
-        let (predicted, y, result) = self.predict_and_correct(&self.y.clone(), &direction, self.ds);
+        // The corrector does not read the current point: lend it out instead of copying it.
+        let from = std::mem::take(&mut self.y);
+        let (predicted, y, result) = self.predict_and_correct(&from, &direction, self.ds);
+        self.y = from;
         let info = match result {
             Ok(info) => info,
             Err(e) => return self.reject(predicted[n], RejectReason::Solver(e)),
