@@ -685,6 +685,14 @@ pub enum StabilityError {
         /// Rows of the matrix.
         dimension: usize,
     },
+    /// The singular value decomposition of a correction step did not converge.
+    #[error(
+        "the singular values of the {dimension} x {dimension} correction matrix did not converge"
+    )]
+    NoSingularValues {
+        /// Rows of the matrix.
+        dimension: usize,
+    },
     /// A multiplier or a matrix entry is not finite.
     #[error("the monodromy matrix has a non-finite entry ({value}) in column {column}")]
     NonFinite {

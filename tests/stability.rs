@@ -2,11 +2,14 @@
 //! that can fail, on exact motions (the clamped bar's exact first nonsmooth mode, a motion
 //! that never touches), on harmonic-balance points (gap homogeneity), and on bad input.
 
-use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
+use nonsmooth_modes::branches::{
+    compute, BackboneOptions, Method, ModeBranches, PeriodGrid, Request,
+};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::stability::{
     floquet, floquet_of_state, StabilityError, StabilityOptions, Verdict, MAX_DIMENSION,
 };
+use nonsmooth_modes::system::BarSystem;
 use nonsmooth_modes::verify::{clamped_first_mode, Grid, Model, State};
 use std::f64::consts::PI;
 
@@ -93,24 +96,28 @@ fn a_motion_without_contact_has_every_multiplier_on_the_circle() {
     assert_eq!(f.verdict, Verdict::Stable);
 }
 
+/// The clamped bar at gap `gap` and its `m = 20` points at `T = 3.8, 3.7, ..., 3.4`, with
+/// the multipliers of each when `stability` is given.
+fn clamped_points(gap: f64, stability: Option<StabilityOptions>) -> (BarSystem, ModeBranches) {
+    let system = clamped_bar_with_obstacle(gap).unwrap();
+    let grid = PeriodGrid {
+        start: 3.8,
+        end: 3.4,
+        steps: 5,
+    };
+    let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
+    let mut request = Request::for_method(method).harmonics(20);
+    request.stability = stability;
+    let result = compute(&system, &request).unwrap();
+    (system, result)
+}
+
 /// Every quantity is homogeneous in the gap: the harmonic-balance points of gaps `1e-3` and
 /// `2e-3` at the same periods give the same verdicts and the same largest multipliers to
 /// `1e-6`, and every converged point has a finite `max_multiplier >= 1 - 1e-6`.
 #[test]
 fn verdicts_are_homogeneous_in_the_gap() {
-    let run = |gap: f64| {
-        let system = clamped_bar_with_obstacle(gap).unwrap();
-        let grid = PeriodGrid {
-            start: 3.8,
-            end: 3.4,
-            steps: 5,
-        };
-        let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
-        let request = Request::for_method(method)
-            .harmonics(20)
-            .with_stability(options(100.0));
-        compute(&system, &request).unwrap()
-    };
+    let run = |gap: f64| clamped_points(gap, Some(options(100.0))).1;
     let (a, b) = (run(1e-3), run(2e-3));
     let mut compared = 0;
     for (p, q) in a.converged().zip(b.converged()) {
@@ -138,14 +145,7 @@ fn verdicts_are_homogeneous_in_the_gap() {
 /// energy bound every point whose correction changed the energy is unresolved.
 #[test]
 fn a_verdict_belongs_to_an_orbit_with_the_points_energy() {
-    let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let grid = PeriodGrid {
-        start: 3.8,
-        end: 3.4,
-        steps: 5,
-    };
-    let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
-    let result = compute(&system, &Request::for_method(method).harmonics(20)).unwrap();
+    let (system, result) = clamped_points(1e-3, None);
     let basis = result.problem().basis();
     let (default, strict) = (
         options(100.0),

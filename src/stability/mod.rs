@@ -90,10 +90,10 @@ pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
 
 use crate::bar::shortest_travel_time;
 use crate::fourier::{period_of_frequency, Basis};
-use crate::modal::inputs::check_frequency;
 use crate::system::BarSystem;
 use crate::verify::{
-    march, Condition, Grid, MarchOptions, Model, SpringUpdate, State, VerifyError,
+    advance, check_fundamental_frequency, march, Condition, Grid, MarchOptions, Model,
+    SpringUpdate, State, VerifyError,
 };
 use coordinates::Coordinates;
 use monodromy::{Monodromy, PeriodMap};
@@ -365,7 +365,7 @@ fn open_section(
         snapshot_every: 0,
     };
     match open_instant(initial, period, spring)? {
-        t if t > 0.0 => Ok(march(initial, t, &options)?.final_state),
+        t if t > 0.0 => Ok(advance(initial, t, &options)?),
         _ => Ok(initial.clone()),
     }
 }
@@ -426,13 +426,7 @@ pub fn floquet<B: Basis>(
     options: &StabilityOptions,
 ) -> Result<Floquet, StabilityError> {
     options.check()?;
-    if check_frequency(omega).is_err() {
-        return Err(VerifyError::InvalidParameter {
-            what: "fundamental frequency omega",
-            value: omega,
-        }
-        .into());
-    }
+    check_fundamental_frequency(omega)?;
     let (grid, period) = options.grid(&Model::from_system(system)?, period_of_frequency(omega))?;
     let initial = State::from_harmonic_balance(system, basis, x, omega, 0.0, grid.dt())?;
     floquet_of_state(&initial, period, options)

@@ -2,7 +2,7 @@
 
 use super::coordinates::Coordinates;
 use crate::error::StabilityError;
-use crate::verify::{march, MarchOptions, SpringUpdate, State};
+use crate::verify::{advance, MarchOptions, SpringUpdate, State};
 use faer::Mat;
 
 /// The monodromy matrix `M = dP/dX` of the one-period map `P` at a state, in the coordinates
@@ -34,7 +34,7 @@ impl PeriodMap<'_> {
         let state = self
             .coordinates
             .to_state(self.template.model(), self.template.grid(), v)?;
-        let trajectory = march(
+        let end = advance(
             &state,
             duration,
             &MarchOptions {
@@ -42,8 +42,7 @@ impl PeriodMap<'_> {
                 snapshot_every: 0,
             },
         )?;
-        self.coordinates
-            .of_snapshot(&trajectory.final_state.snapshot(), out);
+        self.coordinates.of_snapshot(&end.snapshot(), out);
         Ok(())
     }
 

@@ -27,14 +27,14 @@ pub(crate) struct Corrected {
     pub shift: f64,
     /// `max |u - u0| / max |u0|` over the nodes: how far it moved the displacement.
     pub displacement_shift: f64,
-    /// Chord iterations taken.
+    /// Newton iterations taken.
     pub iterations: usize,
 }
 
 /// The minimum-norm solution of `a d = b` over the singular values of `a` above
 /// [`SINGULAR_CUTOFF`] of the largest.
 fn truncated_solve(a: &Mat<f64>, b: &[f64]) -> Result<Vec<f64>, StabilityError> {
-    let svd = a.thin_svd().map_err(|_| StabilityError::NoEigenvalues {
+    let svd = a.thin_svd().map_err(|_| StabilityError::NoSingularValues {
         dimension: a.nrows(),
     })?;
     let (u, s, v) = (svd.U(), svd.S(), svd.V());
@@ -100,8 +100,8 @@ impl PeriodMap<'_> {
             let x = &best.x;
             let monodromy = latest.as_ref().unwrap_or(&at_base);
             let n = monodromy.nrows();
-            let step_matrix =
-                Mat::<f64>::from_fn(n, n, |i, j| monodromy[(i, j)] - f64::from(u8::from(i == j)));
+            let identity = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
+            let step_matrix = Mat::<f64>::from_fn(n, n, |i, j| monodromy[(i, j)] - identity(i, j));
             let rhs: Vec<f64> = r.iter().map(|v| -v).collect();
             let d = truncated_solve(&step_matrix, &rhs)?;
             let mut accepted = None;

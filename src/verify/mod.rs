@@ -148,5 +148,6 @@ pub use model::{Condition, Model};
 pub use periodicity::{
     periodicity_check, periodicity_of_state, PeriodicityOptions, PeriodicityReport,
 };
+pub(crate) use state::check_fundamental_frequency;
 pub use state::{BarCells, BarSnapshot, Snapshot, State};
-pub use trajectory::{march, ContactHistory, MarchedEnd, Trajectory};
+pub use trajectory::{advance, march, ContactHistory, MarchedEnd, Trajectory};

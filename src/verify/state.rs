@@ -93,6 +93,17 @@ fn finite(what: &'static str, bar: usize, index: usize, value: f64) -> Result<f6
     }
 }
 
+/// [`VerifyError::InvalidParameter`] unless `omega` is a fundamental frequency the harmonic
+/// balance accepts (finite, positive, not so small that its period overflows).
+pub(crate) fn check_fundamental_frequency(omega: f64) -> Result<(), VerifyError> {
+    check_frequency(omega)
+        .map(|_| ())
+        .map_err(|_| VerifyError::InvalidParameter {
+            what: "fundamental frequency omega",
+            value: omega,
+        })
+}
+
 impl State {
     /// The state with the given cell means of strain and velocity (the most general input:
     /// the march is exact for it).
@@ -223,12 +234,7 @@ impl State {
                 expected,
             });
         }
-        if check_frequency(omega).is_err() {
-            return Err(VerifyError::InvalidParameter {
-                what: "fundamental frequency omega",
-                value: omega,
-            });
-        }
+        check_fundamental_frequency(omega)?;
         if !theta.is_finite() {
             return Err(VerifyError::InvalidParameter {
                 what: "phase theta",

@@ -100,6 +100,80 @@ fn check_work(grid: &Grid, steps: f64) -> Result<(), VerifyError> {
     Ok(())
 }
 
+/// The steps of a march: `full` whole steps, then a partial one when the duration is not a
+/// whole number of steps, checked against the history and work limits.
+struct Plan {
+    full: usize,
+    partial: Option<f64>,
+    planned: f64,
+}
+
+impl Plan {
+    fn new(initial: &State, duration: f64, snapshot_every: usize) -> Result<Self, VerifyError> {
+        let total = duration / initial.grid().dt();
+        if !(duration.is_finite() && duration >= 0.0) {
+            return Err(VerifyError::InvalidParameter {
+                what: "march duration",
+                value: duration,
+            });
+        }
+        let full = (total + 1e-9).floor();
+        let rest = total - full;
+        let partial = (rest > 1e-9).then_some(rest);
+        check_history(initial, full + 1.0, snapshot_every)?;
+        let planned = full + partial.map_or(0.0, |_| 1.0);
+        check_work(initial.grid(), planned)?;
+        Ok(Self {
+            full: full as usize,
+            partial,
+            planned,
+        })
+    }
+
+    fn steps(&self) -> usize {
+        self.full + usize::from(self.partial.is_some())
+    }
+
+    fn fractions(&self) -> impl Iterator<Item = f64> {
+        std::iter::repeat_n(1.0, self.full).chain(self.partial)
+    }
+
+    /// An integrator from `initial`, its waves allowed the pieces this many steps need.
+    fn integrator(&self, initial: &State, options: &MarchOptions) -> Integrator {
+        let mut start = initial.clone();
+        let grid = initial.grid().clone();
+        start.set_resolution(|b| grid.march_resolution(b, self.planned));
+        Integrator::new(start, *options)
+    }
+}
+
+/// The integrator's state, back at the grid's own resolution.
+fn finish(integrator: Integrator) -> State {
+    let mut state = integrator.into_state();
+    let grid = state.grid().clone();
+    state.set_resolution(|b| grid.resolution(b));
+    state
+}
+
+/// The state `duration` after `initial`: the `final_state` of [`march`] bit for bit, without
+/// recording histories. The stability analysis maps states over one period `2 n` times per
+/// monodromy matrix and needs only where they end.
+///
+/// # Errors
+/// As [`march`].
+pub fn advance(
+    initial: &State,
+    duration: f64,
+    options: &MarchOptions,
+) -> Result<State, VerifyError> {
+    let plan = Plan::new(initial, duration, 0)?;
+    let mut integrator = plan.integrator(initial, options);
+    for f in plan.fractions() {
+        integrator.advance_unchecked(f);
+    }
+    Ok(finish(integrator))
+}
+
 /// Marches `initial` over `duration` (full steps, then one partial step for the remainder)
 /// and records end histories, contact histories, energy and snapshots.
 ///
@@ -124,23 +198,8 @@ pub fn march(
     duration: f64,
     options: &MarchOptions,
 ) -> Result<Trajectory, VerifyError> {
-    let dt = initial.grid().dt();
-    let total = duration / dt;
-    if !(duration.is_finite() && duration >= 0.0) {
-        return Err(VerifyError::InvalidParameter {
-            what: "march duration",
-            value: duration,
-        });
-    }
-    let full = (total + 1e-9).floor();
-    let rest = total - full;
-    let partial = (rest > 1e-9).then_some(rest);
-    check_history(initial, full + 1.0, options.snapshot_every)?;
-    let planned = full + partial.map_or(0.0, |_| 1.0);
-    check_work(initial.grid(), planned)?;
-    let full = full as usize;
-    let steps = full + usize::from(partial.is_some());
-    let fractions = std::iter::repeat_n(1.0, full).chain(partial);
+    let plan = Plan::new(initial, duration, options.snapshot_every)?;
+    let steps = plan.steps();
     let model = initial.model().clone();
     let mut ends: Vec<MarchedEnd> = (0..model.bars().len())
         .flat_map(|b| {
@@ -173,11 +232,8 @@ pub fn march(
     }
     let mut max_penetration = initial.penetration();
     let mut min_contact_force = f64::INFINITY;
-    let mut start = initial.clone();
-    let grid = initial.grid().clone();
-    start.set_resolution(|b| grid.march_resolution(b, planned));
-    let mut integrator = Integrator::new(start, *options);
-    for (k, f) in fractions.enumerate() {
+    let mut integrator = plan.integrator(initial, options);
+    for (k, f) in plan.fractions().enumerate() {
         let summary = integrator.advance_unchecked(f);
         let state = integrator.state();
         times.push(summary.time);
@@ -197,8 +253,7 @@ pub fn march(
             snapshots.push(state.snapshot());
         }
     }
-    let mut final_state = integrator.into_state();
-    final_state.set_resolution(|b| grid.resolution(b));
+    let final_state = finish(integrator);
     let scale = if e0 > 0.0 { e0 } else { 1.0 };
     let energy_drift = energy
         .iter()
