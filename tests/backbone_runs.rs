@@ -2,7 +2,7 @@
 //! with its status, and the reason it ended.
 
 use nonsmooth_modes::branches::{
-    compute, BackboneOptions, Method, ModeBranches, PeriodGrid, PointStatus, Request,
+    compute, AutoChoice, BackboneOptions, Method, ModeBranches, PeriodGrid, PointStatus, Request,
 };
 use nonsmooth_modes::continuation::EndReason;
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
@@ -131,9 +131,10 @@ fn a_completed_run_reports_each_step_status() {
 /// ends), whose first family does not leave its grazing point. At most two solves (plain,
 /// then in the smoothing homotopy) per guess: the seed at each frequency and amplitude, and
 /// with each bar's rigid-body motion added at each of the rigid amplitudes. The search is
-/// that of `Method::Auto` at the first period of the system's grid, `0.9875` of its linear
+/// that of the period grid at the first period of the system's grid, `0.9875` of its linear
 /// period; the grid then run from the unsolved seed converges nowhere either, and the run
-/// is refused with the search's error.
+/// is refused with the search's error. `Method::Auto` also reaches a start through the
+/// tethered system (the contacts tied by springs lowered to zero), and keeps that run.
 #[test]
 fn a_failed_start_search_is_bounded_and_says_why() {
     use nonsmooth_modes::bar::Bar;
@@ -165,10 +166,11 @@ fn a_failed_start_search_is_bounded_and_says_why() {
     // (one subset of four laws), at each ratio and amplitude.
     let closing = ratios * amplitudes;
     let guesses = ratios * amplitudes * (1 + bars.len() * RIGID_AMPLITUDES.len()) + closing;
+    let grid = BackboneOptions::for_mode(&system, 1, 1).unwrap();
     let request = Request {
         settings,
         solver: Some(Solver::default()),
-        ..Request::new(1)
+        ..Request::new(1).method(Method::PeriodGrid(grid))
     };
     match compute(&system, &request) {
         Err(Error::Settings(SettingsError::StartNotFound {
@@ -187,4 +189,21 @@ fn a_failed_start_search_is_bounded_and_says_why() {
         }
         other => panic!("{other:?}"),
     }
+    let auto = Request {
+        method: Method::Auto(None),
+        ..request
+    };
+    let run = compute(&system, &auto).unwrap();
+    assert!(
+        matches!(
+            run.auto,
+            Some(AutoChoice::Tethered {
+                searched_good: 0,
+                ..
+            })
+        ),
+        "{:?}",
+        run.auto
+    );
+    assert!(run.converged().count() > 0);
 }

@@ -56,6 +56,13 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
                  branch is followed by pseudo-arclength over its range instead (--method \
                  sequential keeps the period grid)"
             ),
+            Some(AutoChoice::Tethered {
+                good,
+                searched_good,
+            }) => eprintln!(
+                "backbone: the start reached through the tethered system gave {good} good \
+                 points, the searched start {searched_good}: its period grid is kept"
+            ),
             _ => {}
         }
         eprintln!(

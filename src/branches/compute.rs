@@ -8,7 +8,7 @@ use crate::branches::energy_backbone::{energy_backbone_with, EnergyBackboneOptio
 use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request};
 use crate::branches::result::{Annotator, ModeBranches};
-use crate::branches::start::{backbone_start, BackboneStart};
+use crate::branches::start::{backbone_start, tethered_backbone_start, BackboneStart};
 use crate::branches::subharmonic::genuine_subharmonic_backbone_with;
 use crate::continuation::{EndReason, Rejection};
 use crate::error::{Error, SettingsError};
@@ -38,6 +38,10 @@ use std::ops::ControlFlow;
 ///   truncated system's resonances, pseudo-arclength over the grid's range is run too, and
 ///   the run with more good points is returned ([`AutoChoice::GridFellShort`] when it is
 ///   arclength; the other run's points are not returned).
+/// - On a system with floating bars the start is also reached from the tethered system (the
+///   laws next to a floating bar tied by springs, lowered to zero on the way to the grid's
+///   first frequency), and the period grid from it is run too: the run with more good points
+///   is returned ([`AutoChoice::Tethered`] when it is the tethered one).
 ///
 /// The choice is [`ModeBranches::auto`].
 ///
@@ -78,40 +82,87 @@ pub fn compute_observed(
     observer: impl BackboneObserver,
 ) -> Result<ModeBranches, Error> {
     let problem = NonsmoothSystem::new(system, request.settings)?;
-    let (plan, method, auto) = resolve(system, request)?;
-    if let (Plan::Grid(options, _), Some(AutoChoice::EnteredAtGridStart)) = (&plan, auto) {
-        // Auto's period grid is judged before it is shown: a grid that falls short gives
-        // way to pseudo-arclength over its range if that does better.
-        let options = *options;
-        let solver = request.solver_for(&method)?;
-        let (grid, problem) = quiet_run(system, request, (plan, solver), problem)?;
-        let steps = options.grid.steps;
-        let fell_short = grid_fell_short(grid.good, steps, &grid.end);
-        let arclength = ArclengthBackboneOptions::over_grid(&options);
-        let other = Method::Arclength(arclength);
-        let (tried, problem) = if fell_short {
-            let solver = request.solver_for(&other)?;
-            let plan = Plan::Arclength(arclength);
-            let (run, problem) = quiet_run(system, request, (plan, solver), problem)?;
-            (Some(run), problem)
-        } else {
-            (None, problem)
-        };
-        let (run, method, auto) = match tried {
-            Some(run) if run.good > grid.good => {
-                let good = grid.good;
-                (run, other, Some(AutoChoice::GridFellShort { good, steps }))
-            }
-            _ => (grid, method, auto),
-        };
+    let (plan, method, auto, tethered) = resolve(system, request)?;
+    let judged = matches!(
+        (&plan, auto),
+        (Plan::Grid(..), Some(AutoChoice::EnteredAtGridStart))
+    );
+    if !judged && tethered.is_none() {
         let mut annotator = Annotator::new(problem, request, observer);
-        let end = annotator.replay(run.points, run.end);
-        return Ok(annotator.finish((method, auto), run.e_g, end, run.rejected));
+        let solver = request.solver_for(&method)?;
+        let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
+        return Ok(annotator.finish((method, auto), e_g, end, rejected));
     }
+    // Auto's runs are judged before they are shown.
+    let (run, method, auto, problem) = match tethered {
+        None => judged_run(system, request, (plan, method, auto), problem)?,
+        Some((grid, start)) => {
+            let searched = judged_run(system, request, (plan, method, auto), problem.clone());
+            let plan = Plan::Grid(grid, Some(start));
+            let tied = judged_run(
+                system,
+                request,
+                (plan, Method::PeriodGrid(grid), None),
+                problem,
+            );
+            match (searched, tied) {
+                (Ok(a), Ok(b)) if b.0.good <= a.0.good => a,
+                (Ok(a), Err(_)) => a,
+                (Err(e), Err(_)) => return Err(e),
+                (searched, Ok((run, method, _, problem))) => {
+                    let searched_good = searched.map_or(0, |a| a.0.good);
+                    let choice = AutoChoice::Tethered {
+                        good: run.good,
+                        searched_good,
+                    };
+                    (run, method, Some(choice), problem)
+                }
+            }
+        }
+    };
     let mut annotator = Annotator::new(problem, request, observer);
+    let end = annotator.replay(run.points, run.end);
+    Ok(annotator.finish((method, auto), run.e_g, end, run.rejected))
+}
+
+/// A run of `plan` whose points are kept to be judged. A period grid that Auto chose because
+/// its branch is entered at the grid's first period gives way to pseudo-arclength over its
+/// range where it falls short ([`grid_fell_short`]) and arclength does better.
+fn judged_run(
+    system: &BarSystem,
+    request: &Request,
+    (plan, method, auto): (Plan, Method, Option<AutoChoice>),
+    problem: NonsmoothSystem,
+) -> Result<(QuietRun, Method, Option<AutoChoice>, NonsmoothSystem), Error> {
+    let fallback = match (&plan, auto) {
+        (Plan::Grid(options, _), Some(AutoChoice::EnteredAtGridStart)) => Some(*options),
+        _ => None,
+    };
     let solver = request.solver_for(&method)?;
-    let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
-    Ok(annotator.finish((method, auto), e_g, end, rejected))
+    let (grid, problem) = quiet_run(system, request, (plan, solver), problem)?;
+    let Some(options) = fallback else {
+        return Ok((grid, method, auto, problem));
+    };
+    let steps = options.grid.steps;
+    if !grid_fell_short(grid.good, steps, &grid.end) {
+        return Ok((grid, method, auto, problem));
+    }
+    let arclength = ArclengthBackboneOptions::over_grid(&options);
+    let other = Method::Arclength(arclength);
+    let solver = request.solver_for(&other)?;
+    let plan = Plan::Arclength(arclength);
+    let (run, problem) = quiet_run(system, request, (plan, solver), problem)?;
+    Ok(if run.good > grid.good {
+        let good = grid.good;
+        (
+            run,
+            other,
+            Some(AutoChoice::GridFellShort { good, steps }),
+            problem,
+        )
+    } else {
+        (grid, method, auto, problem)
+    })
 }
 
 /// Whether a period grid of `steps` steps with `good` good points (converged, and not
@@ -221,6 +272,16 @@ impl<O: BackboneObserver> PointSink for Forward<'_, O> {
     }
 }
 
+/// What [`compute`] runs for a request: the plan, the method it stands for (as the result
+/// records it), for [`Method::Auto`] why, and on a system with floating bars the period grid
+/// from the tethered start, the other run Auto judges.
+type Resolved = (
+    Plan,
+    Method,
+    Option<AutoChoice>,
+    Option<(BackboneOptions, BackboneStart)>,
+);
+
 /// What [`compute`] runs: the driver, with its options built from the system and the
 /// request's mode and order in them.
 enum Plan {
@@ -240,10 +301,7 @@ enum Plan {
 /// # Errors
 /// No linear mode `i` (or an order 0), invalid settings, and the errors of the start search
 /// of `Auto` but its failure to find a start.
-fn resolve(
-    system: &BarSystem,
-    request: &Request,
-) -> Result<(Plan, Method, Option<AutoChoice>), Error> {
+fn resolve(system: &BarSystem, request: &Request) -> Result<Resolved, Error> {
     let (mode, subharmonic) = (request.mode, request.subharmonic);
     let grid = |o: &BackboneOptions| BackboneOptions {
         mode,
@@ -257,15 +315,22 @@ fn resolve(
     };
     Ok(match &request.method {
         Method::Auto(grid) => return auto(system, request, *grid),
-        Method::PeriodGrid(o) => (Plan::Grid(grid(o), None), Method::PeriodGrid(grid(o)), None),
+        Method::PeriodGrid(o) => (
+            Plan::Grid(grid(o), None),
+            Method::PeriodGrid(grid(o)),
+            None,
+            None,
+        ),
         Method::GenuineSubharmonic(o) => (
             Plan::Genuine(grid(o)),
             Method::GenuineSubharmonic(grid(o)),
+            None,
             None,
         ),
         Method::Arclength(o) => (
             Plan::Arclength(arclength(o)),
             Method::Arclength(arclength(o)),
+            None,
             None,
         ),
         Method::Switch(o, at) => {
@@ -273,7 +338,12 @@ fn resolve(
                 switch: Some(*at),
                 ..arclength(o)
             };
-            (Plan::Arclength(options), Method::Switch(options, *at), None)
+            (
+                Plan::Arclength(options),
+                Method::Switch(options, *at),
+                None,
+                None,
+            )
         }
         Method::Energy(o) => {
             let options = EnergyBackboneOptions {
@@ -281,7 +351,7 @@ fn resolve(
                 subharmonic,
                 ..*o
             };
-            (Plan::Energy(options), Method::Energy(options), None)
+            (Plan::Energy(options), Method::Energy(options), None, None)
         }
     })
 }
@@ -291,7 +361,7 @@ fn auto(
     system: &BarSystem,
     request: &Request,
     given: Option<BackboneOptions>,
-) -> Result<(Plan, Method, Option<AutoChoice>), Error> {
+) -> Result<Resolved, Error> {
     let (mode, order) = (request.mode, request.subharmonic);
     let grid = BackboneOptions {
         mode,
@@ -304,12 +374,16 @@ fn auto(
             Plan::Genuine(grid),
             Method::GenuineSubharmonic(grid),
             choice,
+            None,
         ));
     }
     let first = frequency_of_period(grid.grid.start);
     let solver = request.solver_for(&Method::PeriodGrid(grid))?;
     let settings = request.settings;
     let floor = grid.trivial_energy;
+    let tethered =
+        tethered_backbone_start(system, settings, (mode, order), (first, floor), &solver)
+            .map(|start| (grid, start));
     let start = match backbone_start(system, settings, (mode, order), first, floor, &solver) {
         Ok(start) => start,
         Err(not_found @ Error::Settings(SettingsError::StartNotFound { .. })) => {
@@ -319,6 +393,7 @@ fn auto(
                 Plan::FromSeed(grid, seed, not_found),
                 Method::PeriodGrid(grid),
                 choice,
+                tethered,
             ));
         }
         Err(e) => return Err(e),
@@ -329,6 +404,7 @@ fn auto(
             Plan::Grid(grid, Some(start)),
             Method::PeriodGrid(grid),
             choice,
+            tethered,
         ));
     }
     let options = ArclengthBackboneOptions::over_grid(&grid);
@@ -337,5 +413,6 @@ fn auto(
         Plan::Arclength(options),
         Method::Arclength(options),
         Some(AutoChoice::EnteredAtShorterPeriod { entered_at }),
+        tethered,
     ))
 }

@@ -76,6 +76,18 @@ impl StartGuesses {
         }
     }
 
+    /// The laws whose gap a rigid-body mode moves (those next to a floating bar).
+    pub(crate) fn touched_laws(&self) -> Vec<usize> {
+        let biggest = self
+            .rigid_gaps
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        (0..self.offsets.len())
+            .filter(|&l| self.rigid_gaps[l].iter().any(|v| v.abs() > 1e-9 * biggest))
+            .collect()
+    }
+
     /// The ways of closing every gap next to a floating bar with the seed's motion and the
     /// rigid-body modes: `(s, d)` such that the seed scaled by `s > 0` with the rigid-body
     /// offsets `d` (on the constant term) makes each law of a subset of `R + 1` of the laws
@@ -95,14 +107,7 @@ impl StartGuesses {
     ) -> Vec<(f64, Vec<f64>)> {
         let r = self.rigid.len();
         let laws = self.offsets.len();
-        let biggest = self
-            .rigid_gaps
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-        let touched: Vec<usize> = (0..laws)
-            .filter(|&l| self.rigid_gaps[l].iter().any(|v| v.abs() > 1e-9 * biggest))
-            .collect();
+        let touched = self.touched_laws();
         if r == 0 || touched.len() <= r || touched.len() > MAX_CLOSING_LAWS {
             return Vec::new();
         }

@@ -18,6 +18,7 @@ mod result;
 mod start;
 mod subharmonic;
 mod switch;
+mod tether;
 
 pub use backbone::{
     ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PeriodGrid,

@@ -91,6 +91,16 @@ pub enum AutoChoice {
     /// unsolved seed, and may enter its branch further on (a run that never does ends with
     /// [`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound)).
     NoStartFound,
+    /// The system has floating bars, and the period grid from the start reached through the
+    /// tethered system (every law next to a floating bar tied by a spring, lowered to zero
+    /// along the path) gave more good points than the run from the searched start: its run
+    /// is returned.
+    Tethered {
+        /// Good points of the tethered start's period grid.
+        good: usize,
+        /// Good points of the run from the searched start (0 where it found none).
+        searched_good: usize,
+    },
     /// The branch could be entered only at period `entered_at`, shorter than the grid's
     /// first: pseudo-arclength from the grid's first period, which walks the branch back.
     EnteredAtShorterPeriod {

@@ -4,6 +4,7 @@
 //! along the branch of an arclength backbone whose start lies beyond the asked frequency.
 
 use crate::branches::escape::{EscapingArclength, StallEscape};
+use crate::branches::tether::tethered_start;
 use crate::continuation::{
     Arclength, ArclengthOptions, Branch, ContinuationProblem, Event, Point, Step,
 };
@@ -353,6 +354,35 @@ pub(crate) fn backbone_start<S: NonlinearSolver>(
         trivial_energy * e_g,
     )?;
     Ok(BackboneStart { x, omega })
+}
+
+/// The start of the backbone of NSM `mode` sub `subharmonic` at `omega` reached from the
+/// tethered system ([`tethered_start`]) on a system with floating bars; `None` on a held
+/// system, or where the homotopy does not reach `omega` with a motion of energy above
+/// `trivial_energy * E_g`.
+pub(crate) fn tethered_backbone_start<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: HarmonicBalanceSettings,
+    (mode, subharmonic): (usize, usize),
+    (omega, trivial_energy): (f64, f64),
+    solver: &S,
+) -> Option<BackboneStart> {
+    let guesses = StartGuesses::new(system);
+    if !guesses.floating() {
+        return None;
+    }
+    let mut problem = NonsmoothSystem::new(system, settings).ok()?;
+    let (e_g, _) = grazing_energy(system).ok()?;
+    let laws = guesses.touched_laws();
+    let floor = trivial_energy * e_g;
+    let x = tethered_start(
+        &mut problem,
+        solver,
+        (mode, subharmonic),
+        (omega, &laws),
+        floor,
+    )?;
+    Some(BackboneStart { x, omega })
 }
 
 /// The walk back of an arclength backbone whose start `(x, from)` lies beyond the asked

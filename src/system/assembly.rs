@@ -293,6 +293,19 @@ pub struct BarSystem {
 }
 
 impl BarSystem {
+    /// The same bars with each condition replaced by `f` of it (a condition that keeps the
+    /// ends and the equation count of the one it replaces, as the crate's own auxiliary
+    /// systems do).
+    pub(crate) fn map_conditions(
+        &self,
+        f: impl FnMut(&Arc<dyn BoundaryCondition>) -> Arc<dyn BoundaryCondition>,
+    ) -> BarSystem {
+        BarSystem {
+            bars: self.bars.clone(),
+            conditions: self.conditions.iter().map(f).collect(),
+        }
+    }
+
     /// The bars, in the order they were added.
     pub fn bars(&self) -> &[Bar] {
         &self.bars
