@@ -61,7 +61,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
                 searched_good,
             }) => eprintln!(
                 "backbone: the start reached through the tethered system gave {good} good \
-                 points, the searched start {searched_good}: its period grid is kept"
+                 points, the searched start {searched_good}: its run is kept"
             ),
             _ => {}
         }

@@ -435,14 +435,15 @@ pub(crate) trait PointSink {
 
 /// [`arclength_backbone`] whose observer sees every accepted point and every rejected step,
 /// and may stop the run on either
-/// ([`EndReason::StoppedByObserver`](crate::continuation::EndReason::StoppedByObserver)).
+/// ([`EndReason::StoppedByObserver`](crate::continuation::EndReason::StoppedByObserver));
+/// from `given` where a start was found beforehand, else from the start search's.
 ///
 /// # Errors
 /// Invalid settings or options, a failed seed or a failed start.
 pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
     system: &BarSystem,
     settings: HarmonicBalanceSettings,
-    options: &ArclengthBackboneOptions,
+    (options, given): (&ArclengthBackboneOptions, Option<BackboneStart>),
     solver: S,
     mut observer: impl PointSink,
 ) -> Result<(f64, Branch), Error> {
@@ -472,13 +473,16 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
     }
     let floor = check_trivial_energy(options.trivial_energy)? * e_g;
     // A floating bar's branch may start only at a higher frequency than asked.
-    let (start, omega0) = usable_start(
-        &mut problem,
-        &solver,
-        (start, options.subharmonic),
-        omega0,
-        floor,
-    )?;
+    let (start, omega0) = match given {
+        Some(given) => (given.x, given.omega),
+        None => usable_start(
+            &mut problem,
+            &solver,
+            (start, options.subharmonic),
+            omega0,
+            floor,
+        )?,
+    };
     // Where the start lies beyond the asked frequency, the branch is first walked back to it.
     let (walked, walk_rejections) = walk_back(
         &problem,

@@ -40,8 +40,9 @@ use std::ops::ControlFlow;
 ///   arclength; the other run's points are not returned).
 /// - On a system with floating bars the start is also reached from the tethered system (the
 ///   laws next to a floating bar tied by springs, lowered to zero on the way to the grid's
-///   first frequency), and the period grid from it is run too: the run with more good points
-///   is returned ([`AutoChoice::Tethered`] when it is the tethered one).
+///   first frequency), and the period grid from it is run too (judged as above, arclength
+///   then starting from the same start): the run with more good points is returned
+///   ([`AutoChoice::Tethered`] when it is the tethered one).
 ///
 /// The choice is [`ModeBranches::auto`].
 ///
@@ -99,10 +100,11 @@ pub fn compute_observed(
         Some((grid, start)) => {
             let searched = judged_run(system, request, (plan, method, auto), problem.clone());
             let plan = Plan::Grid(grid, Some(start));
+            let entered = Some(AutoChoice::EnteredAtGridStart);
             let tied = judged_run(
                 system,
                 request,
-                (plan, Method::PeriodGrid(grid), None),
+                (plan, Method::PeriodGrid(grid), entered),
                 problem,
             );
             match (searched, tied) {
@@ -134,13 +136,16 @@ fn judged_run(
     (plan, method, auto): (Plan, Method, Option<AutoChoice>),
     problem: NonsmoothSystem,
 ) -> Result<(QuietRun, Method, Option<AutoChoice>, NonsmoothSystem), Error> {
+    // The arclength fallback starts where the grid did when its start was found beforehand.
     let fallback = match (&plan, auto) {
-        (Plan::Grid(options, _), Some(AutoChoice::EnteredAtGridStart)) => Some(*options),
+        (Plan::Grid(options, start), Some(AutoChoice::EnteredAtGridStart)) => {
+            Some((*options, start.clone()))
+        }
         _ => None,
     };
     let solver = request.solver_for(&method)?;
     let (grid, problem) = quiet_run(system, request, (plan, solver), problem)?;
-    let Some(options) = fallback else {
+    let Some((options, start)) = fallback else {
         return Ok((grid, method, auto, problem));
     };
     let steps = options.grid.steps;
@@ -150,7 +155,7 @@ fn judged_run(
     let arclength = ArclengthBackboneOptions::over_grid(&options);
     let other = Method::Arclength(arclength);
     let solver = request.solver_for(&other)?;
-    let plan = Plan::Arclength(arclength);
+    let plan = Plan::Arclength(arclength, start);
     let (run, problem) = quiet_run(system, request, (plan, solver), problem)?;
     Ok(if run.good > grid.good {
         let good = grid.good;
@@ -243,10 +248,10 @@ fn run_plan<O: BackboneObserver>(
             let (e_g, end) = energy_backbone_with(system, settings, &options, solver, see)?;
             (e_g, end, 0)
         }
-        Plan::Arclength(options) => {
+        Plan::Arclength(options, given) => {
             let seen = Forward(annotator);
             let (e_g, branch) =
-                arclength_backbone_observed(system, settings, &options, solver, seen)?;
+                arclength_backbone_observed(system, settings, (&options, given), solver, seen)?;
             (e_g, branch.end, branch.rejections)
         }
         Plan::FromSeed(options, start, not_found) => {
@@ -292,7 +297,8 @@ enum Plan {
     FromSeed(BackboneOptions, BackboneStart, Error),
     Genuine(BackboneOptions),
     Energy(EnergyBackboneOptions),
-    Arclength(ArclengthBackboneOptions),
+    /// Pseudo-arclength, from a start found beforehand or searching its own.
+    Arclength(ArclengthBackboneOptions, Option<BackboneStart>),
 }
 
 /// The plan of `request`, the method it stands for (as the result records it) and, for
@@ -328,7 +334,7 @@ fn resolve(system: &BarSystem, request: &Request) -> Result<Resolved, Error> {
             None,
         ),
         Method::Arclength(o) => (
-            Plan::Arclength(arclength(o)),
+            Plan::Arclength(arclength(o), None),
             Method::Arclength(arclength(o)),
             None,
             None,
@@ -339,7 +345,7 @@ fn resolve(system: &BarSystem, request: &Request) -> Result<Resolved, Error> {
                 ..arclength(o)
             };
             (
-                Plan::Arclength(options),
+                Plan::Arclength(options, None),
                 Method::Switch(options, *at),
                 None,
                 None,
@@ -410,7 +416,7 @@ fn auto(
     let options = ArclengthBackboneOptions::over_grid(&grid);
     let entered_at = period_of_frequency(start.omega);
     Ok((
-        Plan::Arclength(options),
+        Plan::Arclength(options, None),
         Method::Arclength(options),
         Some(AutoChoice::EnteredAtShorterPeriod { entered_at }),
         tethered,

@@ -91,12 +91,13 @@ pub enum AutoChoice {
     /// unsolved seed, and may enter its branch further on (a run that never does ends with
     /// [`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound)).
     NoStartFound,
-    /// The system has floating bars, and the period grid from the start reached through the
-    /// tethered system (every law next to a floating bar tied by a spring, lowered to zero
-    /// along the path) gave more good points than the run from the searched start: its run
-    /// is returned.
+    /// The system has floating bars, and the run from the start reached through the tethered
+    /// system (every law next to a floating bar tied by a spring, lowered to zero along the
+    /// path) gave more good points than the run from the searched start: its run is
+    /// returned. It is the period grid from that start, or pseudo-arclength from the same
+    /// start where the grid falls short and arclength does better.
     Tethered {
-        /// Good points of the tethered start's period grid.
+        /// Good points of the tethered start's run.
         good: usize,
         /// Good points of the run from the searched start (0 where it found none).
         searched_good: usize,
