@@ -231,11 +231,14 @@ pub(crate) fn tethered_start<S: NonlinearSolver>(
             ok
         })
     };
+    // Amplitudes that solve to a start already tried would follow its path again.
+    let mut tried: Vec<Vec<f64>> = Vec::new();
     for amplitude in TETHERED_AMPLITUDES {
         let mut x: Vec<f64> = seed.iter().map(|v| v * amplitude).collect();
-        if !solve_at(0.0, &mut x) {
+        if !solve_at(0.0, &mut x) || tried.iter().any(|y| same_state(&x, y)) {
             continue;
         }
+        tried.push(x.clone());
         let (mut t, mut dt) = (0.0f64, 0.05f64);
         while t < 1.0 {
             let next = (t + dt).min(1.0);
@@ -255,6 +258,13 @@ pub(crate) fn tethered_start<S: NonlinearSolver>(
         }
     }
     None
+}
+
+/// Whether two solutions are the same state to `1e-6` of the larger's norm.
+fn same_state(x: &[f64], y: &[f64]) -> bool {
+    let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let gap: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
+    norm(&gap) <= 1e-6 * norm(x).max(norm(y))
 }
 
 /// Amplitudes of the tethered start, relative to the grazing seed's (as
@@ -314,6 +324,16 @@ mod tests {
         assert_eq!(f0, f1);
         let moved = f0.iter().zip(&f2).filter(|(a, b)| a != b).count();
         assert!(moved > 0, "a stiff tether changes the laws' rows");
+    }
+
+    #[test]
+    fn states_are_the_same_to_a_millionth() {
+        let x = [1.0, -2.0, 3.0];
+        let near: Vec<f64> = x.iter().map(|v| v * (1.0 + 1e-8)).collect();
+        let far: Vec<f64> = x.iter().map(|v| v * 1.01).collect();
+        assert!(same_state(&x, &near));
+        assert!(!same_state(&x, &far));
+        assert!(same_state(&[0.0; 3], &[0.0; 3]));
     }
 
     #[test]
