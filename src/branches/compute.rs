@@ -319,37 +319,22 @@ fn resolve(system: &BarSystem, request: &Request) -> Result<Resolved, Error> {
         subharmonic,
         ..*o
     };
-    Ok(match &request.method {
+    let (plan, method) = match &request.method {
         Method::Auto(grid) => return auto(system, request, *grid),
-        Method::PeriodGrid(o) => (
-            Plan::Grid(grid(o), None),
-            Method::PeriodGrid(grid(o)),
-            None,
-            None,
-        ),
-        Method::GenuineSubharmonic(o) => (
-            Plan::Genuine(grid(o)),
-            Method::GenuineSubharmonic(grid(o)),
-            None,
-            None,
-        ),
+        Method::PeriodGrid(o) => (Plan::Grid(grid(o), None), Method::PeriodGrid(grid(o))),
+        Method::GenuineSubharmonic(o) => {
+            (Plan::Genuine(grid(o)), Method::GenuineSubharmonic(grid(o)))
+        }
         Method::Arclength(o) => (
             Plan::Arclength(arclength(o), None),
             Method::Arclength(arclength(o)),
-            None,
-            None,
         ),
         Method::Switch(o, at) => {
             let options = ArclengthBackboneOptions {
                 switch: Some(*at),
                 ..arclength(o)
             };
-            (
-                Plan::Arclength(options, None),
-                Method::Switch(options, *at),
-                None,
-                None,
-            )
+            (Plan::Arclength(options, None), Method::Switch(options, *at))
         }
         Method::Energy(o) => {
             let options = EnergyBackboneOptions {
@@ -357,9 +342,11 @@ fn resolve(system: &BarSystem, request: &Request) -> Result<Resolved, Error> {
                 subharmonic,
                 ..*o
             };
-            (Plan::Energy(options), Method::Energy(options), None, None)
+            (Plan::Energy(options), Method::Energy(options))
         }
-    })
+    };
+    // Only Auto chooses, and only Auto has a tethered run to judge.
+    Ok((plan, method, None, None))
 }
 
 /// What [`Method::Auto`] runs on `system` from the period grid `given` ([`compute`]).

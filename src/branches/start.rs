@@ -12,7 +12,7 @@ use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
 use crate::modal::drift::check_held;
 use crate::modal::energy::energy;
-use crate::modal::linear::{branch_seed, grazing_energy, seed_from_mode};
+use crate::modal::linear::{branch_seed, grazing_energy, open_mode, seed_from_mode};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
@@ -371,16 +371,20 @@ pub(crate) fn tethered_backbone_start<S: NonlinearSolver>(
     if !guesses.floating() {
         return None;
     }
-    let mut problem = NonsmoothSystem::new(system, settings).ok()?;
-    let (e_g, _) = grazing_energy(system).ok()?;
+    // The first linear mode is the one `E_g` is found from: not searched twice.
+    let (e_g, first) = grazing_energy(system).ok()?;
+    let original = if mode == 1 {
+        first
+    } else {
+        open_mode(system, mode).ok()?
+    };
     let laws = guesses.touched_laws();
-    let floor = trivial_energy * e_g;
     let x = tethered_start(
-        &mut problem,
+        (system, settings),
         solver,
-        (mode, subharmonic),
+        (&original, subharmonic),
         (omega, &laws),
-        floor,
+        trivial_energy * e_g,
     )?;
     Some(BackboneStart { x, omega })
 }

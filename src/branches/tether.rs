@@ -15,18 +15,16 @@ use crate::bc::{
     BoundaryCondition, LawSamples, LawValue, LinearRows, Observable, Quantity, Term, UnilateralLaw,
 };
 use crate::continuation::ContinuationProblem;
-use crate::fourier::Basis;
 use crate::modal::energy::energy;
-use crate::modal::linear::{
-    natural_frequencies, open_mode, seed_from_mode, ContactState, LinearMode,
-};
+use crate::modal::linear::{natural_frequencies, seed_from_mode, ContactState, LinearMode};
 use crate::solve::{NonlinearSolver, SmoothingHomotopy};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::sync::Arc;
 
-/// A unilateral law with a linear spring of stiffness `kappa` across its gap.
+/// A condition whose unilateral law has a linear spring of stiffness `kappa` across its gap;
+/// its ends, rows and residual are the inner condition's.
 #[derive(Debug)]
-struct TetheredLaw {
+struct Tethered {
     inner: Arc<dyn BoundaryCondition>,
     gap: Observable,
     force: Observable,
@@ -35,15 +33,36 @@ struct TetheredLaw {
     kappa: f64,
 }
 
-impl TetheredLaw {
+impl Tethered {
+    /// `condition` with its law tethered by `kappa` (`None` for a condition without a law).
+    fn new(condition: &Arc<dyn BoundaryCondition>, kappa: f64) -> Option<Self> {
+        let law = condition.unilateral()?;
+        let (gap, mut force) = (law.gap(), law.force());
+        let closure: Vec<Term> = (gap.terms.iter())
+            .filter(|t| is_displacement(t.quantity))
+            .map(|t| Term::new(t.end, t.quantity, -t.coefficient))
+            .collect();
+        let spring = closure
+            .iter()
+            .map(|t| Term::new(t.end, t.quantity, -kappa * t.coefficient));
+        force.terms.extend(spring);
+        Some(Self {
+            inner: condition.clone(),
+            gap,
+            force,
+            closure,
+            kappa,
+        })
+    }
+
     fn inner_law(&self) -> &dyn UnilateralLaw {
         self.inner
             .unilateral()
-            .expect("only conditions with a law are tethered")
+            .expect("built from a condition with a law (Tethered::new)")
     }
 }
 
-impl UnilateralLaw for TetheredLaw {
+impl UnilateralLaw for Tethered {
     fn gap(&self) -> Observable {
         self.gap.clone()
     }
@@ -62,57 +81,29 @@ impl UnilateralLaw for TetheredLaw {
     }
 }
 
-/// A condition whose unilateral law is tethered; its ends and rows are the inner one's.
-#[derive(Debug)]
-struct Tethered {
-    law: TetheredLaw,
-}
-
 impl BoundaryCondition for Tethered {
     fn name(&self) -> String {
-        format!("{} tethered by {}", self.law.inner.name(), self.law.kappa)
+        format!("{} tethered by {}", self.inner.name(), self.kappa)
     }
     fn ends(&self) -> Vec<EndRef> {
-        self.law.inner.ends()
+        self.inner.ends()
     }
     fn linear_rows(&self, omega: f64, stiffness: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
-        self.law.inner.linear_rows(omega, stiffness, rows);
+        self.inner.linear_rows(omega, stiffness, rows);
     }
     fn unilateral(&self) -> Option<&dyn UnilateralLaw> {
-        Some(&self.law)
+        Some(self)
     }
     fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
-        let c: f64 = (self.law.closure.iter())
+        let c: f64 = (self.closure.iter())
             .map(|t| t.coefficient * value(t.end, t.quantity))
             .sum();
-        self.law.inner.stored_energy(value) + 0.5 * self.law.kappa * c * c
+        self.inner.stored_energy(value) + 0.5 * self.kappa * c * c
     }
 }
 
 fn is_displacement(q: Quantity) -> bool {
     matches!(q, Quantity::Displacement | Quantity::OutwardDisplacement)
-}
-
-/// `condition` with its law tethered by `kappa`.
-fn tether(condition: Arc<dyn BoundaryCondition>, kappa: f64) -> Arc<dyn BoundaryCondition> {
-    let law = condition.unilateral().expect("a condition with a law");
-    let (gap, mut force) = (law.gap(), law.force());
-    let closure: Vec<Term> = (gap.terms.iter())
-        .filter(|t| is_displacement(t.quantity))
-        .map(|t| Term::new(t.end, t.quantity, -t.coefficient))
-        .collect();
-    force
-        .terms
-        .extend((closure.iter()).map(|t| Term::new(t.end, t.quantity, -kappa * t.coefficient)));
-    Arc::new(Tethered {
-        law: TetheredLaw {
-            inner: condition,
-            gap,
-            force,
-            closure,
-            kappa,
-        },
-    })
 }
 
 /// `system` with the laws of `laws` (indices among the system's laws) tethered, each by
@@ -134,7 +125,10 @@ fn tethered_system(system: &BarSystem, laws: &[usize], scale: f64) -> BarSystem 
                 bar.stiffness() / bar.length()
             })
             .fold(f64::INFINITY, f64::min);
-        tether(c.clone(), scale * kappa)
+        match Tethered::new(c, scale * kappa) {
+            Some(tethered) => Arc::new(tethered),
+            None => c.clone(),
+        }
     })
 }
 
@@ -157,50 +151,43 @@ impl TetherPath {
     /// system itself took).
     fn problem_at(&self, t: f64) -> Option<NonsmoothSystem> {
         let held = tethered_system(&self.system, &self.laws, self.scale * (1.0 - t));
-        let mut p = NonsmoothSystem::new(&held, self.settings).ok()?;
-        p.set_parameter(self.omega(t));
-        Some(p)
+        NonsmoothSystem::new(&held, self.settings).ok()
     }
     fn omega(&self, t: f64) -> f64 {
         self.from + t * (self.to - self.from)
     }
 }
 
-/// The start of NSM `mode` sub `subharmonic` of `problem`'s system at `omega` reached from
-/// the tethered system's (laws `laws` tethered): the tethered mode that continues `mode`
+/// The start of NSM `original` sub `subharmonic` of `system` at `omega` reached from the
+/// tethered system's (laws `laws` tethered): the tethered mode that continues `original`
 /// (largest overlap of shapes), its branch entered near its grazing point at the same ratio
 /// to its linear frequency as `omega` to the system's, then the tether lowered to zero and the
 /// frequency moved to `omega` together, in steps of the homotopy parameter each solved from
 /// the last (by `solver`, then inside a [`SmoothingHomotopy`]), a step that fails halved.
+/// Returns the solution at `omega` if every step is solved to a motion of energy above
+/// `floor`.
 pub(crate) fn tethered_start<S: NonlinearSolver>(
-    problem: &mut NonsmoothSystem,
+    (system, settings): (&BarSystem, HarmonicBalanceSettings),
     solver: &S,
-    (mode, subharmonic): (usize, usize),
+    (original, subharmonic): (&LinearMode, usize),
     (omega, laws): (f64, &[usize]),
     floor: f64,
 ) -> Option<Vec<f64>> {
-    let system = problem.system().clone();
-    let basis = problem.basis().clone();
-    let settings = HarmonicBalanceSettings {
-        harmonics: basis.harmonics(),
-        samples_per_harmonic: basis.samples() / basis.harmonics(),
-        complementarity: problem.complementarity(),
-        kink_blend: problem.description().kink_blend(),
-    };
-    let original = open_mode(&system, mode).ok()?;
     let shape = original.shapes.first()?;
     let scale = TETHER_SCALE;
-    let held = tethered_system(&system, laws, scale);
+    let held = tethered_system(system, laws, scale);
     let candidates = natural_frequencies(&held, ContactState::Open, 2.0 * original.omega).ok()?;
     let overlap = |s: &[f64]| -> f64 { s.iter().zip(shape).map(|(a, b)| a * b).sum::<f64>().abs() };
     let linear = candidates.into_iter().max_by(|a, b| {
         let of = |m: &LinearMode| m.shapes.first().map_or(0.0, |s| overlap(s));
         of(a).total_cmp(&of(b))
     })?;
-    let ratio = omega / original.omega;
-    let from = linear.omega * ratio;
-    let mut tethered = NonsmoothSystem::new(&held, settings).ok()?;
-    let seed = seed_from_mode(&mut tethered, &linear, subharmonic, from).ok()?;
+    let from = linear.omega * omega / original.omega;
+    // The problems at both ends of the path are built once; those between at each step.
+    let mut first = NonsmoothSystem::new(&held, settings).ok()?;
+    let seed = seed_from_mode(&mut first, &linear, subharmonic, from).ok()?;
+    let mut last = NonsmoothSystem::new(system, settings).ok()?;
+    let basis = last.basis().clone();
     let path = TetherPath {
         system: system.clone(),
         laws: laws.to_vec(),
@@ -211,25 +198,25 @@ pub(crate) fn tethered_start<S: NonlinearSolver>(
     };
     let homotopy = SmoothingHomotopy::new(solver);
     let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
-    let solve_at = |t: f64, x: &mut Vec<f64>| -> bool {
-        let p = if t >= 1.0 {
-            Some(problem.clone())
-        } else {
-            path.problem_at(t)
-        };
-        let Some(mut p) = p else {
-            return false;
-        };
-        let at = path.omega(t);
+    let solve_on = |p: &mut NonsmoothSystem, at: f64, x: &mut Vec<f64>| -> bool {
+        p.set_parameter(at);
         solvers.iter().any(|s| {
             let mut y = x.clone();
-            p.set_parameter(at);
-            let ok = s.solve(&mut p, &mut y).is_ok() && energy(&system, &basis, &y, at) > floor;
+            let ok = s.solve(p, &mut y).is_ok() && energy(system, &basis, &y, at) > floor;
             if ok {
                 *x = y;
             }
             ok
         })
+    };
+    let mut solve_at = |t: f64, x: &mut Vec<f64>| -> bool {
+        if t <= 0.0 {
+            solve_on(&mut first, from, x)
+        } else if t >= 1.0 {
+            solve_on(&mut last, omega, x)
+        } else {
+            (path.problem_at(t)).is_some_and(|mut p| solve_on(&mut p, path.omega(t), x))
+        }
     };
     // Amplitudes that solve to a start already tried would follow its path again.
     let mut tried: Vec<Vec<f64>> = Vec::new();
