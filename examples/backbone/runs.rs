@@ -63,6 +63,16 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
                 "backbone: the start reached through the tethered system gave {good} good \
                  points, the searched start {searched_good}: its run is kept"
             ),
+            Some(AutoChoice::Lifted {
+                harmonics,
+                good,
+                direct_good,
+            }) => eprintln!(
+                "backbone: the runs at {} harmonics gave {direct_good} good points; the run at \
+                 {harmonics} harmonics, each point lifted to {} harmonics and solved there, gave \
+                 {good}: its run is kept",
+                a.settings.harmonics, a.settings.harmonics
+            ),
             _ => {}
         }
         eprintln!(

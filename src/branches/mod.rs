@@ -3,6 +3,7 @@
 //! branches in a system parameter; their starts and defaults derived from the system; and
 //! what a run returns.
 
+mod auto;
 mod backbone;
 mod compute;
 mod convergence;
@@ -11,7 +12,9 @@ mod energy_backbone;
 mod escape;
 mod guesses;
 mod level;
+mod lift;
 mod parameter;
+mod plan;
 mod point;
 mod request;
 mod result;
@@ -38,8 +41,8 @@ pub use point::{Backbone, BackbonePoint, PointStatus};
 pub use request::{AutoChoice, Method, Request, TimeDomainCheck};
 pub use result::ModeBranches;
 pub use start::{
-    BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES,
-    START_RATIOS,
+    BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, MIN_COARSE_HARMONICS, RIGID_AMPLITUDES,
+    START_AMPLITUDES, START_RATIOS,
 };
 pub use subharmonic::{leave_subspace, symmetry_breaking_direction, GENUINE_SHARE, NUDGES};
 pub use switch::SwitchAt;

@@ -97,12 +97,7 @@ impl BackbonePoint {
         status: PointStatus,
     ) -> Self {
         let energy_normalized = energy / e_g;
-        let status = match status {
-            PointStatus::Converged if !(energy.is_finite() && energy_normalized.is_finite()) => {
-                PointStatus::NonFiniteEnergy
-            }
-            status => status,
-        };
+        let status = status.with_energy(energy, energy_normalized);
         Self {
             step: p.step,
             period: time.period,
@@ -180,6 +175,17 @@ pub enum PointStatus {
 }
 
 impl PointStatus {
+    /// The status of a point of energy `energy` and `E / E_g` `energy_normalized`: a
+    /// converged one whose energy is not finite is [`PointStatus::NonFiniteEnergy`].
+    pub(crate) fn with_energy(self, energy: f64, energy_normalized: f64) -> Self {
+        match self {
+            Self::Converged if !(energy.is_finite() && energy_normalized.is_finite()) => {
+                Self::NonFiniteEnergy
+            }
+            status => status,
+        }
+    }
+
     /// The status of a continuation point of a backbone, whose acceptance test is the
     /// trivial-energy floor.
     pub fn of(point: &Point) -> Self {

@@ -108,6 +108,19 @@ pub enum AutoChoice {
         /// Period of the start found.
         entered_at: f64,
     },
+    /// The runs at the request's harmonics fell short (fewer good points than half the
+    /// grid's steps), and `Auto`'s run at `harmonics` (half the request's), each converged
+    /// point lifted to the request's harmonics and solved there at its frequency, gave more
+    /// good points: its run is returned. Its method is the coarse run's; its points keep
+    /// the coarse run's steps and branches.
+    Lifted {
+        /// Harmonics of the coarse run.
+        harmonics: usize,
+        /// Good points of the lifted run.
+        good: usize,
+        /// Good points of the best run at the request's harmonics.
+        direct_good: usize,
+    },
 }
 
 /// The time-domain check of every converged point ([`crate::verify::periodicity_check`]).

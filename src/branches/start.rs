@@ -191,8 +191,11 @@ fn search_guesses<S: NonlinearSolver>(
     })
 }
 
-/// Fewest harmonics at which [`search_coarse`] searches a start: below them the truncated
-/// motion is too coarse to be lifted.
+/// Fewest harmonics of a coarse truncation whose solutions are lifted to more harmonics:
+/// the start search at half the harmonics on a system with floating bars, and the run of
+/// [`Method::Auto`](crate::branches::Method::Auto) at half the harmonics where its runs fall
+/// short ([`compute`](crate::branches::compute)). Below them the truncated motion is too
+/// coarse to be lifted.
 pub const MIN_COARSE_HARMONICS: usize = 10;
 
 /// Where the search at the problem's harmonics `m` found nothing on a system with floating
