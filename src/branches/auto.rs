@@ -23,7 +23,7 @@ use std::ops::ControlFlow;
 pub(crate) type AutoRun = (QuietRun, Method, Option<AutoChoice>, NonsmoothSystem);
 
 /// What [`Method::Auto`] returns for `request` on `system` over the period grid `given`
-/// (`None`: the system's own), as [`compute`](crate::branches::compute)(crate::branches::compute) documents it: the
+/// (`None`: the system's own), as [`compute`](crate::branches::compute) documents it: the
 /// run from the searched start (and, with floating bars, the one from the tethered start)
 /// and, where the better of them falls short (fewer good points than half the grid's
 /// steps) and half the harmonics are at least [`MIN_COARSE_HARMONICS`], the run of `Auto`
@@ -31,7 +31,7 @@ pub(crate) type AutoRun = (QuietRun, Method, Option<AutoChoice>, NonsmoothSystem
 /// good points is kept.
 ///
 /// # Errors
-/// See [`compute`](crate::branches::compute)(crate::branches::compute).
+/// See [`compute`](crate::branches::compute).
 pub(crate) fn judged_auto(
     system: &BarSystem,
     request: &Request,
@@ -45,9 +45,14 @@ pub(crate) fn judged_auto(
         ..given.map_or_else(|| BackboneOptions::for_mode(system, mode, order), Ok)?
     };
     let direct = direct_run(system, request, grid, problem.clone());
-    let direct_good = direct.as_ref().map_or(0, |run| run.0.good);
+    // Only a run that fell short, or a start that was not found, is worth a coarser run.
+    let direct_good = match &direct {
+        Ok((run, ..)) if 2 * run.good < grid.grid.steps => run.good,
+        Err(Error::Settings(SettingsError::StartNotFound { .. })) => 0,
+        _ => return direct,
+    };
     let harmonics = request.settings.harmonics / 2;
-    if 2 * direct_good >= grid.grid.steps || harmonics < MIN_COARSE_HARMONICS.max(order) {
+    if harmonics < MIN_COARSE_HARMONICS.max(order) {
         return direct;
     }
     let coarse = Request {
@@ -186,7 +191,7 @@ type Resolved = (
 );
 
 /// What [`Method::Auto`] runs on `system` over the period grid `grid`
-/// ([`compute`](crate::branches::compute)(crate::branches::compute)).
+/// ([`compute`](crate::branches::compute)).
 fn resolve(
     system: &BarSystem,
     request: &Request,
