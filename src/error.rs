@@ -211,6 +211,15 @@ pub enum SettingsError {
         /// The bars the drift moves (0-based indices).
         bars: Vec<usize>,
     },
+    /// A run cannot be lifted to fewer harmonics than it has
+    /// ([`branches::lift`](crate::branches::lift)).
+    #[error("a run at {from} harmonics cannot be lifted to {to}: lifting adds harmonics")]
+    LiftToFewerHarmonics {
+        /// Harmonics of the run.
+        from: usize,
+        /// Harmonics asked.
+        to: usize,
+    },
     /// The seed's harmonic exceeds the basis.
     #[error(
         "subharmonic {subharmonic} needs harmonic {subharmonic} but the basis stops at {harmonics}"

@@ -5,7 +5,8 @@ use nonsmooth_modes::bc::{
     BoundaryCondition, Contact, LinearRows, Quantity, Robin, Signorini, Term,
 };
 use nonsmooth_modes::branches::{
-    compute, ArclengthBackboneOptions, BackboneOptions, Method, ModeBranches, PeriodGrid, Request,
+    compute, lift, ArclengthBackboneOptions, BackboneOptions, Method, ModeBranches, PeriodGrid,
+    Request,
 };
 use nonsmooth_modes::continuation::{linspace, ContinuationProblem, Sequential, SequentialOptions};
 use nonsmooth_modes::linalg::DenseMatrix;
@@ -992,4 +993,27 @@ fn kink_blend_must_be_non_negative_and_finite() {
         ..Default::default()
     };
     assert!(NonsmoothSystem::new(&system, exact).is_ok());
+}
+
+/// A run is lifted to more harmonics, never fewer, and not to zero: the error names both
+/// numbers.
+#[test]
+fn a_run_is_not_lifted_to_fewer_harmonics() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let grid = PeriodGrid {
+        start: 3.9,
+        end: 3.8,
+        steps: 3,
+    };
+    let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
+    let run = compute(&system, &Request::for_method(method).harmonics(12)).unwrap();
+    match lift(&run, &Request::for_method(method).harmonics(11)) {
+        Err(Error::Settings(SettingsError::LiftToFewerHarmonics { from: 12, to: 11 })) => {}
+        other => panic!("{other:?}"),
+    }
+    let zero = Request::for_method(method).harmonics(0);
+    assert!(lift(&run, &zero).is_err());
+    // The same harmonics solve each point again, where it already is.
+    let same = lift(&run, &Request::for_method(method).harmonics(12)).unwrap();
+    assert_eq!(same.converged().count(), run.converged().count());
 }

@@ -4,11 +4,9 @@
 //! short.
 
 use crate::branches::backbone::{ArclengthBackboneOptions, BackboneOptions};
-use crate::branches::lift::lifted_points;
+use crate::branches::lift::lifted_run;
 use crate::branches::plan::{quiet_run, Plan, QuietRun};
-use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request};
-use crate::branches::result::Annotator;
 use crate::branches::start::{
     backbone_start, tethered_backbone_start, BackboneStart, MIN_COARSE_HARMONICS,
 };
@@ -16,7 +14,6 @@ use crate::continuation::EndReason;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
-use std::ops::ControlFlow;
 
 /// A judged run of [`Method::Auto`]: its points (annotated, not yet shown), the method
 /// that ran, why, and the problem its points solve.
@@ -27,7 +24,7 @@ pub(crate) type AutoRun = (QuietRun, Method, Option<AutoChoice>, NonsmoothSystem
 /// run from the searched start (and, with floating bars, the one from the tethered start)
 /// and, where the better of them falls short (fewer good points than half the grid's
 /// steps) and half the harmonics are at least [`MIN_COARSE_HARMONICS`], the run of `Auto`
-/// at half the harmonics lifted to the request's ([`lifted_points`]): the run with more
+/// at half the harmonics lifted to the request's ([`lift`](crate::branches::lift)): the run with more
 /// good points is kept.
 ///
 /// # Errors
@@ -70,17 +67,9 @@ pub(crate) fn judged_auto(
     let Ok((run, method, _, _)) = judged_auto(system, &coarse, given, coarse_problem) else {
         return direct;
     };
-    let solver = request.solver.unwrap_or_default();
     let floor = grid.trivial_energy * run.e_g;
-    let mut problem = problem;
-    let points = lifted_points(&run.points, &mut problem, &solver, (run.e_g, floor));
-    let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
-    let mut annotator = Annotator::new(problem, request, quiet);
-    for point in points {
-        let _ = annotator.point(point);
-    }
-    let (points, problem) = annotator.into_parts();
-    let lifted = QuietRun::new(points, run.e_g, run.end, run.rejected);
+    let coarse = (&run.points[..], run.e_g, floor);
+    let (lifted, problem) = lifted_run(coarse, (run.end, run.rejected), request, problem);
     if lifted.good <= direct_good {
         return direct;
     }

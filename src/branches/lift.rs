@@ -8,11 +8,93 @@
 //! ([`Layout`](crate::system::Layout)), so a coarse point is a guess at `m` with its higher
 //! harmonics zero, and the solve at `m` adds what the coarse truncation missed.
 
+use crate::branches::backbone::TRIVIAL_ENERGY;
+use crate::branches::plan::QuietRun;
 use crate::branches::point::{BackbonePoint, PointStatus};
-use crate::continuation::{ContinuationProblem, Event};
+use crate::branches::request::Request;
+use crate::branches::result::{Annotator, ModeBranches};
+use crate::continuation::{ContinuationProblem, EndReason, Event};
+use crate::error::{Error, SettingsError};
+use crate::fourier::Basis;
 use crate::modal::energy;
 use crate::solve::{norm, NonlinearSolver, Problem, SmoothingHomotopy, Solver};
 use crate::system::NonsmoothSystem;
+use std::ops::ControlFlow;
+
+/// `run` lifted to the harmonics of `request`: every converged point of `run` (a result of
+/// [`compute`](crate::branches::compute) or of a lift) lifted to
+/// `request.settings.harmonics` harmonics, its higher harmonics zero, and solved there at
+/// its own frequency, by the request's solver (full Newton by default) and then inside a
+/// [`SmoothingHomotopy`], from the lifted point and then from the solution of the point
+/// before it on the same branch. The points are annotated as the request asks (character,
+/// label, time-domain check, multipliers) and keep the run's steps, branches and jumps; a
+/// point that no solve takes to a motion (energy above [`TRIVIAL_ENERGY`] `E_g`) holds its
+/// lifted guess, with the last failure as its status. The result keeps the run's method,
+/// [`Method::Auto`](crate::branches::Method::Auto)'s choice and end reason; the request's
+/// method is not used. This is continuation in the number of harmonics, point by point:
+/// [`Method::Auto`](crate::branches::Method::Auto) uses it where its runs fall short
+/// ([`AutoChoice::Lifted`](crate::branches::AutoChoice::Lifted)); a convergence study in `m`
+/// can chain it.
+///
+/// # Errors
+/// Invalid settings, and [`SettingsError::LiftToFewerHarmonics`] for a request with fewer
+/// harmonics than the run.
+///
+/// # Example
+/// ```
+/// use nonsmooth_modes::branches::{compute, lift, Request};
+/// use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+///
+/// let system = clamped_bar_with_obstacle(1e-3)?;
+/// let coarse = compute(&system, &Request::new(1).harmonics(10))?;
+/// let fine = lift(&coarse, &Request::new(1).harmonics(20))?;
+/// assert_eq!(fine.points.len(), coarse.converged().count());
+/// assert!(fine.converged().count() > 100);
+/// # Ok::<(), nonsmooth_modes::Error>(())
+/// ```
+pub fn lift(run: &ModeBranches, request: &Request) -> Result<ModeBranches, Error> {
+    let (from, to) = (
+        run.problem().basis().harmonics(),
+        request.settings.harmonics,
+    );
+    if to < from {
+        return Err(SettingsError::LiftToFewerHarmonics { from, to }.into());
+    }
+    let problem = NonsmoothSystem::new(run.problem().system(), request.settings)?;
+    let floor = TRIVIAL_ENERGY * run.grazing_energy;
+    let coarse = (&run.points[..], run.grazing_energy, floor);
+    let (lifted, problem) = lifted_run(
+        coarse,
+        (run.end.clone(), run.rejected_steps),
+        request,
+        problem,
+    );
+    let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
+    let mut annotator = Annotator::new(problem, request, quiet);
+    let end = annotator.replay(lifted.points, lifted.end);
+    Ok(annotator.finish((run.method, run.auto), lifted.e_g, end, lifted.rejected))
+}
+
+/// The points of a coarse run `(points, E_g, floor)` lifted to `problem`'s harmonics
+/// ([`lifted_points`]) and annotated as `request` asks, as a run that ended as the coarse
+/// one did (`end`, with its rejected steps); gives the problem back.
+pub(crate) fn lifted_run(
+    (points, e_g, floor): (&[BackbonePoint], f64, f64),
+    (end, rejected): (EndReason, usize),
+    request: &Request,
+    mut problem: NonsmoothSystem,
+) -> (QuietRun, NonsmoothSystem) {
+    let solver = request.solver.unwrap_or_default();
+    let points = lifted_points(points, &mut problem, &solver, (e_g, floor));
+    let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
+    let mut annotator = Annotator::new(problem, request, quiet);
+    for point in points {
+        // A quiet observer never stops the run.
+        let _ = annotator.point(point);
+    }
+    let (points, problem) = annotator.into_parts();
+    (QuietRun::new(points, e_g, end, rejected), problem)
+}
 
 /// Each converged point of `points` (a run on `problem`'s system at fewer harmonics), lifted
 /// to `problem`'s harmonics and solved there at its frequency: by `solver`, then by `solver`
@@ -112,11 +194,25 @@ fn solve_first(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::branches::{compute, BackboneOptions, Method, ModeBranches, PeriodGrid, Request};
+    use crate::branches::backbone::{backbone_with, BackboneOptions, PeriodGrid};
     use crate::reference::clamped_bar_with_obstacle;
+    use crate::system::HarmonicBalanceSettings;
+
+    /// A run of the clamped bar.
+    struct Run {
+        points: Vec<BackbonePoint>,
+        grazing_energy: f64,
+        problem: NonsmoothSystem,
+    }
+
+    impl Run {
+        fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
+            self.points.iter().filter(|p| p.converged)
+        }
+    }
 
     /// The clamped bar's period grid over `3.9 -> 3.5` at `harmonics`.
-    fn clamped_run(harmonics: usize) -> (ModeBranches, BackboneOptions) {
+    fn clamped_run(harmonics: usize) -> (Run, BackboneOptions) {
         let system = clamped_bar_with_obstacle(1e-3).unwrap();
         let grid = BackboneOptions {
             grid: PeriodGrid {
@@ -126,10 +222,24 @@ mod tests {
             },
             ..BackboneOptions::for_mode(&system, 1, 1).unwrap()
         };
-        let request = Request::new(1)
-            .harmonics(harmonics)
-            .method(Method::PeriodGrid(grid));
-        (compute(&system, &request).unwrap(), grid)
+        let settings = HarmonicBalanceSettings {
+            harmonics,
+            ..HarmonicBalanceSettings::default()
+        };
+        let mut points = Vec::new();
+        let see = |p| {
+            points.push(p);
+            ControlFlow::Continue(())
+        };
+        let (grazing_energy, _) =
+            backbone_with(&system, settings, &grid, Solver::default(), see).unwrap();
+        let problem = NonsmoothSystem::new(&system, settings).unwrap();
+        let run = Run {
+            points,
+            grazing_energy,
+            problem,
+        };
+        (run, grid)
     }
 
     /// The clamped bar's points at 10 harmonics, lifted to 20, are the points the grid at
@@ -144,7 +254,7 @@ mod tests {
         let mut failed = points[4].clone();
         failed.converged = false;
         points.push(failed);
-        let mut problem = fine.problem().clone();
+        let mut problem = fine.problem.clone();
         let e_g = coarse.grazing_energy;
         let floor = grid.trivial_energy * e_g;
         let lifted = lifted_points(&points, &mut problem, &Solver::default(), (e_g, floor));
@@ -170,7 +280,7 @@ mod tests {
     #[test]
     fn a_point_that_does_not_solve_keeps_its_guess() {
         let ((coarse, _), (fine, _)) = (clamped_run(10), clamped_run(20));
-        let mut problem = fine.problem().clone();
+        let mut problem = fine.problem.clone();
         let e_g = coarse.grazing_energy;
         // Every motion lies below an infinite floor: each solve collapses "to rest".
         let points = &coarse.points[..1];

@@ -36,6 +36,7 @@ pub use energy_backbone::{
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use level::EnergyLevel;
+pub use lift::lift;
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
 pub use request::{AutoChoice, Method, Request, TimeDomainCheck};

@@ -11,7 +11,7 @@ use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
-    compute, compute_observed, parameter_branch, ArclengthBackboneOptions, BackboneObserver,
+    compute, compute_observed, lift, parameter_branch, ArclengthBackboneOptions, BackboneObserver,
     BackboneOptions, BackbonePoint, EnergyBackboneOptions, EnergyGrid, Method, ParameterSteps,
     PeriodGrid, PointStatus, Request, SwitchAt, TimeDomainCheck,
 };
@@ -83,6 +83,15 @@ pub(crate) fn backbone_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     let run = typed(c, "backbone", run)?;
     // A run stopped by the observer says so (the plain form's observer never stops it).
     c.mode_branches("backbone", &run, stopped);
+    // Lifted to any settings (fewer harmonics, zero, more), it keeps its end reason.
+    if d.flag("lift", 0.3) {
+        let lifted = Request {
+            settings: settings(d),
+            ..request.clone()
+        };
+        let lifted = typed(c, "lift", lift(&run, &lifted))?;
+        c.mode_branches("lift", &lifted, stopped);
+    }
     // The observer saw the points the run returns.
     if observed && points != run.points {
         c.no_end.push(format!(

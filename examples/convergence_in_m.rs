@@ -1,0 +1,233 @@
+//! Convergence in the number of harmonics `m` of the two first nonsmooth modes with an exact
+//! family: the clamped bar facing a wall, `E/E_g = 8 / (pi^2 (T - 3)^2)`, and the free–free
+//! bar between two walls, `E/E_g = 8 / (pi^2 (2T - 3)^2)` (unit bars, gaps `1e-3`).
+//!
+//! ```text
+//! cargo run --release --example convergence_in_m -- [--harmonics 20,40,80,160] [--out FILE]
+//! ```
+//!
+//! Each way of computing the branch runs over the system's own period grid
+//! ([`BackboneOptions::for_mode`], 181 periods) at each `m`:
+//! - `grid`: the period grid ([`Method::PeriodGrid`]);
+//! - `auto`: [`Method::Auto`] (which lifts its run at `m / 2` where its own falls short);
+//! - `auto-checked`: the same with the time-domain check ([`TimeDomainCheck::for_system`]),
+//!   by which `Auto` judges its runs;
+//! - `lifted`: the grid at the first `m`, each later `m` lifted from the one before it
+//!   ([`lift`]): continuation in `m`, point by point;
+//! - `exact-start` (the clamped bar only): Newton at each period from the exact family's own
+//!   Fourier coefficients, what the truncated equations give near the exact motion.
+//!
+//! For each it prints and writes (CSV, `--out`, default `convergence_in_m.csv`; columns
+//! `system,way,harmonics,converged,within_2,within_5,median_error`) the converged points,
+//! the share of the 181 periods whose nearest converged point (within half a grid step) lies
+//! within 2 % and within 5 % of the exact `E/E_g`, and the median relative error of the
+//! converged points.
+
+use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::branches::{
+    compute, lift, BackboneOptions, Method, ModeBranches, PeriodGrid, Request, TimeDomainCheck,
+};
+use nonsmooth_modes::continuation::ContinuationProblem;
+use nonsmooth_modes::modal::energy;
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, clamped_grazing_energy, ClampedFirstMode,
+};
+use nonsmooth_modes::solve::{NonlinearSolver, Solver};
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, NonsmoothSystem};
+use std::error::Error;
+use std::f64::consts::PI;
+use std::io::Write;
+
+const GAP: f64 = 1e-3;
+
+/// One system with an exact family: its name, the system and the family's `E/E_g` at `T`.
+struct Family {
+    name: &'static str,
+    system: BarSystem,
+    exact: fn(f64) -> f64,
+}
+
+/// One row of the table.
+struct Row {
+    converged: usize,
+    within_2: f64,
+    within_5: f64,
+    median_error: f64,
+}
+
+impl Row {
+    /// The row of the converged points `(T, E/E_g)` against `exact` over the periods of
+    /// `grid`. A period counts as within a bound when the point nearest to it (within half a
+    /// grid step) is: a run that is not a grid (arclength) has points at other periods, and
+    /// some periods with several.
+    fn of(
+        points: impl Iterator<Item = (f64, f64)>,
+        exact: fn(f64) -> f64,
+        grid: PeriodGrid,
+    ) -> Self {
+        let error = |(t, e): (f64, f64)| (e / exact(t) - 1.0).abs();
+        let points: Vec<(f64, f64)> = points.collect();
+        let mut errors: Vec<f64> = points.iter().map(|&p| error(p)).collect();
+        errors.sort_by(f64::total_cmp);
+        let step = (grid.end - grid.start).abs() / (grid.steps - 1) as f64;
+        let nearest: Vec<Option<f64>> = (0..grid.steps)
+            .map(|k| {
+                let period =
+                    grid.start + (grid.end - grid.start) * k as f64 / (grid.steps - 1) as f64;
+                let distance = |p: &&(f64, f64)| (p.0 - period).abs();
+                (points.iter())
+                    .filter(|p| distance(p) <= 0.5 * step)
+                    .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+                    .map(|&p| error(p))
+            })
+            .collect();
+        let share = |bound: f64| {
+            nearest
+                .iter()
+                .filter(|e| e.is_some_and(|e| e < bound))
+                .count() as f64
+                / grid.steps as f64
+        };
+        Self {
+            converged: errors.len(),
+            within_2: share(0.02),
+            within_5: share(0.05),
+            median_error: errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN),
+        }
+    }
+}
+
+fn free_free_between_walls() -> Result<BarSystem, Box<dyn Error>> {
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::new(1.0, 1.0, 1.0)?);
+    b.signorini(bar.left(), GAP)?;
+    b.signorini(bar.right(), GAP)?;
+    Ok(b.build()?)
+}
+
+/// The converged points of a run, as `(T, E/E_g)`.
+fn converged(run: &ModeBranches) -> impl Iterator<Item = (f64, f64)> + '_ {
+    run.converged().map(|p| (p.period, p.energy_normalized))
+}
+
+/// `(T, E/E_g)` where Newton converges at the periods of `grid` from the clamped bar's exact
+/// coefficients at the request's harmonics.
+fn exact_start(
+    system: &BarSystem,
+    grid: &BackboneOptions,
+    request: &Request,
+) -> Result<Vec<(f64, f64)>, Box<dyn Error>> {
+    let mut problem = NonsmoothSystem::new(system, request.settings)?;
+    let harmonics = request.settings.harmonics;
+    let solver = Solver::default();
+    let e_g = clamped_grazing_energy(GAP);
+    let steps = grid.grid.steps;
+    let mut points = Vec::new();
+    for k in 0..steps {
+        let t = grid.grid.start + (grid.grid.end - grid.grid.start) * k as f64 / (steps - 1) as f64;
+        let mut x = ClampedFirstMode::new(GAP, t).unknowns(harmonics);
+        let omega = 2.0 * PI / t;
+        problem.set_parameter(omega);
+        if solver.solve(&mut problem, &mut x).is_ok() {
+            let e = energy(system, problem.basis(), &x, omega);
+            points.push((t, e / e_g));
+        }
+    }
+    Ok(points)
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let mut harmonics = vec![20, 40, 80, 160];
+    let mut out = String::from("convergence_in_m.csv");
+    let mut args = std::env::args().skip(1);
+    while let Some(flag) = args.next() {
+        let value = args.next().ok_or_else(|| format!("{flag} needs a value"))?;
+        match flag.as_str() {
+            "--harmonics" => {
+                harmonics = (value.split(','))
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()?;
+            }
+            "--out" => out = value,
+            _ => return Err(format!("unknown flag {flag}").into()),
+        }
+    }
+    if harmonics.is_empty() || harmonics.windows(2).any(|w| w[1] < w[0]) {
+        return Err("--harmonics takes increasing numbers".into());
+    }
+    let families = [
+        Family {
+            name: "clamped",
+            system: clamped_bar_with_obstacle(GAP)?,
+            exact: |t| 8.0 / (PI * PI * (t - 3.0).powi(2)),
+        },
+        Family {
+            name: "free-free-walls",
+            system: free_free_between_walls()?,
+            exact: |t| 8.0 / (PI * PI * (2.0 * t - 3.0).powi(2)),
+        },
+    ];
+    let mut csv = std::fs::File::create(&out)?;
+    writeln!(
+        csv,
+        "system,way,harmonics,converged,within_2,within_5,median_error"
+    )?;
+    println!("| system | way | m | converged | within 2 % | within 5 % | median error |");
+    println!("|---|---|---|---|---|---|---|");
+    for family in &families {
+        let grid = BackboneOptions::for_mode(&family.system, 1, 1)?;
+        let mut lifted: Option<ModeBranches> = None;
+        for &m in &harmonics {
+            let request = Request::new(1).harmonics(m);
+            let mut rows = Vec::new();
+            let by_grid = compute(
+                &family.system,
+                &request.clone().method(Method::PeriodGrid(grid)),
+            )?;
+            rows.push((
+                "grid",
+                Row::of(converged(&by_grid), family.exact, grid.grid),
+            ));
+            let auto = compute(&family.system, &request)?;
+            rows.push(("auto", Row::of(converged(&auto), family.exact, grid.grid)));
+            let check = TimeDomainCheck::for_system(&family.system);
+            let checked = compute(&family.system, &request.clone().checked(check))?;
+            rows.push((
+                "auto-checked",
+                Row::of(converged(&checked), family.exact, grid.grid),
+            ));
+            let chained = match lifted.take() {
+                Some(run) => lift(&run, &request)?,
+                None => by_grid,
+            };
+            rows.push((
+                "lifted",
+                Row::of(converged(&chained), family.exact, grid.grid),
+            ));
+            lifted = Some(chained);
+            if family.name == "clamped" {
+                let points = exact_start(&family.system, &grid, &request)?;
+                rows.push((
+                    "exact-start",
+                    Row::of(points.into_iter(), family.exact, grid.grid),
+                ));
+            }
+            for (way, r) in rows {
+                let name = family.name;
+                println!(
+                    "| {name} | {way} | {m} | {} | {:.0} % | {:.0} % | {:.3} |",
+                    r.converged,
+                    100.0 * r.within_2,
+                    100.0 * r.within_5,
+                    r.median_error
+                );
+                writeln!(
+                    csv,
+                    "{name},{way},{m},{},{},{},{}",
+                    r.converged, r.within_2, r.within_5, r.median_error
+                )?;
+            }
+        }
+    }
+    Ok(())
+}
