@@ -14,6 +14,12 @@
 //!   by which `Auto` judges its runs;
 //! - `lifted`: the grid at the first `m`, each later `m` lifted from the one before it
 //!   ([`lift`]): continuation in `m`, point by point;
+//! - `corrected`: the grid's points whose state the exact time-domain map's shooting (the
+//!   correction before the Floquet multipliers, [`StabilityOptions::default`]) brings to a
+//!   periodic orbit, at the energy of that orbit;
+//! - `lifted-corrected`: the lifted run's points corrected so;
+//! - `extrapolated`: `2 E_m - E_(m/2)` from the lifted runs at `m` and `m / 2`, at the
+//!   periods where both converged (an error decaying like `1/m`);
 //! - `exact-start` (the clamped bar only): Newton at each period from the exact family's own
 //!   Fourier coefficients, what the truncated equations give near the exact motion.
 //!
@@ -33,7 +39,9 @@ use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, clamped_grazing_energy, ClampedFirstMode,
 };
 use nonsmooth_modes::solve::{NonlinearSolver, Solver};
+use nonsmooth_modes::stability::{StabilityOptions, Verdict};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, NonsmoothSystem};
+use std::collections::HashMap;
 use std::error::Error;
 use std::f64::consts::PI;
 use std::io::Write;
@@ -110,6 +118,28 @@ fn converged(run: &ModeBranches) -> impl Iterator<Item = (f64, f64)> + '_ {
     run.converged().map(|p| (p.period, p.energy_normalized))
 }
 
+/// `(T, E/E_g (1 + c))` of the converged points whose state the exact time-domain map's
+/// shooting corrected to a periodic orbit (a verdict other than unresolved), `c` the
+/// correction's relative change of energy.
+fn corrected(run: &ModeBranches) -> impl Iterator<Item = (f64, f64)> + '_ {
+    run.converged().filter_map(|p| match &p.stability {
+        Some(Ok(f)) if f.verdict != Verdict::Unresolved => {
+            Some((p.period, p.energy_normalized * (1.0 + f.energy_correction)))
+        }
+        _ => None,
+    })
+}
+
+/// `(T, 2 E_m - E_m')` at the periods where both `coarse` (at `m'`) and `fine` (at
+/// `m = 2 m'`) converged: Richardson's extrapolation for an error that decays like `1/m`.
+fn extrapolated(coarse: &ModeBranches, fine: &ModeBranches) -> std::vec::IntoIter<(f64, f64)> {
+    let before: HashMap<u64, f64> = converged(coarse).map(|(t, e)| (t.to_bits(), e)).collect();
+    let points: Vec<(f64, f64)> = converged(fine)
+        .filter_map(|(t, e)| before.get(&t.to_bits()).map(|e0| (t, 2.0 * e - e0)))
+        .collect();
+    points.into_iter()
+}
+
 /// `(T, E/E_g)` where Newton converges at the periods of `grid` from the clamped bar's exact
 /// coefficients at the request's harmonics.
 fn exact_start(
@@ -182,11 +212,16 @@ fn main() -> Result<(), Box<dyn Error>> {
             let mut rows = Vec::new();
             let by_grid = compute(
                 &family.system,
-                &request.clone().method(Method::PeriodGrid(grid)),
+                &(request.clone().method(Method::PeriodGrid(grid)))
+                    .with_stability(StabilityOptions::default()),
             )?;
             rows.push((
                 "grid",
                 Row::of(converged(&by_grid), family.exact, grid.grid),
+            ));
+            rows.push((
+                "corrected",
+                Row::of(corrected(&by_grid), family.exact, grid.grid),
             ));
             let auto = compute(&family.system, &request)?;
             rows.push(("auto", Row::of(converged(&auto), family.exact, grid.grid)));
@@ -196,14 +231,23 @@ fn main() -> Result<(), Box<dyn Error>> {
                 "auto-checked",
                 Row::of(converged(&checked), family.exact, grid.grid),
             ));
-            let chained = match lifted.take() {
-                Some(run) => lift(&run, &request)?,
+            let stability = request.clone().with_stability(StabilityOptions::default());
+            let chained = match &lifted {
+                Some(run) => lift(run, &stability)?,
                 None => by_grid,
             };
             rows.push((
                 "lifted",
                 Row::of(converged(&chained), family.exact, grid.grid),
             ));
+            rows.push((
+                "lifted-corrected",
+                Row::of(corrected(&chained), family.exact, grid.grid),
+            ));
+            if let Some(coarse) = &lifted {
+                let points = extrapolated(coarse, &chained);
+                rows.push(("extrapolated", Row::of(points, family.exact, grid.grid)));
+            }
             lifted = Some(chained);
             if family.name == "clamped" {
                 let points = exact_start(&family.system, &grid, &request)?;
