@@ -27,7 +27,7 @@
 //! `system,way,harmonics,converged,within_2,within_5,median_error`) the converged points,
 //! the share of the 181 periods whose nearest converged point (within half a grid step) lies
 //! within 2 % and within 5 % of the exact `E/E_g`, and the median relative error of the
-//! converged points.
+//! converged points (empty without one).
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
@@ -60,7 +60,8 @@ struct Row {
     converged: usize,
     within_2: f64,
     within_5: f64,
-    median_error: f64,
+    /// `None` without a converged point.
+    median_error: Option<f64>,
 }
 
 impl Row {
@@ -100,7 +101,7 @@ impl Row {
             converged: errors.len(),
             within_2: share(0.02),
             within_5: share(0.05),
-            median_error: errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN),
+            median_error: errors.get(errors.len() / 2).copied(),
         }
     }
 }
@@ -258,17 +259,21 @@ fn main() -> Result<(), Box<dyn Error>> {
             }
             for (way, r) in rows {
                 let name = family.name;
+                // No converged point has no median: a dash in the table, empty in the CSV.
+                let (shown, written) = match r.median_error {
+                    Some(e) => (format!("{e:.3}"), e.to_string()),
+                    None => ("—".to_string(), String::new()),
+                };
                 println!(
-                    "| {name} | {way} | {m} | {} | {:.0} % | {:.0} % | {:.3} |",
+                    "| {name} | {way} | {m} | {} | {:.0} % | {:.0} % | {shown} |",
                     r.converged,
                     100.0 * r.within_2,
                     100.0 * r.within_5,
-                    r.median_error
                 );
                 writeln!(
                     csv,
-                    "{name},{way},{m},{},{},{},{}",
-                    r.converged, r.within_2, r.within_5, r.median_error
+                    "{name},{way},{m},{},{},{},{written}",
+                    r.converged, r.within_2, r.within_5
                 )?;
             }
         }
