@@ -31,9 +31,9 @@
 
 use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
-    compute, lift, BackboneOptions, Method, ModeBranches, PeriodGrid, Request, TimeDomainCheck,
+    compute, lift, BackboneOptions, Method, ModeBranches, Request, TimeDomainCheck,
 };
-use nonsmooth_modes::continuation::ContinuationProblem;
+use nonsmooth_modes::continuation::{linspace, ContinuationProblem};
 use nonsmooth_modes::modal::energy;
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, clamped_grazing_energy, ClampedFirstMode,
@@ -65,37 +65,27 @@ struct Row {
 }
 
 impl Row {
-    /// The row of the converged points `(T, E/E_g)` against `exact` over the periods of
-    /// `grid`. A period counts as within a bound when the point nearest to it (within half a
-    /// grid step) is: a run that is not a grid (arclength) has points at other periods, and
+    /// The row of the converged points `(T, E/E_g)` against `exact` over the grid's
+    /// `periods`. A period counts as within a bound when the point nearest to it (within half
+    /// a grid step) is: a run that is not a grid (arclength) has points at other periods, and
     /// some periods with several.
-    fn of(
-        points: impl Iterator<Item = (f64, f64)>,
-        exact: fn(f64) -> f64,
-        grid: PeriodGrid,
-    ) -> Self {
-        let error = |(t, e): (f64, f64)| (e / exact(t) - 1.0).abs();
-        let points: Vec<(f64, f64)> = points.collect();
-        let mut errors: Vec<f64> = points.iter().map(|&p| error(p)).collect();
+    fn of(points: &[(f64, f64)], exact: fn(f64) -> f64, periods: &[f64]) -> Self {
+        let error = |&(t, e): &(f64, f64)| (e / exact(t) - 1.0).abs();
+        let mut errors: Vec<f64> = points.iter().map(error).collect();
         errors.sort_by(f64::total_cmp);
-        let step = (grid.end - grid.start).abs() / (grid.steps - 1) as f64;
-        let nearest: Vec<Option<f64>> = (0..grid.steps)
-            .map(|k| {
-                let period =
-                    grid.start + (grid.end - grid.start) * k as f64 / (grid.steps - 1) as f64;
+        let half_step = 0.5 * (periods[1] - periods[0]).abs();
+        let nearest: Vec<Option<f64>> = (periods.iter())
+            .map(|&period| {
                 let distance = |p: &&(f64, f64)| (p.0 - period).abs();
                 (points.iter())
-                    .filter(|p| distance(p) <= 0.5 * step)
+                    .filter(|p| distance(p) <= half_step)
                     .min_by(|a, b| distance(a).total_cmp(&distance(b)))
-                    .map(|&p| error(p))
+                    .map(error)
             })
             .collect();
         let share = |bound: f64| {
-            nearest
-                .iter()
-                .filter(|e| e.is_some_and(|e| e < bound))
-                .count() as f64
-                / grid.steps as f64
+            let within = nearest.iter().filter(|e| e.is_some_and(|e| e < bound));
+            within.count() as f64 / periods.len() as f64
         };
         Self {
             converged: errors.len(),
@@ -115,48 +105,50 @@ fn free_free_between_walls() -> Result<BarSystem, Box<dyn Error>> {
 }
 
 /// The converged points of a run, as `(T, E/E_g)`.
-fn converged(run: &ModeBranches) -> impl Iterator<Item = (f64, f64)> + '_ {
-    run.converged().map(|p| (p.period, p.energy_normalized))
+fn converged(run: &ModeBranches) -> Vec<(f64, f64)> {
+    run.converged()
+        .map(|p| (p.period, p.energy_normalized))
+        .collect()
 }
 
 /// `(T, E/E_g (1 + c))` of the converged points whose state the exact time-domain map's
 /// shooting corrected to a periodic orbit (a verdict other than unresolved), `c` the
 /// correction's relative change of energy.
-fn corrected(run: &ModeBranches) -> impl Iterator<Item = (f64, f64)> + '_ {
-    run.converged().filter_map(|p| match &p.stability {
-        Some(Ok(f)) if f.verdict != Verdict::Unresolved => {
-            Some((p.period, p.energy_normalized * (1.0 + f.energy_correction)))
-        }
-        _ => None,
-    })
+fn corrected(run: &ModeBranches) -> Vec<(f64, f64)> {
+    (run.converged())
+        .filter_map(|p| match &p.stability {
+            Some(Ok(f)) if f.verdict != Verdict::Unresolved => {
+                Some((p.period, p.energy_normalized * (1.0 + f.energy_correction)))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 /// `(T, 2 E_m - E_m')` at the periods where both `coarse` (at `m'`) and `fine` (at
 /// `m = 2 m'`) converged: Richardson's extrapolation for an error that decays like `1/m`.
-fn extrapolated(coarse: &ModeBranches, fine: &ModeBranches) -> std::vec::IntoIter<(f64, f64)> {
-    let before: HashMap<u64, f64> = converged(coarse).map(|(t, e)| (t.to_bits(), e)).collect();
-    let points: Vec<(f64, f64)> = converged(fine)
-        .filter_map(|(t, e)| before.get(&t.to_bits()).map(|e0| (t, 2.0 * e - e0)))
+fn extrapolated(coarse: &ModeBranches, fine: &ModeBranches) -> Vec<(f64, f64)> {
+    let before: HashMap<u64, f64> = (converged(coarse).into_iter())
+        .map(|(t, e)| (t.to_bits(), e))
         .collect();
-    points.into_iter()
+    (converged(fine).into_iter())
+        .filter_map(|(t, e)| before.get(&t.to_bits()).map(|e0| (t, 2.0 * e - e0)))
+        .collect()
 }
 
-/// `(T, E/E_g)` where Newton converges at the periods of `grid` from the clamped bar's exact
+/// `(T, E/E_g)` where Newton converges at `periods` from the clamped bar's exact
 /// coefficients at the request's harmonics.
 fn exact_start(
     system: &BarSystem,
-    grid: &BackboneOptions,
+    periods: &[f64],
     request: &Request,
 ) -> Result<Vec<(f64, f64)>, Box<dyn Error>> {
     let mut problem = NonsmoothSystem::new(system, request.settings)?;
-    let harmonics = request.settings.harmonics;
     let solver = Solver::default();
     let e_g = clamped_grazing_energy(GAP);
-    let steps = grid.grid.steps;
     let mut points = Vec::new();
-    for k in 0..steps {
-        let t = grid.grid.start + (grid.grid.end - grid.grid.start) * k as f64 / (steps - 1) as f64;
-        let mut x = ClampedFirstMode::new(GAP, t).unknowns(harmonics);
+    for &t in periods {
+        let mut x = ClampedFirstMode::new(GAP, t).unknowns(request.settings.harmonics);
         let omega = 2.0 * PI / t;
         problem.set_parameter(omega);
         if solver.solve(&mut problem, &mut x).is_ok() {
@@ -207,54 +199,39 @@ fn main() -> Result<(), Box<dyn Error>> {
     println!("|---|---|---|---|---|---|---|");
     for family in &families {
         let grid = BackboneOptions::for_mode(&family.system, 1, 1)?;
+        let periods = linspace(grid.grid.start, grid.grid.end, grid.grid.steps)?;
+        let row = |points: Vec<(f64, f64)>| Row::of(&points, family.exact, &periods);
         let mut lifted: Option<ModeBranches> = None;
         for &m in &harmonics {
             let request = Request::new(1).harmonics(m);
-            let mut rows = Vec::new();
+            let stability = request.clone().with_stability(StabilityOptions::default());
+            let check = TimeDomainCheck::for_system(&family.system);
             let by_grid = compute(
                 &family.system,
-                &(request.clone().method(Method::PeriodGrid(grid)))
-                    .with_stability(StabilityOptions::default()),
+                &stability.clone().method(Method::PeriodGrid(grid)),
             )?;
-            rows.push((
-                "grid",
-                Row::of(converged(&by_grid), family.exact, grid.grid),
-            ));
-            rows.push((
-                "corrected",
-                Row::of(corrected(&by_grid), family.exact, grid.grid),
-            ));
             let auto = compute(&family.system, &request)?;
-            rows.push(("auto", Row::of(converged(&auto), family.exact, grid.grid)));
-            let check = TimeDomainCheck::for_system(&family.system);
             let checked = compute(&family.system, &request.clone().checked(check))?;
-            rows.push((
-                "auto-checked",
-                Row::of(converged(&checked), family.exact, grid.grid),
-            ));
-            let stability = request.clone().with_stability(StabilityOptions::default());
+            let mut rows = vec![
+                ("grid", row(converged(&by_grid))),
+                ("corrected", row(corrected(&by_grid))),
+                ("auto", row(converged(&auto))),
+                ("auto-checked", row(converged(&checked))),
+            ];
             let chained = match &lifted {
                 Some(run) => lift(run, &stability)?,
                 None => by_grid,
             };
-            rows.push((
-                "lifted",
-                Row::of(converged(&chained), family.exact, grid.grid),
-            ));
-            rows.push((
-                "lifted-corrected",
-                Row::of(corrected(&chained), family.exact, grid.grid),
-            ));
+            rows.push(("lifted", row(converged(&chained))));
+            rows.push(("lifted-corrected", row(corrected(&chained))));
             if let Some(coarse) = &lifted {
-                let points = extrapolated(coarse, &chained);
-                rows.push(("extrapolated", Row::of(points, family.exact, grid.grid)));
+                rows.push(("extrapolated", row(extrapolated(coarse, &chained))));
             }
             lifted = Some(chained);
             if family.name == "clamped" {
-                let points = exact_start(&family.system, &grid, &request)?;
                 rows.push((
                     "exact-start",
-                    Row::of(points.into_iter(), family.exact, grid.grid),
+                    row(exact_start(&family.system, &periods, &request)?),
                 ));
             }
             for (way, r) in rows {

@@ -17,7 +17,7 @@ use crate::continuation::{ContinuationProblem, EndReason, Event};
 use crate::error::{Error, SettingsError};
 use crate::fourier::Basis;
 use crate::modal::energy;
-use crate::solve::{norm, NonlinearSolver, Problem, SmoothingHomotopy, Solver};
+use crate::solve::{norm, NonlinearSolver, Problem, SmoothingHomotopy, SolveInfo, Solver};
 use crate::system::NonsmoothSystem;
 use std::ops::ControlFlow;
 
@@ -121,15 +121,19 @@ pub(crate) fn lifted_points(
         problem.set_parameter(coarse.omega);
         let guesses = std::iter::once(guess.clone()).chain(neighbour.map(|(_, x)| x));
         let solved = solve_first(problem, &solvers, guesses, (coarse.omega, floor));
-        let (x, status, iterations, energy) = match solved {
-            Ok((x, iterations, energy)) => (x, PointStatus::Converged, iterations, energy),
+        let (x, status, (iterations, residual_norm), energy) = match solved {
+            Ok((x, info, energy)) => {
+                let solve = (info.iterations, info.residual_norm);
+                (x, PointStatus::Converged, solve, energy)
+            }
             Err(status) => {
                 let energy = energy(problem.system(), problem.basis(), &guess, coarse.omega);
-                (guess, status, 0, energy)
+                // The solver's norm is of its last iterate: the guess kept needs its own.
+                let mut residual = vec![0.0; guess.len()];
+                problem.residual(&guess, &mut residual);
+                (guess, status, (0, norm(&residual)), energy)
             }
         };
-        let mut residual = vec![0.0; x.len()];
-        problem.residual(&x, &mut residual);
         let status = status.with_energy(energy, energy / e_g);
         let converged = status == PointStatus::Converged;
         if converged {
@@ -147,7 +151,7 @@ pub(crate) fn lifted_points(
             energy_normalized: energy / e_g,
             converged,
             status,
-            residual_norm: norm(&residual),
+            residual_norm,
             iterations,
             x,
             step_size: coarse.step_size,
@@ -163,14 +167,15 @@ pub(crate) fn lifted_points(
 }
 
 /// The first solution of `problem` (its parameter set) that one of `solvers`, tried in turn
-/// on each of `guesses`, reaches with an energy above `floor` at `omega`: the solution, the
-/// iterations of its solve and its energy; or the status of the last failure.
+/// on each of `guesses`, reaches with an energy above `floor` at `omega`: the solution, what
+/// its solve took and its energy; or the status of the last
+/// failure.
 fn solve_first(
     problem: &mut NonsmoothSystem,
     solvers: &[&dyn NonlinearSolver],
     guesses: impl IntoIterator<Item = Vec<f64>>,
     (omega, floor): (f64, f64),
-) -> Result<(Vec<f64>, usize, f64), PointStatus> {
+) -> Result<(Vec<f64>, SolveInfo, f64), PointStatus> {
     let mut failure = None;
     for guess in guesses {
         for solver in solvers {
@@ -179,7 +184,7 @@ fn solve_first(
                 Ok(info) => {
                     let e = energy(problem.system(), problem.basis(), &x, omega);
                     if e > floor {
-                        return Ok((x, info.iterations, e));
+                        return Ok((x, info, e));
                     }
                     failure = Some(PointStatus::CollapsedToRest);
                 }

@@ -17,7 +17,7 @@ use crate::bc::{
 use crate::continuation::ContinuationProblem;
 use crate::modal::energy::energy;
 use crate::modal::linear::{natural_frequencies, seed_from_mode, ContactState, LinearMode};
-use crate::solve::{NonlinearSolver, SmoothingHomotopy};
+use crate::solve::{norm, NonlinearSolver, SmoothingHomotopy};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::sync::Arc;
 
@@ -249,9 +249,8 @@ pub(crate) fn tethered_start<S: NonlinearSolver>(
 
 /// Whether two solutions are the same state to `1e-6` of the larger's norm.
 fn same_state(x: &[f64], y: &[f64]) -> bool {
-    let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
-    let gap: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
-    norm(&gap) <= 1e-6 * norm(x).max(norm(y))
+    let gap = x.iter().zip(y).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    gap.sqrt() <= 1e-6 * norm(x).max(norm(y))
 }
 
 /// Amplitudes of the tethered start, relative to the grazing seed's (as
