@@ -19,8 +19,8 @@
 use nonsmooth_modes::branches::{compute, BackbonePoint, Request};
 use nonsmooth_modes::io::write_columns_csv;
 use nonsmooth_modes::plot::{
-    backbone_panel, render_svg, stability_series, Figure, LegendPosition, LinePanel, Rgb, Series,
-    FREQUENCY_LABEL, PALETTE,
+    backbone_panel, render_svg, stability_series, Figure, LinePanel, Rgb, Series, FREQUENCY_LABEL,
+    PALETTE,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::stability::StabilityOptions;
@@ -57,7 +57,7 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         .map(|p| (p.omega / omega_1, p.energy_normalized, stable(p)))
         .collect();
     let exact = ClampedFamily::new(gap, 1)?.backbone(3.99, 3.04, 201);
-    let mut backbone = backbone_panel("E / E_g, m = 20", &[], None);
+    let mut backbone = backbone_panel("E/E_g, m = 20", &[], None);
     backbone.series = stability_series("NSM1", PALETTE[0], &marked);
     backbone.series.push(
         Series::line("exact family (stable)", exact)
@@ -75,7 +75,6 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         .collect();
     let multipliers = LinePanel {
         series: stability_series("NSM1", PALETTE[0], &moduli),
-        legend: LegendPosition::UpperRight,
         ..LinePanel::new(
             "largest multiplier modulus (points with a verdict)",
             FREQUENCY_LABEL,

@@ -61,10 +61,10 @@ fn write_point_cells(p: &BackbonePoint, mut out: impl Write) -> io::Result<()> {
 }
 
 /// Header of [`write_branches_csv`]: `branch,harmonics`, the columns of
-/// [`BACKBONE_CSV_HEADER`], then `omega_ratio,exact_energy_normalized`.
+/// [`BACKBONE_CSV_HEADER`], then `omega_ratio,exact_energy_normalized,label`.
 pub const BRANCHES_CSV_HEADER: &str = "branch,harmonics,step,period,omega,energy,\
      energy_normalized,converged,status,residual_norm,iterations,step_size,event,omega_ratio,\
-     exact_energy_normalized";
+     exact_energy_normalized,label";
 
 /// One branch of a table written by [`write_branches_csv`].
 #[derive(Clone, Copy)]
@@ -93,8 +93,10 @@ impl std::fmt::Debug for LabelledBranch<'_> {
 
 /// Writes several labelled branches as one CSV table: [`BRANCHES_CSV_HEADER`], then one row
 /// per point, branch after branch: the branch label and its number of harmonics, the cells of
-/// [`write_backbone_csv`], `Omega / omega_1` and the exact `E / E_g` at the point's period
-/// (an empty cell for a branch without one).
+/// [`write_backbone_csv`], `Omega / omega_1`, the exact `E / E_g` at the point's period (an
+/// empty cell for a branch without one), and the point's [`Label`](crate::modal::Label)
+/// (`skeleton`, `subharmonic-2`, `internal-resonance-h3-mode2`, ...; empty where the point has
+/// none).
 ///
 /// # Errors
 /// Any I/O error of `out`.
@@ -112,6 +114,10 @@ pub fn write_branches_csv(
             write!(out, ",{:.12},", p.omega / omega_1)?;
             if let Some(exact) = b.exact {
                 write!(out, "{:.12e}", exact(p.period))?;
+            }
+            write!(out, ",")?;
+            if let Some(label) = &p.label {
+                write!(out, "{label}")?;
             }
             writeln!(out)?;
         }
@@ -195,7 +201,13 @@ mod tests {
 
     #[test]
     fn branches_csv_labels_rows_and_leaves_missing_exact_values_empty() {
-        let points = [point(), point()];
+        let mut resonant = point();
+        resonant.label = Some(crate::modal::Label::InternalResonance {
+            harmonic: 3,
+            mode: 2,
+            omega: 4.7,
+        });
+        let points = [point(), resonant];
         let exact = |t: f64| 2.0 * t;
         let branches = [
             LabelledBranch {
@@ -235,6 +247,9 @@ mod tests {
         let ratio: f64 = cells[k].parse().unwrap();
         assert!((ratio - point().omega / 0.5).abs() < 1e-11);
         assert_eq!(cells[k + 1].parse::<f64>().unwrap(), 7.0);
+        assert_eq!(cells[k + 2], "");
+        let cells: Vec<&str> = lines[2].split(',').collect();
+        assert_eq!(cells[k + 2], "internal-resonance-h3-mode2");
         let cells: Vec<&str> = lines[3].split(',').collect();
         assert_eq!(cells[..2], ["NSM2", "40"]);
         assert_eq!(cells[k + 1], "");

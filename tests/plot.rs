@@ -3,8 +3,8 @@
 
 use nonsmooth_modes::plot::{
     backbone_panel, histories_panel, plot_backbone, plot_histories, plot_snapshots,
-    plot_space_time, plot_xy, render_svg, space_time_panel, Figure, LinePanel, MapPanel, Panel,
-    PlacedBar, Placement, PlotError, Series, SpaceTimeField,
+    plot_space_time, plot_xy, render_svg, space_time_panel, Annotation, Figure, LegendPosition,
+    LinePanel, MapPanel, Panel, PlacedBar, Placement, PlotError, Series, SpaceTimeField,
 };
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -195,4 +195,97 @@ fn bad_input_is_an_error_not_a_panic() {
         plot_backbone(&missing, "", &[], None),
         Err(PlotError::Draw(_))
     ));
+}
+
+/// The `x` and `y` of the `<text>` element whose content is `content`.
+fn text_position(svg: &str, content: &str) -> (f64, f64) {
+    let end = svg
+        .find(&format!(">{content}</text>"))
+        .unwrap_or_else(|| panic!("no text {content:?}"));
+    let start = svg[..end].rfind("<text ").unwrap();
+    let tag = &svg[start..end];
+    let attr = |name: &str| -> f64 {
+        let key = format!(" {name}=\"");
+        let at = tag.find(&key).unwrap() + key.len();
+        let len = tag[at..].find('"').unwrap();
+        tag[at..at + len].parse().unwrap()
+    };
+    (attr("x"), attr("y"))
+}
+
+/// A panel of one labelled series on `points` (the canvas is 640 x 440).
+fn legend_panel(points: Vec<(f64, f64)>) -> Figure {
+    let mut panel = LinePanel::new("", "x", "y");
+    panel.x_range = Some((0.0, 1.0));
+    panel.y_range = Some((0.0, 1.0));
+    panel.series.push(Series::markers("the data", points));
+    Figure::new("", 1, vec![panel.into()])
+}
+
+#[test]
+fn the_automatic_legend_covers_no_data() {
+    let dir = out_dir("legend");
+    // Data in the upper left quarter only: the legend goes to the upper right.
+    let path = dir.join("corner.svg");
+    let cloud: Vec<(f64, f64)> = (0..=20)
+        .flat_map(|i| (0..=20).map(move |j| (0.025 * i as f64, 0.5 + 0.025 * j as f64)))
+        .collect();
+    render_svg(&path, &legend_panel(cloud)).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let (x, y) = text_position(&svg, "the data");
+    assert!(x > 320.0 && y < 220.0, "legend at ({x}, {y})");
+    // Data everywhere: the legend goes outside the plot, right of its frame.
+    let path = dir.join("full.svg");
+    let grid: Vec<(f64, f64)> = (0..=40)
+        .flat_map(|i| (0..=40).map(move |j| (i as f64 / 40.0, j as f64 / 40.0)))
+        .collect();
+    render_svg(&path, &legend_panel(grid.clone())).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let (x, _) = text_position(&svg, "the data");
+    let rightmost_tick = text_position(&svg, "1").0;
+    assert!(
+        x > rightmost_tick,
+        "legend at x = {x}, axis ends at {rightmost_tick}"
+    );
+    // Data everywhere and a label too long for a strip on the right: below the plot.
+    let long = "a label long enough that a strip for it would take half the panel";
+    let mut wide = legend_panel(grid);
+    if let Panel::Lines(p) = &mut wide.panels[0] {
+        p.series[0].label = long.into();
+    }
+    let path = dir.join("below.svg");
+    render_svg(&path, &wide).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let (_, y) = text_position(&svg, long);
+    let axis_label = text_position(&svg, "x").1;
+    assert!(
+        y > axis_label,
+        "legend at y = {y}, axis label at {axis_label}"
+    );
+    // A fixed position is kept, whatever it covers.
+    let mut fixed = legend_panel(vec![(0.5, 0.5)]);
+    if let Panel::Lines(p) = &mut fixed.panels[0] {
+        p.legend = LegendPosition::LowerRight;
+    }
+    let path = dir.join("fixed.svg");
+    render_svg(&path, &fixed).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let (x, y) = text_position(&svg, "the data");
+    assert!(x > 320.0 && y > 220.0, "legend at ({x}, {y})");
+}
+
+#[test]
+fn point_labels_are_drawn_and_text_offsets_are_in_pixels() {
+    let dir = out_dir("labels");
+    let mut panel = backbone_panel("lettered", &[Series::markers("NSM1", exact_curve())], None);
+    let p = exact_curve()[10];
+    panel.annotations = vec![Annotation::new(p, "a"), Annotation::new(p, "b")];
+    let path = dir.join("labels.svg");
+    render_svg(&path, &Figure::new("Ω/ω₁", 1, vec![panel.into()])).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let (a, b) = (text_position(&svg, "a"), text_position(&svg, "b"));
+    assert!(a != b, "two labels of one point at the same place");
+    // Every vertical text offset is baked into `y`: no `dy` in font-relative units.
+    assert!(!svg.contains("dy="), "a text keeps a relative offset");
+    assert!(svg.contains(">Ω/ω₁</text>"));
 }

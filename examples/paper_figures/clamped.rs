@@ -1,15 +1,16 @@
 //! Figs. 7-9: backbones of the clamped bar against the exact families, sequential against
 //! arclength continuation, and the internally resonant solutions of the first mode.
 
-use crate::common::{arclength_series, marked, settings};
+use crate::common::{arclength_series, labelled_series, marked, settings, subscript};
 use crate::common::{
     omega_1, point_map, reference_line, series, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
-use crate::runs::{arclength_run, pick, run, Branch, Exact, Run};
+use crate::lettered::{labelled, nearest_with, on_exact};
+use crate::runs::{arclength_run, run, Branch, Exact, Run};
 use nonsmooth_modes::branches::BackbonePoint;
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::harmonic_energies;
-use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, Panel, Series};
+use nonsmooth_modes::modal::{harmonic_energies, Label};
+use nonsmooth_modes::plot::{backbone_panel, Figure, Marker, Panel, Rgb};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::system::BarSystem;
 use std::f64::consts::PI;
@@ -39,25 +40,36 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
         run(&system, m, &sub2)?.with_exact(Exact::new(2, 2)?),
     ];
     stats.count(&runs);
-    let branches: Vec<Series> = runs
+    let coloured: Vec<(&Run, Rgb, Marker)> = runs
         .iter()
         .zip([GREEN, RED, YELLOW])
-        .map(|(r, c)| series(r, w1, c, Marker::Circle))
+        .map(|(r, c)| (r, c, Marker::Circle))
         .collect();
+    let branches = labelled_series(&coloured, w1);
     let mut bb = backbone_panel("backbones, m = 20", &branches, Some(&first_mode_curve()?));
     let exact_nsm2 = ClampedFamily::new(GAP, 2)?.backbone(1.2525, 1.3330, 101);
     let exact_sub2: Vec<(f64, f64)> = exact_nsm2.iter().map(|&(w, e)| (w / 2.0, e)).collect();
     bb.series
         .push(reference_line("exact NSM2, NSM2 sub2", exact_nsm2));
     bb.series.push(reference_line("", exact_sub2));
-    // NSM2 rises in the upper right corner and NSM2 sub2 in the upper left.
-    bb.legend = LegendPosition::UpperMiddle;
     let basis = settings(m).cosine_basis()?;
+    // a: NSM1, c: NSM2, d: NSM2 sub2, each labelled so and within 5 % of its exact family,
+    // nearest the paper's period.
+    let sub2 = Label::Subharmonic { order: 2 };
     let picks = [
-        ("a", pick(&runs[0], 3.6, 0.05)),
-        ("c", pick(&runs[1], 1.29, 0.05)),
-        ("d", pick(&runs[2], 2.58, 0.05)),
-    ];
+        ("a", 3.6, Label::Skeleton),
+        ("c", 1.29, Label::Skeleton),
+        ("d", 2.58, sub2),
+    ]
+    .into_iter()
+    .zip(&runs)
+    .map(|((name, period, label), r)| {
+        let p = nearest_with(r, period, |p| {
+            Ok(labelled(p, &label) && on_exact(r, p, 0.05))
+        })?;
+        Ok((name, p))
+    })
+    .collect::<Res<Vec<_>>>()?;
     for (name, p) in &picks {
         stats.lettered(name, p.is_some());
     }
@@ -65,15 +77,15 @@ pub fn fig07(ctx: &Ctx) -> Res<Stats> {
     let mut marks = Vec::new();
     for ((name, p), r) in picks.into_iter().zip(&runs) {
         if let Some(p) = p {
-            marks.push(p);
+            marks.push((name, p));
             let title = format!(
-                "point {name}: {}, T = {:.3}, E/Eg = {:.2}",
+                "point {name}: {}, T = {:.3}, E/E_g = {:.2}",
                 r.label, p.period, p.energy_normalized
             );
             panels.push(point_map(&system, &basis, p, 60, title)?);
         }
     }
-    let all = marked(bb, "points a, c, d", &marks, w1, panels);
+    let all = marked(bb, "", &marks, w1, panels);
     let refs: Vec<&Run> = runs.iter().collect();
     ctx.backbone_figure(
         &mut stats,
@@ -170,7 +182,11 @@ pub fn fig09(ctx: &Ctx) -> Res<Stats> {
     );
     let mut panels = Vec::new();
     let mut notes = Vec::new();
-    for (p, name) in spikes.iter().zip(["a", "b", "c"]) {
+    let lettered: Vec<(&str, &BackbonePoint)> = ["a", "b", "c"]
+        .into_iter()
+        .zip(spikes.iter().copied())
+        .collect();
+    for &(name, p) in &lettered {
         let (n, j) = resonance(&system, &basis, p)?;
         notes.push(format!(
             "{name}: T={:.3} x{:.2}, NSM1 with NSM{j} (harmonic {n})",
@@ -178,7 +194,8 @@ pub fn fig09(ctx: &Ctx) -> Res<Stats> {
             ratio(p)
         ));
         let title = format!(
-            "({name}) NSM1 with NSM{j} ({n} Omega ~ omega_{j}), E/E_exact {:.2}",
+            "({name}) NSM1 with NSM{j} ({n}Ω ≈ ω{}), E/E_exact {:.2}",
+            subscript(j),
             ratio(p)
         );
         panels.push(point_map(&system, &basis, p, 80, title)?);
@@ -190,7 +207,7 @@ pub fn fig09(ctx: &Ctx) -> Res<Stats> {
         &Figure::new(
             "Fig. 9: internally resonant NSM1 solutions, m = 40",
             2,
-            marked(bb, "resonant points", &spikes, w1, panels),
+            marked(bb, "internal resonances", &lettered, w1, panels),
         ),
         &[&r],
         w1,

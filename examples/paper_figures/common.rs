@@ -4,15 +4,15 @@
 
 use crate::runs::Run;
 use crate::summary::Item;
-use nonsmooth_modes::branches::BackbonePoint;
+use nonsmooth_modes::branches::{group_by_label, BackbonePoint};
 use nonsmooth_modes::continuation::Event;
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
 use nonsmooth_modes::modal::diagnostics::EndHistory;
-use nonsmooth_modes::modal::{displacement_grid, end_history, grazing_energy};
+use nonsmooth_modes::modal::{displacement_grid, end_history, grazing_energy, Label};
 use nonsmooth_modes::plot::{
-    render_svg, space_time_panel, Figure, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
-    SpaceTimeField, PALETTE,
+    render_svg, space_time_panel, Annotation, Figure, LinePanel, MapPanel, Marker, Panel, Rgb,
+    Series, SpaceTimeField, PALETTE,
 };
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use std::io::Write as _;
@@ -208,6 +208,49 @@ pub fn series(run: &Run, omega_1: f64, color: Rgb, marker: Marker) -> Series {
         .with_marker(marker)
 }
 
+/// The runs' converged points grouped by label (`branches::group_by_label`): each run's own
+/// branch (skeleton or subharmonic, and any point without a label) as markers in its colour
+/// and marker, named by the run; then each run's internal resonances as small rings in the
+/// same colour, one legend entry for them all.
+pub fn labelled_series(runs: &[(&Run, Rgb, Marker)], omega_1: f64) -> Vec<Series> {
+    let at = |p: &BackbonePoint| (p.omega / omega_1, p.energy_normalized);
+    let mut own = Vec::new();
+    let mut apart = Vec::new();
+    for &(run, color, marker) in runs {
+        let groups = group_by_label(&run.points);
+        let resonant: Vec<(f64, f64)> = groups
+            .iter()
+            .filter(|g| matches!(g.label, Label::InternalResonance { .. }))
+            .flat_map(|g| g.points.iter().map(|p| at(p)))
+            .collect();
+        let branch: Vec<(f64, f64)> = run
+            .converged()
+            .filter(|p| !matches!(p.label, Some(Label::InternalResonance { .. })))
+            .map(at)
+            .collect();
+        own.push(
+            Series::markers(run.label.clone(), branch)
+                .with_color(color)
+                .with_marker(marker),
+        );
+        if !resonant.is_empty() {
+            let label = if apart.is_empty() {
+                "internal resonances (rings, branch colour)"
+            } else {
+                ""
+            };
+            apart.push(
+                Series::markers(label, resonant)
+                    .with_color(color)
+                    .with_marker(Marker::Ring)
+                    .with_size(3),
+            );
+        }
+    }
+    own.extend(apart);
+    own
+}
+
 /// A thin dashed black line: a reference curve.
 pub fn reference_line(label: &str, points: Vec<(f64, f64)>) -> Series {
     Series::line(label, points)
@@ -252,24 +295,37 @@ pub fn field(
     }
 }
 
-/// The backbone panel `bb` with `points` marked (black rings, one legend entry `label`),
-/// followed by `panels`.
+/// The backbone panel `bb` with the lettered `points` marked (black rings, each labelled with
+/// its letter, and one legend entry naming the letters found, with `note` in parentheses if
+/// not empty), followed by `panels`.
 pub fn marked(
     mut bb: LinePanel,
-    label: &str,
-    points: &[&BackbonePoint],
+    note: &str,
+    points: &[(&str, &BackbonePoint)],
     omega_1: f64,
     panels: Vec<Panel>,
 ) -> Vec<Panel> {
-    let p: Vec<(f64, f64)> = points
-        .iter()
-        .map(|p| (p.omega / omega_1, p.energy_normalized))
-        .collect();
+    let at = |p: &BackbonePoint| (p.omega / omega_1, p.energy_normalized);
+    let letters: Vec<&str> = points.iter().map(|(letter, _)| *letter).collect();
+    let noun = if letters.len() == 1 {
+        "point"
+    } else {
+        "points"
+    };
+    let mut label = format!("{noun} {}", letters.join(", "));
+    if !note.is_empty() {
+        label.push_str(&format!(" ({note})"));
+    }
     bb.series.push(
-        Series::markers(label, p)
+        Series::markers(label, points.iter().map(|(_, p)| at(p)).collect())
             .with_color(Rgb::BLACK)
             .with_marker(Marker::Ring)
             .with_size(7),
+    );
+    bb.annotations.extend(
+        points
+            .iter()
+            .map(|(letter, p)| Annotation::new(at(p), *letter)),
     );
     let mut all = vec![Panel::Lines(bb)];
     all.extend(panels);
@@ -278,7 +334,7 @@ pub fn marked(
 
 /// Space-time map of `f` in units of `g0`.
 pub fn map_panel(title: String, f: &SpaceTimeField) -> Res<Panel> {
-    let mut p: MapPanel = space_time_panel(title, f, "u / g0")?;
+    let mut p: MapPanel = space_time_panel(title, f, "u/g₀")?;
     p.values.iter_mut().for_each(|v| *v /= GAP);
     Ok(p.into())
 }
@@ -294,10 +350,18 @@ pub fn point_map(
     map_panel(title, &field(system, basis, p, 0, instants))
 }
 
-/// `Omega/omega_1 = ..., E/Eg = ...` of a point.
+/// `n` in subscript digits (`ω₁₂` for `ω` and 12).
+pub fn subscript(n: usize) -> String {
+    n.to_string()
+        .chars()
+        .map(|d| char::from_u32(0x2080 + d.to_digit(10).unwrap_or(0)).unwrap_or(d))
+        .collect()
+}
+
+/// `Ω/ω₁ = ..., E/E_g = ...` of a point.
 pub fn frequency_energy(p: &BackbonePoint, omega_1: f64) -> String {
     format!(
-        "Omega/omega_1 = {:.3}, E/Eg = {:.2}",
+        "Ω/ω₁ = {:.3}, E/E_g = {:.2}",
         p.omega / omega_1,
         p.energy_normalized
     )

@@ -24,6 +24,7 @@
 
 mod clamped;
 mod common;
+mod lettered;
 mod residual;
 mod robin;
 mod runs;

@@ -2,14 +2,18 @@
 //! fields, second mode, and the third subharmonic of the second mode.
 
 use crate::common::{
-    arclength_series, field, frequency_energy, map_panel, marked, omega_1, point_map, series,
-    settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_series, field, frequency_energy, labelled_series, map_panel, marked, omega_1,
+    point_map, series, settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
-use crate::runs::{arclength_run, pick, run, Branch, Run};
+use crate::lettered::{contacts, labelled, nearest_with, Content, MIN_RESONANT_SHARE};
+use crate::runs::{arclength_run, continued_from, run, Branch, Run};
 use nonsmooth_modes::branches::{symmetry_breaking_direction, BackbonePoint, GENUINE_SHARE};
 use nonsmooth_modes::continuation::ContinuationProblem;
-use nonsmooth_modes::modal::{energy, grazing_energy, law_history, subharmonic_share};
-use nonsmooth_modes::plot::{backbone_panel, Figure, LegendPosition, Marker, PALETTE};
+use nonsmooth_modes::modal::{
+    energy, grazing_energy, law_history, natural_frequencies, subharmonic_share, ContactState,
+    Label,
+};
+use nonsmooth_modes::plot::{backbone_panel, Figure, Marker, Series, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
 use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
@@ -40,35 +44,56 @@ pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
     let branch = Branch::new("NSM1 arclength m = 40", 1, (9.5, 6.0), 0);
     let arc = arclength_run(ctx, &system, 40, &branch, w1)?;
     s10.count([&r20, &r40, &arc]);
-    let mut branches = vec![
-        series(&r20, w1, GREEN, Marker::Circle),
-        series(&r40, w1, BLUE, Marker::Triangle).with_size(2),
-    ];
+    let mut branches = labelled_series(
+        &[
+            (&r20, GREEN, Marker::Circle),
+            (&r40, BLUE, Marker::Triangle),
+        ],
+        w1,
+    );
+    branches[1].size = 2;
     branches.extend(arclength_series(&arc, w1, PALETTE[4], false));
     let mut bb = backbone_panel("Robin bar (k = 0.5): NSM1", &branches, None);
     bb.x_guides = vec![OMEGA_2 / 4.0 / w1];
-    // Points a, b, c on the m = 40 branch: low energy, around omega_2/4, high energy.
+    // Points a, b, c on the m = 40 branch, all on the skeleton (harmonic 1 dominant): a at low
+    // energy and c at high energy, each with one contact per period; b around omega_2/4, where
+    // harmonic 4 meets omega_2 and carries at least `MIN_RESONANT_SHARE` of the energy.
+    let basis_40 = settings(40).cosine_basis()?;
+    let meets_omega_2 = |p: &BackbonePoint| -> Res<bool> {
+        let c = Content::of(&system, &basis_40, p)?;
+        Ok(c.share_near(0, OMEGA_2) >= MIN_RESONANT_SHARE)
+    };
     let targets = [
         (8.8, "a"),
         (2.0 * PI / (OMEGA_2 / 4.0) * 0.985, "b"),
         (6.6, "c"),
     ];
-    let picks: Vec<(&str, &BackbonePoint)> = targets
-        .iter()
-        .filter_map(|&(t, n)| pick(&r40, t, 0.0).map(|p| (n, p)))
-        .collect();
+    let mut picks: Vec<(&str, &BackbonePoint)> = Vec::new();
+    for &(t, n) in &targets {
+        let p = nearest_with(&r40, t, |p| {
+            if !labelled(p, &Label::Skeleton) {
+                return Ok(false);
+            }
+            if n == "b" {
+                meets_omega_2(p)
+            } else {
+                Ok(contacts(p, 1))
+            }
+        })?;
+        if let Some(p) = p {
+            picks.push((n, p));
+        }
+    }
     for (_, letter) in targets {
         s10.lettered(letter, picks.iter().any(|(name, _)| *name == letter));
     }
-    bb.legend = LegendPosition::UpperLeft;
-    let marks: Vec<&BackbonePoint> = picks.iter().map(|(_, p)| *p).collect();
     ctx.backbone_figure(
         &mut s10,
         "fig10_robin_nsm1",
         &Figure::new(
-            "Fig. 10: NSM1 of the Robin-Signorini bar (dashed: omega_2/4)",
+            "Fig. 10: NSM1 of the Robin-Signorini bar (dashed: ω₂/4)",
             1,
-            marked(bb, "points a, b, c (m = 40)", &marks, w1, Vec::new()),
+            marked(bb, "m = 40", &picks, w1, Vec::new()),
         ),
         &[&r20, &r40, &arc],
         w1,
@@ -127,24 +152,39 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
     // next steps); the converged points after that are isolated solutions, drawn apart.
     let (branch, beyond) = r.split_at_end(END_GAP, "NSM2 past its end (isolated)");
     stats.count([&branch, &beyond]);
-    let mut bb = backbone_panel(
+    let bb = backbone_panel(
         "Robin bar: NSM2, m = 20",
         &[
-            series(&branch, w1, RED, Marker::Circle),
-            series(&beyond, w1, RED, Marker::Ring),
-        ],
+            labelled_series(&[(&branch, RED, Marker::Circle)], w1),
+            vec![series(&beyond, w1, RED, Marker::Ring)],
+        ]
+        .concat(),
         None,
     );
-    // e: low energy; d: the largest local excess over its neighbours (an internal resonance)
-    // along the first unbroken run of converged steps, below the blow-up.
+    // e: low energy, on the skeleton; d: among the internal resonances (a harmonic n >= 2 at
+    // an open-contact natural frequency holds at least `MIN_RESONANT_SHARE` of the energy),
+    // the largest local excess over its neighbours along the first unbroken run of converged
+    // steps, below the blow-up.
     let conv: Vec<&BackbonePoint> = branch.points.iter().take_while(|p| p.converged).collect();
     let e = conv
         .iter()
-        .find(|p| p.period < 1.86)
-        .or(conv.first())
+        .find(|p| p.period < 1.86 && labelled(p, &Label::Skeleton))
         .copied();
-    let d = conv
-        .windows(3)
+    let basis = settings(m).cosine_basis()?;
+    let omega_max = (m + 1) as f64 * conv.iter().fold(0.0f64, |a, p| a.max(p.omega));
+    let natural: Vec<f64> = natural_frequencies(&system, ContactState::Open, omega_max)?
+        .iter()
+        .map(|mode| mode.omega)
+        .collect();
+    let mut resonant = Vec::new();
+    for w in conv.windows(3) {
+        let share = Content::of(&system, &basis, w[1])?.resonant_share(0, &natural);
+        if share >= MIN_RESONANT_SHARE {
+            resonant.push(w);
+        }
+    }
+    let d = resonant
+        .into_iter()
         .max_by(|a, b| {
             let ex = |w: &[&BackbonePoint]| {
                 w[1].energy_normalized / (0.5 * (w[0].energy_normalized + w[2].energy_normalized))
@@ -152,26 +192,23 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
             ex(a).total_cmp(&ex(b))
         })
         .map(|w| w[1]);
-    let basis = settings(m).cosine_basis()?;
     let mut panels = Vec::new();
     let mut marks = Vec::new();
     for (name, p) in [("e", e), ("d", d)] {
         stats.lettered(name, p.is_some());
         if let Some(p) = p {
-            marks.push(p);
+            marks.push((name, p));
             let title = format!("point {name}: {}", frequency_energy(p, w1));
             panels.push(point_map(&system, &basis, p, 60, title)?);
         }
     }
-    // The resonant point d sits at the top left, where the legend would hide it.
-    bb.legend = LegendPosition::LowerRight;
     ctx.backbone_figure(
         &mut stats,
         "fig12_robin_nsm2",
         &Figure::new(
             "Fig. 12: NSM2 of the Robin-Signorini bar",
             3,
-            marked(bb, "points e, d", &marks, w1, panels),
+            marked(bb, "", &marks, w1, panels),
         ),
         &[&branch, &beyond],
         w1,
@@ -292,9 +329,9 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     let branch = Branch::new("NSM2 sub3", 2, (t3 - 0.02, 4.6), ctx.steps(113)).subharmonic(3);
     let r = run(&system, m, &branch.genuine())?;
     stats.count([&r]);
-    let bb = backbone_panel(
+    let mut bb = backbone_panel(
         format!("Robin bar: NSM2 sub3, m = {m}"),
-        &[series(&r, w1, YELLOW, Marker::Circle)],
+        &labelled_series(&[(&r, YELLOW, Marker::Circle)], w1),
         None,
     );
     // g: one contact and two grazings per period; f: two contacts and one grazing.
@@ -319,20 +356,57 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     if let Some(p) = &off {
         g = Some((p, 1, 2));
     }
+    // g's own branch: continued from g both ways in steps of 0.001 in the period, kept while
+    // its points stay genuinely subharmonic (off the repeated branch, which the continuation
+    // falls back onto where the branch ends).
     let basis = settings(m).cosine_basis()?;
+    let through_g = match g {
+        Some((p, _, _)) => {
+            let all = continued_from(&system, m, p, (0.001, 60), "branch through g")?;
+            let mut same = Vec::with_capacity(all.points.len());
+            for q in &all.points {
+                same.push(subharmonic_share(&system, &basis, &q.x, q.omega, 3)? >= GENUINE_SHARE);
+            }
+            let at = all.points.iter().position(|q| q.period == p.period);
+            let (lo, hi) = at.map_or((0, 0), |i| {
+                let lo = (0..=i).rev().take_while(|&k| same[k]).last().unwrap_or(i);
+                let hi = (i..same.len()).take_while(|&k| same[k]).last().unwrap_or(i);
+                (lo, hi + 1)
+            });
+            Some(Run {
+                points: all.points[lo..hi].to_vec(),
+                ..all
+            })
+        }
+        None => None,
+    };
+    if let Some(b) = &through_g {
+        stats.count([b]);
+        bb.series.push(
+            Series::line(
+                "branch through g",
+                b.converged()
+                    .map(|q| (q.omega / w1, q.energy_normalized))
+                    .collect(),
+            )
+            .with_color(PALETTE[4])
+            .with_marker(Marker::Circle)
+            .with_size(1),
+        );
+    }
     let mut panels = Vec::new();
     let mut marks = Vec::new();
     let mut notes = Vec::new();
     for (name, p) in [("g", g), ("f", f)] {
         stats.lettered(name, p.is_some());
         if let Some((p, c, gr)) = p {
-            marks.push(p);
+            marks.push((name, p));
             notes.push(format!(
                 "{name}: {c} contact(s), {gr} grazing(s), {}",
                 frequency_energy(p, w1)
             ));
             let title = format!(
-                "point {name}: {c} contact(s), {gr} grazing(s), Omega/omega_1 = {:.3}",
+                "point {name}: {c} contact(s), {gr} grazing(s), Ω/ω₁ = {:.3}",
                 p.omega / w1
             );
             panels.push(point_map(&system, &basis, p, 90, title)?);
@@ -347,9 +421,12 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
         &Figure::new(
             "Fig. 13: NSM2 sub3 of the Robin-Signorini bar",
             3,
-            marked(bb, "points g, f", &marks, w1, panels),
+            marked(bb, "", &marks, w1, panels),
         ),
-        &[&r],
+        &[Some(&r), through_g.as_ref()]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
         w1,
     )?;
     Ok(stats)

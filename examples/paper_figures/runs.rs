@@ -5,14 +5,16 @@
 use crate::common::{settings, Ctx, Res, GAP};
 use nonsmooth_modes::branches::{
     compute, ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions,
-    Method, PeriodGrid, PointStatus, Request,
+    Method, PeriodGrid, PointStatus, Request, TRIVIAL_ENERGY,
 };
-use nonsmooth_modes::continuation::{ArclengthOptions, EndReason};
+use nonsmooth_modes::continuation::{
+    ArclengthOptions, EndReason, PeriodParametrised, Sequential, SequentialOptions, Step,
+};
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::modal::{energy, grazing_energy};
 use nonsmooth_modes::reference::ClampedFamily;
 use nonsmooth_modes::solve::{NewtonOptions, SemismoothNewton, SolveInfo, Solver};
-use nonsmooth_modes::system::BarSystem;
+use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;
 
 /// The request of `method` for NSM `mode` sub `subharmonic` with `m` harmonics, solved by
@@ -254,25 +256,6 @@ pub fn arclength_run(
     })
 }
 
-/// The converged point whose period is closest to `target`, preferring points whose energy
-/// is within `tolerance` of the run's exact branch if it has one (low-energy, non-resonant
-/// solutions).
-pub fn pick(run: &Run, target: f64, tolerance: f64) -> Option<&BackbonePoint> {
-    let near_exact = |p: &&BackbonePoint| {
-        run.exact
-            .is_none_or(|e| (p.energy_normalized / e.at(p.period) - 1.0).abs() < tolerance)
-    };
-    let by_distance = |a: &&BackbonePoint, b: &&BackbonePoint| {
-        (a.period - target)
-            .abs()
-            .total_cmp(&(b.period - target).abs())
-    };
-    run.converged()
-        .filter(near_exact)
-        .min_by(by_distance)
-        .or_else(|| run.converged().min_by(by_distance))
-}
-
 /// A motion `x` of `system` solved at the fixed frequency `omega` (not continued), as a
 /// converged point with its energy.
 pub fn solved_point(
@@ -301,5 +284,60 @@ pub fn solved_point(
         character: None,
         label: None,
         stability: None,
+    })
+}
+
+/// The branch through the converged point `p` of `system` with `m` harmonics: sequential
+/// continuation in the period from `p`, `steps` steps of `step` towards longer and towards
+/// shorter periods (each direction ends after three failures in a row), joined in order of
+/// decreasing period with `p` among them. Points at rest (below `TRIVIAL_ENERGY E_g`) are not
+/// kept.
+pub fn continued_from(
+    system: &BarSystem,
+    m: usize,
+    p: &BackbonePoint,
+    (step, steps): (f64, usize),
+    label: &str,
+) -> Res<Run> {
+    let e_g = grazing_energy(system)?.0;
+    let mut points = vec![p.clone()];
+    for direction in [1.0, -1.0] {
+        let problem = NonsmoothSystem::new(system, settings(m))?;
+        let basis = problem.basis().clone();
+        let periods: Vec<f64> = (1..=steps)
+            .map(|i| p.period + direction * step * i as f64)
+            .collect();
+        let options = SequentialOptions {
+            max_consecutive_failures: 3,
+            ..SequentialOptions::default()
+        };
+        let mut driver = Sequential::new(
+            PeriodParametrised::new(problem),
+            SemismoothNewton::default(),
+            p.x.clone(),
+            periods,
+            options,
+        )?;
+        loop {
+            match driver.step() {
+                Step::Accepted(q) => {
+                    let omega = 2.0 * PI / q.parameter;
+                    let e = energy(system, &basis, &q.x, omega);
+                    let point = BackbonePoint::from_point(&q, omega, e, e_g);
+                    if point.converged && point.energy_normalized > TRIVIAL_ENERGY {
+                        points.push(point);
+                    }
+                }
+                Step::Rejected(_) => {}
+                Step::Finished(_) => break,
+            }
+        }
+    }
+    points.sort_by(|a, b| b.period.total_cmp(&a.period));
+    Ok(Run {
+        label: label.to_string(),
+        m,
+        points,
+        exact: None,
     })
 }

@@ -1,13 +1,14 @@
 //! Figs. 14-18: two bars in contact, in the configurations `(l, c, alpha)` = (0.95, 1, 1),
-//! (3.8, 4, 4) and (0.95, 2, 1), with the paper's definition `alpha = E1A1/(E2A2)`
+//! (3.8, 4, 4) and (0.95, 2, 1), with the paper's definition `α = E₁A₁/(E₂A₂)`
 //! (`reference::paper_second_bar`): backbones with snapshots of both bars, the contact
 //! interface, and a time-domain check of one point.
 
 use crate::common::{
-    arclength_series, field, frequency_energy, marked, omega_1, over_gap, reference_line,
-    right_end, series, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_series, field, frequency_energy, labelled_series, marked, omega_1, over_gap,
+    reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
 };
-use crate::runs::{arclength_run, energy_run, pick, run, solved_point, Branch, Run};
+use crate::lettered;
+use crate::runs::{arclength_run, energy_run, run, solved_point, Branch, Run};
 use nonsmooth_modes::branches::BackbonePoint;
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::CosineBasis;
@@ -40,7 +41,7 @@ pub struct TwoBar {
 }
 
 impl TwoBar {
-    /// Bar 2 `(l, c, alpha)` (the paper's triplet, `alpha = E1A1/(E2A2)`) facing the unit
+    /// Bar 2 `(l, c, alpha)` (the paper's triplet, `α = E₁A₁/(E₂A₂)`) facing the unit
     /// bar, and its backbones along `branches`.
     fn new((l, c, alpha): (f64, f64, f64), branches: &[Branch<'_>]) -> Res<Self> {
         let system = two_bars_in_contact(paper_second_bar(l, c, alpha)?, GAP)?;
@@ -99,8 +100,8 @@ fn snapshots(
         placed("bar 2", two, 1.0 + l2, true),
     ];
     let mut panel = snapshots_panel(title, &bars, instants, &[1.0])?;
-    panel.y_label = "u / g0 (bar 1 solid, bar 2 dashed as -w)".into();
-    panel.x_label = "position (8 instants over T, blue -> red)".into();
+    panel.y_label = "u/g₀ (bar 1 solid, bar 2 dashed as −w)".into();
+    panel.x_label = "position (8 instants over T, blue → red)".into();
     panel.legend = LegendPosition::Hidden;
     Ok(panel.into())
 }
@@ -140,68 +141,51 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     let nsm2_arc = Branch::new("NSM2 (bar 1) arclength", 3, (1.33, 1.05), 0);
     let arc = arclength_run(ctx, &tb.system, M, &nsm2_arc, tb.w1)?;
     stats.count(tb.runs.iter().chain([&arc]));
-    let mut branches: Vec<Series> = tb
+    let coloured: Vec<(&Run, Rgb, Marker)> = tb
         .runs
         .iter()
         .zip([GREEN, RED, PALETTE[5]])
-        .map(|(r, c)| series(r, tb.w1, c, Marker::Circle))
+        .map(|(r, c)| (r, c, Marker::Circle))
         .collect();
+    let mut branches = labelled_series(&coloured, tb.w1);
     branches.extend(arclength_series(&arc, tb.w1, PALETTE[4], false));
     let mut bb = backbone_panel("(0.95, 1, 1): backbones, m = 20", &branches, None);
     let w12 = OMEGA_1_BAR_2;
     bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1, 3.0];
-    // NSM1 fills the upper left corner and NSM2 the upper right.
-    bb.legend = LegendPosition::UpperMiddle;
     let conv: Vec<&BackbonePoint> = tb.runs[0].converged().collect();
-    // b, c, d, e: NSM1 points nearest Omega/omega_1 = 1.07, 1.2, 1.27, 1.33 (the paper's
-    // NSM1 panels, in frequency order) off the internal-resonance spikes; f: the first NSM2
-    // sub-branch (bar 1's mode), g: the second (bar 2's), at the median energy of its
-    // converged points.
-    let near = |target: f64| {
-        (0..conv.len())
-            .filter(|&i| off_spike(&conv, i))
-            .map(|i| &conv[i])
-            .min_by(|x, y| {
-                (x.omega / tb.w1 - target)
-                    .abs()
-                    .total_cmp(&(y.omega / tb.w1 - target).abs())
-            })
-            .copied()
-    };
-    let f = tb.runs.get(1).and_then(|r| r.converged().nth(5));
-    let g = tb.runs.get(2).and_then(|r| {
-        let mut on: Vec<&BackbonePoint> = r.converged().collect();
-        on.sort_by(|x, y| x.energy_normalized.total_cmp(&y.energy_normalized));
-        on.get(on.len() / 2).copied()
-    });
-    let picks: Vec<(&str, &BackbonePoint)> = [
-        ("b", near(1.07)),
-        ("c", near(1.2)),
-        ("d", near(1.27)),
-        ("e", near(1.33)),
-        ("f", f),
-        ("g", g),
-    ]
-    .into_iter()
-    .filter_map(|(name, p)| p.map(|p| (name, p)))
-    .collect();
+    let nsm1: Vec<&BackbonePoint> = (0..conv.len())
+        .filter(|&i| off_spike(&conv, i))
+        .map(|i| conv[i])
+        .collect();
+    let basis = settings(M).cosine_basis()?;
+    let lettered = lettered::fig14(
+        &tb.system,
+        &basis,
+        tb.w1,
+        &nsm1,
+        tb.runs.get(1),
+        tb.runs.get(2),
+    )?;
+    let picks: Vec<(&str, &BackbonePoint)> = lettered
+        .iter()
+        .filter_map(|&(name, p)| p.map(|p| (name, p)))
+        .collect();
     for letter in ["b", "c", "d", "e", "f", "g"] {
         stats.lettered(letter, picks.iter().any(|(name, _)| *name == letter));
     }
-    let marks: Vec<&BackbonePoint> = picks.iter().map(|(_, p)| *p).collect();
     let panels = named_snapshots(tb, &picks)?;
     ctx.backbone_figure(
         &mut stats,
         "fig14_two_bar_config1",
         &Figure::new(
-            "Fig. 14: two bars (l, c, alpha) = (0.95, 1, 1) (dashed: omega_1^(2), 4/3 omega_1^(2), omega_2^(1))",
+            "Fig. 14: two bars (l, c, α) = (0.95, 1, 1) (dashed: ω₁⁽²⁾, 4/3 ω₁⁽²⁾, ω₂⁽¹⁾)",
             3,
-            marked(bb, "points b-g", &marks, tb.w1, panels),
+            marked(bb, "", &picks, tb.w1, panels),
         ),
         &tb.runs().into_iter().chain([&arc]).collect::<Vec<_>>(),
         tb.w1,
     )?;
-    Ok((stats, marks.into_iter().cloned().collect()))
+    Ok((stats, picks.iter().map(|(_, p)| (*p).clone()).collect()))
 }
 
 /// Interface positions from `x = 1` in units of `g0`: bar 1 at `u(1)`, bar 2 at `g0 - w(l)`.
@@ -225,7 +209,7 @@ pub fn fig15(ctx: &Ctx, tb: &TwoBar, points: &[BackbonePoint]) -> Res<Stats> {
         let mut panel = LinePanel::new(
             format!("({tag}) {}", frequency_energy(p, tb.w1)),
             "t",
-            "position - 1 and strain, / g0",
+            "position − 1 and strain, /g₀",
         );
         panel.series = vec![
             Series::from_columns("bar 1 position", &h1.time, &pos1).with_color(GREEN),
@@ -237,13 +221,6 @@ pub fn fig15(ctx: &Ctx, tb: &TwoBar, points: &[BackbonePoint]) -> Res<Stats> {
                 .with_color(YELLOW)
                 .dashed(),
         ];
-        // Where neither panel has data: (a)'s triangle leaves the upper right free, (b)'s
-        // strain dips fill the lower corners.
-        panel.legend = if tag == "a" {
-            LegendPosition::UpperRight
-        } else {
-            LegendPosition::LowerMiddle
-        };
         panels.push(Panel::Lines(panel));
         table.push(format!("t_{tag}"), h1.time);
         for (n, c) in [
@@ -311,21 +288,18 @@ pub fn fig16(ctx: &Ctx, tb: &TwoBar, p: &BackbonePoint) -> Res<Stats> {
     let (hb1, hb2) = interface_positions(&h1.displacement, &h2.displacement);
     let problem = NonsmoothSystem::new(&tb.system, settings(M))?;
     let law = law_history(&problem, &p.x, p.omega, 0, SAMPLES)?;
-    let mut pos = LinePanel::new("interface positions - 1", "t", "/ g0");
+    let mut pos = LinePanel::new("interface positions − 1", "t", "/g₀");
     pos.series = vec![
         Series::from_columns("bar 1, time domain", t, &u1).with_color(GREEN),
         Series::from_columns("bar 2, time domain", t, &u2).with_color(YELLOW),
         hb_line("bar 1, FD-BEM", &h1.time, &hb1, Rgb::BLACK),
         hb_line("bar 2, FD-BEM", &h2.time, &hb2, PALETTE[7]),
     ];
-    // The positions fill the lower right, the force spikes the upper corners.
-    pos.legend = LegendPosition::UpperRight;
-    let mut frc = LinePanel::new("contact force", "t", "lambda / g0");
+    let mut frc = LinePanel::new("contact force", "t", "λ/g₀");
     frc.series = vec![
         Series::from_columns("time domain (step mean)", &tm, &force).with_color(BLUE),
         hb_line("FD-BEM", &law.time, &over_gap(&law.force), Rgb::BLACK),
     ];
-    frc.legend = LegendPosition::UpperMiddle;
     // Snapshots of the marched field.
     let l2 = tb.system.bars()[1].length();
     let marched = |bar: usize| -> SpaceTimeField {
@@ -383,11 +357,14 @@ pub fn fig17(ctx: &Ctx) -> Res<Stats> {
     let tb = TwoBar::new((3.8, 4.0, 4.0), &[nsm1])?.with_nsm2_of_bar_2()?;
     stats.count(&tb.runs);
     let mut bb = backbone_panel(
-        "(3.8, 4, 4), alpha = E1A1/(E2A2): NSM1 and NSM2, m = 20",
-        &[
-            series(&tb.runs[0], tb.w1, GREEN, Marker::Circle),
-            series(&tb.runs[1], tb.w1, RED, Marker::Circle),
-        ],
+        "(3.8, 4, 4), α = E₁A₁/(E₂A₂): NSM1 and NSM2, m = 20",
+        &labelled_series(
+            &[
+                (&tb.runs[0], GREEN, Marker::Circle),
+                (&tb.runs[1], RED, Marker::Circle),
+            ],
+            tb.w1,
+        ),
         None,
     );
     let w12 = OMEGA_1_BAR_2;
@@ -399,19 +376,19 @@ pub fn fig17(ctx: &Ctx) -> Res<Stats> {
     let mut panels = Vec::new();
     let mut marks = Vec::new();
     if let Some(p) = lowest {
-        marks.push(p);
+        marks.push(("b", p));
         panels.push(snapshots_of(
             &tb.system,
             &basis,
             p,
-            frequency_energy(p, tb.w1),
+            format!("point b: {}", frequency_energy(p, tb.w1)),
         )?);
     }
     // Without a converged point the legend entry "point" is left out altogether.
     let all = if marks.is_empty() {
         vec![Panel::Lines(bb)]
     } else {
-        marked(bb, "point", &marks, tb.w1, panels)
+        marked(bb, "", &marks, tb.w1, panels)
     };
     ctx.backbone_figure(
         &mut stats,
@@ -512,27 +489,29 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
     stats.count(runs);
     let mut bb = backbone_panel(
         "(0.95, 2, 1): backbones, m = 20",
-        &[
-            series(&runs[0], w1, Rgb::BLACK, Marker::Circle),
-            series(&runs[1], w1, PALETTE[7], Marker::Square).with_size(2),
-        ],
+        &{
+            let mut s = labelled_series(
+                &[
+                    (&runs[0], Rgb::BLACK, Marker::Circle),
+                    (&runs[1], PALETTE[7], Marker::Square),
+                ],
+                w1,
+            );
+            s[1].size = 2;
+            s
+        },
         None,
     );
     bb.x_guides = vec![1.0, 1.13, 0.5 * w12 / w1, w12 / w1, 1.25 * w12 / w1];
-    // The paper's a and b: family 1 in the middle of [omega_1^(1), omega_1^(2)/2] and inside
-    // [omega_1^(2)/2, 1.13 omega_1^(1)], found only if the nearest converged point is inside.
-    // Its c, d and e are family-2 points with bar 2 in NSM1 and bar 1 in NSM6 sub5, NSM3 sub2
-    // below (softening) and above (hardening) omega_3^(1)/2 (`subharmonic_of_bar_1`).
+    // The paper's a and b (family 1) by the bars' harmonic content; its c, d and e are
+    // family-2 points with bar 2 in NSM1 and bar 1 in NSM6 sub5, NSM3 sub2 below (softening)
+    // and above (hardening) omega_3^(1)/2 (`subharmonic_of_bar_1`).
     let half = 0.5 * w12 / w1;
-    let family1 = [("a", 1.0, half), ("b", half, 1.13)].map(|(letter, lo, hi)| {
-        let target = 2.0 * PI / (0.5 * (lo + hi) * w1);
-        let p = pick(&runs[0], target, 0.0).filter(|p| (lo..hi).contains(&(p.omega / w1)));
-        (letter, p)
-    });
+    let basis = settings(M).cosine_basis()?;
+    let family1 = lettered::fig18_family1(&tb.system, &basis, w1, &runs[0], half)?;
     for (letter, p) in &family1 {
         stats.lettered(letter, p.is_some());
     }
-    let basis = settings(M).cosine_basis()?;
     let mut classified = Vec::new();
     for p in runs[1].converged() {
         if let Some(nj) = subharmonic_of_bar_1(&tb.system, &basis, p)? {
@@ -571,16 +550,14 @@ pub fn fig18(ctx: &Ctx) -> Res<Stats> {
         .chain(family2)
         .filter_map(|(name, p)| p.map(|p| (name, p)))
         .collect();
-    let picks: Vec<&BackbonePoint> = named.iter().map(|(_, p)| *p).collect();
-    bb.legend = LegendPosition::UpperLeft;
     let panels = named_snapshots(&tb, &named)?;
     ctx.backbone_figure(
         &mut stats,
         "fig18_two_bar_config3",
         &Figure::new(
-            "Fig. 18: two bars (0.95, 2, 1) (dashed: omega_1^(1), 1.13 omega_1^(1), omega_1^(2)/2, omega_1^(2), 1.25 omega_1^(2))",
+            "Fig. 18: two bars (0.95, 2, 1) (dashed: ω₁⁽¹⁾, 1.13 ω₁⁽¹⁾, ω₁⁽²⁾/2, ω₁⁽²⁾, 1.25 ω₁⁽²⁾)",
             3,
-            marked(bb, "points a-e", &picks, w1, panels),
+            marked(bb, "", &named, w1, panels),
         ),
         &tb.runs(),
         w1,

@@ -10,6 +10,7 @@ mod convergence;
 mod defaults;
 mod energy_backbone;
 mod escape;
+mod groups;
 mod guesses;
 mod level;
 mod lift;
@@ -35,6 +36,7 @@ pub use energy_backbone::{
     SLOPE_COLLAPSE, SLOPE_MEMORY,
 };
 pub use escape::{EscapingArclength, StallEscape};
+pub use groups::{group_by_label, PointGroup};
 pub use level::EnergyLevel;
 pub use lift::lift;
 pub use parameter::{parameter_branch, ParameterSteps};

@@ -53,6 +53,13 @@ impl ModeBranches {
         self.points.iter().filter(move |p| p.branch == index)
     }
 
+    /// The converged points grouped by label: the mode's own branch (skeleton or subharmonic)
+    /// first, then each internal resonance apart, then the unverified points
+    /// ([`group_by_label`](crate::branches::group_by_label)).
+    pub fn by_label(&self) -> Vec<crate::branches::PointGroup<'_>> {
+        crate::branches::group_by_label(&self.points)
+    }
+
     /// The number of branches (one more than the largest branch index; 0 without points).
     pub fn branch_count(&self) -> usize {
         self.points.iter().map(|p| p.branch + 1).max().unwrap_or(0)

@@ -3,16 +3,15 @@
 
 use super::snapshots::{snapshots_panel, PlacedBar};
 use super::types::{
-    Figure, LegendPosition, LineKind, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
-    SpaceTimeField, PALETTE,
+    Figure, LineKind, LinePanel, MapPanel, Marker, Panel, Rgb, Series, SpaceTimeField, PALETTE,
 };
 use super::{render_svg, PlotError};
 use std::path::Path;
 
 /// Axis label of normalised frequencies.
-pub const FREQUENCY_LABEL: &str = "Omega / omega_1";
+pub const FREQUENCY_LABEL: &str = "Ω/ω₁";
 /// Axis label of normalised energies.
-pub const ENERGY_LABEL: &str = "E / E_g";
+pub const ENERGY_LABEL: &str = "E/E_g";
 
 /// A backbone panel: `E/E_g` (logarithmic) against `Omega/omega_1` for several labelled
 /// branches, each with markers in its own colour, and an optional exact curve drawn as a
@@ -43,7 +42,7 @@ pub fn backbone_panel(
         .collect();
     if let Some(e) = exact {
         series.push(
-            Series::line("exact 8/(pi^2 (T-3)^2)", e.to_vec())
+            Series::line("exact 8/(π²(T − 3)²)", e.to_vec())
                 .with_color(Rgb::BLACK)
                 .with_size(1),
         );
@@ -104,7 +103,6 @@ pub fn histories_panel(
     }
     Ok(LinePanel {
         series: out,
-        legend: LegendPosition::UpperRight,
         ..LinePanel::new(title, "t", "")
     })
 }

@@ -1,10 +1,15 @@
 //! Line panels: linear or logarithmic axes, guide lines, series drawn as lines and markers,
-//! and the legend. The run drawing ([`draw_run`]) also serves the overlays of colour maps.
+//! the legend and the point labels. The run drawing ([`draw_run`]) also serves the overlays of
+//! colour maps.
 
+use super::annotate;
 use super::axes::{axis_range, axis_tick, clip_segments, finite_range, log_axis, segments, shown};
+use super::legend::{
+    draw_legend, fixed_box, free_box, least_covered_box, legend_size, Entry, INSET,
+};
+use super::place::{Drawn, PixelBox};
 use super::types::{LegendPosition, LineKind, LinePanel, Marker, Series, PALETTE};
 use super::{draw_err, panel_builder, Area, PlotError, FONT};
-use plotters::chart::SeriesAnno;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
@@ -23,24 +28,113 @@ pub(super) fn draw_line_panel(area: &Area<'_>, panel: &LinePanel) -> Result<(), 
     );
     let xr = axis_range(panel.x_range, xd, panel.x_log, "horizontal range")?;
     let yr = axis_range(panel.y_range, yd, panel.y_log, "vertical range")?;
-    let b = &mut panel_builder(area, &panel.title, 78);
+    let lines = Lines::of(panel, xr, yr);
     match (panel.x_log, panel.y_log) {
-        (false, false) => fill_lines(b, xr.0..xr.1, yr.0..yr.1, panel, xr, yr),
-        (true, false) => fill_lines(b, log_axis(xr), yr.0..yr.1, panel, xr, yr),
-        (false, true) => fill_lines(b, xr.0..xr.1, log_axis(yr), panel, xr, yr),
-        (true, true) => fill_lines(b, log_axis(xr), log_axis(yr), panel, xr, yr),
+        (false, false) => fill_lines(area, || xr.0..xr.1, || yr.0..yr.1, &lines),
+        (true, false) => fill_lines(area, || log_axis(xr), || yr.0..yr.1, &lines),
+        (false, true) => fill_lines(area, || xr.0..xr.1, || log_axis(yr), &lines),
+        (true, true) => fill_lines(area, || log_axis(xr), || log_axis(yr), &lines),
     }
 }
 
-/// Builds the chart of axes `x_spec` and `y_spec` (of ranges `xr` and `yr`) and draws the
-/// mesh, the guides, the series and the legend of `panel` on it.
-fn fill_lines<X, Y>(
-    builder: &mut ChartBuilder<'_, '_, SVGBackend<'_>>,
-    x_spec: X,
-    y_spec: Y,
-    panel: &LinePanel,
+/// A line panel ready to draw: its ranges, and each series' colour and runs of points within
+/// the ranges.
+struct Lines<'a> {
+    panel: &'a LinePanel,
     xr: (f64, f64),
     yr: (f64, f64),
+    drawn: Vec<SeriesRuns<'a>>,
+}
+
+/// A series, its colour, and its runs of points within the panel's ranges.
+struct SeriesRuns<'a> {
+    series: &'a Series,
+    color: RGBColor,
+    runs: Vec<Vec<(f64, f64)>>,
+}
+
+impl<'a> Lines<'a> {
+    fn of(panel: &'a LinePanel, xr: (f64, f64), yr: (f64, f64)) -> Self {
+        let drawn = panel
+            .series
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let color = s.color.unwrap_or(PALETTE[i % PALETTE.len()]).color();
+                let runs = clip_segments(segments(&s.points, panel.x_log, panel.y_log), xr, yr);
+                SeriesRuns {
+                    series: s,
+                    color,
+                    runs,
+                }
+            })
+            .collect();
+        Self {
+            panel,
+            xr,
+            yr,
+            drawn,
+        }
+    }
+
+    /// The legend rows: labelled series with something drawn.
+    fn entries(&self) -> Vec<Entry<'a>> {
+        self.drawn
+            .iter()
+            .filter(|d| !d.series.label.is_empty() && !d.runs.is_empty())
+            .map(|d| Entry {
+                series: d.series,
+                color: d.color,
+            })
+            .collect()
+    }
+
+    /// What the series draw, in the pixels of `pixel`.
+    fn drawn_pixels(&self, pixel: impl Fn(&(f64, f64)) -> (i32, i32)) -> Drawn {
+        let mut d = Drawn::default();
+        let to = |p: &(f64, f64)| {
+            let (x, y) = pixel(p);
+            (f64::from(x), f64::from(y))
+        };
+        for SeriesRuns {
+            series: s, runs, ..
+        } in &self.drawn
+        {
+            for run in runs {
+                if s.marker.is_some() {
+                    let r = f64::from(s.size.max(1));
+                    d.points.extend(run.iter().map(|p| (to(p), r)));
+                }
+                if s.line != LineKind::None {
+                    d.segments
+                        .extend(run.windows(2).map(|w| (to(&w[0]), to(&w[1]))));
+                }
+            }
+        }
+        d
+    }
+}
+
+/// The plotting rectangle of a chart, in screen pixels.
+fn plot_box<DB: DrawingBackend, CT: CoordTranslate>(chart: &ChartContext<'_, DB, CT>) -> PixelBox {
+    let (x, y) = chart.plotting_area().get_pixel_range();
+    PixelBox {
+        x0: f64::from(x.start),
+        y0: f64::from(y.start),
+        x1: f64::from(x.end),
+        y1: f64::from(y.end),
+    }
+}
+
+/// Builds the chart of axes `x_spec()` and `y_spec()` and draws the mesh, the guides, the
+/// series, the legend and the point labels of `lines` on it. An automatic legend that finds
+/// no free place in the plot takes a strip on the right of `area`, found on a scratch chart
+/// of the same size before the real one is laid out.
+fn fill_lines<X, Y>(
+    area: &Area<'_>,
+    x_spec: impl Fn() -> X,
+    y_spec: impl Fn() -> Y,
+    lines: &Lines<'_>,
 ) -> Result<(), PlotError>
 where
     X: AsRangedCoord<Value = f64>,
@@ -48,9 +142,33 @@ where
     X::CoordDescType: ValueFormatter<f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let mut chart = builder
-        .build_cartesian_2d(x_spec, y_spec)
+    let panel = lines.panel;
+    let entries = lines.entries();
+    let size = legend_size(&entries);
+    let outside = match panel.legend {
+        _ if entries.is_empty() => false,
+        LegendPosition::Outside => true,
+        LegendPosition::Auto => !fits_inside(area, lines, size, x_spec(), y_spec())?,
+        _ => false,
+    };
+    let side = outside.then(|| strip_side(area, size)).flatten();
+    let (chart_area, legend_area) = match side {
+        Some(StripSide::Right) => {
+            let (w, _) = area.dim_in_pixel();
+            let (a, b) = area.split_horizontally(w - strip_width(size));
+            (a, Some((b, StripSide::Right)))
+        }
+        Some(StripSide::Below) => {
+            let (_, h) = area.dim_in_pixel();
+            let (a, b) = area.split_vertically(h - strip_height(size));
+            (a, Some((b, StripSide::Below)))
+        }
+        None => (area.clone(), None),
+    };
+    let mut chart = panel_builder(&chart_area, &panel.title, Y_LABEL_AREA)
+        .build_cartesian_2d(x_spec(), y_spec())
         .map_err(draw_err)?;
+    let (xr, yr) = (lines.xr, lines.yr);
     let xf = |v: &f64| axis_tick(*v, panel.x_log, xr);
     let yf = |v: &f64| axis_tick(*v, panel.y_log, yr);
     chart
@@ -84,122 +202,159 @@ where
             .draw_series(DashedLineSeries::new(ends, 6, 4, guide))
             .map_err(draw_err)?;
     }
-    let mut any_label = false;
-    for (i, s) in panel.series.iter().enumerate() {
-        let color = s.color.unwrap_or(PALETTE[i % PALETTE.len()]).color();
-        let mut legend_drawn = false;
-        for run in clip_segments(segments(&s.points, panel.x_log, panel.y_log), xr, yr) {
-            let legend = !s.label.is_empty() && !legend_drawn;
-            legend_drawn |= draw_run(&mut chart, &run, s, color, legend)?;
+    for d in &lines.drawn {
+        for run in &d.runs {
+            draw_run(&mut chart, run, d.series, d.color)?;
         }
-        any_label |= legend_drawn;
     }
-    let position = match panel.legend {
-        LegendPosition::Hidden => None,
-        LegendPosition::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
-        LegendPosition::UpperRight => Some(SeriesLabelPosition::UpperRight),
-        LegendPosition::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
-        LegendPosition::LowerRight => Some(SeriesLabelPosition::LowerRight),
-        LegendPosition::UpperMiddle => Some(SeriesLabelPosition::UpperMiddle),
-        LegendPosition::LowerMiddle => Some(SeriesLabelPosition::LowerMiddle),
+    let plot = plot_box(&chart);
+    let legend_box = match (&legend_area, panel.legend) {
+        _ if entries.is_empty() => None,
+        (Some((strip, side)), _) => {
+            let (x, y) = strip.get_base_pixel();
+            let (x, y) = (f64::from(x), f64::from(y));
+            Some(match side {
+                StripSide::Right => PixelBox::at(x + INSET, plot.y0.max(y), size.0, size.1),
+                StripSide::Below => PixelBox::at(plot.x0, y + 0.5 * INSET, size.0, size.1),
+            })
+        }
+        (None, LegendPosition::Auto | LegendPosition::Outside) => {
+            let drawn = lines.drawn_pixels(|p| chart.backend_coord(p));
+            free_box(&plot, size, &drawn).or_else(|| least_covered_box(&plot, size, &drawn))
+        }
+        (None, position) => fixed_box(position, &plot, size),
     };
-    if let (true, Some(position)) = (any_label, position) {
-        chart
-            .configure_series_labels()
-            .position(position)
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(160, 160, 160))
-            .draw()
-            .map_err(draw_err)?;
+    let mut taken: Vec<PixelBox> = legend_box.iter().cloned().collect();
+    let placed = annotate::place(
+        &panel.annotations,
+        |p| {
+            let shown_here = shown(p.0, panel.x_log)
+                && shown(p.1, panel.y_log)
+                && within(p.0, xr)
+                && within(p.1, yr);
+            shown_here.then(|| {
+                let (x, y) = chart.backend_coord(&p);
+                (f64::from(x), f64::from(y))
+            })
+        },
+        &plot,
+        &mut taken,
+    );
+    annotate::draw(area, &placed)?;
+    if let Some(b) = legend_box {
+        draw_legend(area, &b, &entries)?;
     }
     Ok(())
 }
 
+/// Which side of a panel a legend strip takes when the legend has no free place in the plot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StripSide {
+    Right,
+    Below,
+}
+
+/// Width of a strip on the right holding a legend of `size`.
+fn strip_width(size: (f64, f64)) -> u32 {
+    (size.0 + 2.0 * INSET).ceil() as u32
+}
+
+/// Height of a strip below the plot holding a legend of `size`.
+fn strip_height(size: (f64, f64)) -> u32 {
+    (size.1 + INSET).ceil() as u32
+}
+
+/// The side of `area` a legend strip of `size` takes: the right if it leaves the plot at
+/// least half the width, else below if it leaves two thirds of the height; `None` if neither.
+fn strip_side(area: &Area<'_>, size: (f64, f64)) -> Option<StripSide> {
+    let (w, h) = area.dim_in_pixel();
+    if strip_width(size) < w / 2 {
+        Some(StripSide::Right)
+    } else if strip_height(size) < h / 3 {
+        Some(StripSide::Below)
+    } else {
+        None
+    }
+}
+
+/// Whether a legend of `size` has a free place in the plot of `lines` laid out on `area`, found
+/// on a scratch chart of the same size (the real one is built once the legend's place, inside
+/// or in a strip beside the plot, is known).
+fn fits_inside<X, Y>(
+    area: &Area<'_>,
+    lines: &Lines<'_>,
+    size: (f64, f64),
+    x_spec: X,
+    y_spec: Y,
+) -> Result<bool, PlotError>
+where
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+{
+    let mut scratch = String::new();
+    let root = SVGBackend::with_string(&mut scratch, area.dim_in_pixel()).into_drawing_area();
+    let chart = panel_builder(&root, &lines.panel.title, Y_LABEL_AREA)
+        .build_cartesian_2d(x_spec, y_spec)
+        .map_err(draw_err)?;
+    let base = area.get_base_pixel();
+    let drawn = lines.drawn_pixels(|p| {
+        let (x, y) = chart.backend_coord(p);
+        (x + base.0, y + base.1)
+    });
+    let plot = plot_box(&chart);
+    let (dx, dy) = (f64::from(base.0), f64::from(base.1));
+    let plot = PixelBox {
+        x0: plot.x0 + dx,
+        y0: plot.y0 + dy,
+        x1: plot.x1 + dx,
+        y1: plot.y1 + dy,
+    };
+    Ok(free_box(&plot, size, &drawn).is_some())
+}
+
+/// Width of the label area left of a line panel's vertical axis, in pixels.
+const Y_LABEL_AREA: u32 = 78;
+
 /// Draws one run of points of `s` in `color`: its line (if any), then its markers (if any).
-/// With `legend`, the first of them drawn carries the legend entry of `s`; returns whether
-/// one did.
 pub(super) fn draw_run<'a, DB, CT>(
     chart: &mut ChartContext<'a, DB, CT>,
     run: &[(f64, f64)],
     s: &Series,
     color: RGBColor,
-    legend: bool,
-) -> Result<bool, PlotError>
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend + 'a,
     CT: CoordTranslate<From = (f64, f64)>,
 {
     let stroke = color.stroke_width(s.size.max(1));
     let points = run.iter().cloned();
-    let line = match s.line {
-        LineKind::None => None,
-        LineKind::Solid => Some(chart.draw_series(LineSeries::new(points, stroke))),
-        LineKind::Dashed => Some(chart.draw_series(DashedLineSeries::new(points, 8, 5, stroke))),
-    };
-    let mut labelled = false;
-    if let Some(anno) = line {
-        let anno = anno.map_err(draw_err)?;
-        if legend {
-            set_legend(anno, s, color);
-            labelled = true;
+    match s.line {
+        LineKind::None => {}
+        LineKind::Solid => {
+            chart
+                .draw_series(LineSeries::new(points, stroke))
+                .map_err(draw_err)?;
+        }
+        LineKind::Dashed => {
+            chart
+                .draw_series(DashedLineSeries::new(points, 8, 5, stroke))
+                .map_err(draw_err)?;
         }
     }
     if let Some(m) = s.marker {
-        let anno = draw_markers(chart, run, m, s.size.max(1) as i32, color)?;
-        if legend && !labelled {
-            set_legend(anno, s, color);
-            labelled = true;
-        }
+        draw_markers(chart, run, m, s.size.max(1) as i32, color)?;
     }
-    Ok(labelled)
-}
-
-/// Sets the legend entry of `s` on `anno`: its marker alone for a series without a line, a
-/// short dashed or solid line otherwise.
-fn set_legend<'a, DB: DrawingBackend + 'a>(
-    anno: &mut SeriesAnno<'a, DB>,
-    s: &Series,
-    color: RGBColor,
-) {
-    anno.label(s.label.as_str());
-    let stroke = color.stroke_width(2);
-    match (s.line, s.marker) {
-        (LineKind::None, Some(m)) => {
-            let fill = color.filled();
-            match m {
-                Marker::Circle => anno.legend(move |(x, y)| Circle::new((x + 10, y), 4, fill)),
-                Marker::Ring => anno.legend(move |(x, y)| Circle::new((x + 10, y), 4, stroke)),
-                Marker::Square => anno
-                    .legend(move |(x, y)| Rectangle::new([(x + 6, y - 4), (x + 14, y + 4)], fill)),
-                Marker::Triangle => {
-                    anno.legend(move |(x, y)| TriangleMarker::new((x + 10, y), 5, fill))
-                }
-                Marker::Cross => anno.legend(move |(x, y)| Cross::new((x + 10, y), 4, stroke)),
-            };
-        }
-        (LineKind::Dashed, _) => {
-            anno.legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(vec![(0, 0), (5, 0)], stroke)
-                    + PathElement::new(vec![(8, 0), (13, 0)], stroke)
-                    + PathElement::new(vec![(16, 0), (21, 0)], stroke)
-            });
-        }
-        _ => {
-            anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], stroke));
-        }
-    }
+    Ok(())
 }
 
 /// Draws marker `m` of radius `r` at every point of `run`.
-fn draw_markers<'c, 'b, DB, CT>(
-    chart: &'c mut ChartContext<'b, DB, CT>,
+fn draw_markers<'b, DB, CT>(
+    chart: &mut ChartContext<'b, DB, CT>,
     run: &[(f64, f64)],
     m: Marker,
     r: i32,
     color: RGBColor,
-) -> Result<&'c mut SeriesAnno<'b, DB>, PlotError>
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend + 'b,
     CT: CoordTranslate<From = (f64, f64)>,
@@ -216,5 +371,6 @@ where
         Marker::Triangle => chart.draw_series(pts.map(|p| TriangleMarker::new(p, r + 1, fill))),
         Marker::Cross => chart.draw_series(pts.map(|p| Cross::new(p, r, color.stroke_width(2)))),
     }
-    .map_err(draw_err)
+    .map_err(draw_err)?;
+    Ok(())
 }

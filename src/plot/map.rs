@@ -25,9 +25,7 @@ fn colormap(s: f64, diverging: bool) -> Rgb {
             Rgb(150, 205, 60),
             Rgb(250, 230, 40),
         ];
-        let s = s.clamp(0.0, 1.0) * (stops.len() - 1) as f64;
-        let i = (s.floor() as usize).min(stops.len() - 2);
-        stops[i].mix(stops[i + 1], s - i as f64)
+        Rgb::along(&stops, s)
     }
 }
 
@@ -142,7 +140,7 @@ pub(super) fn draw_map_panel(area: &Area<'_>, panel: &MapPanel) -> Result<(), Pl
             PALETTE[i % PALETTE.len()]
         });
         for run in clip_segments(segments(&s.points, false, false), xr, yr) {
-            draw_run(&mut chart, &run, s, color.color(), false)?;
+            draw_run(&mut chart, &run, s, color.color())?;
         }
     }
     draw_colour_bar(&bar, panel, (vlo, vhi), normalise)

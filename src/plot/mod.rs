@@ -32,22 +32,26 @@
 // Split by plot kind: the data types (`types`), axis ranges and ticks (`axes`), line panels
 // (`lines`), colour maps (`map`), bar snapshots (`snapshots`), and the panel builders with the
 // one-call helpers (`helpers`). Everything public is re-exported here.
+mod annotate;
 mod axes;
 mod helpers;
+mod legend;
 mod lines;
 mod map;
+mod place;
 mod snapshots;
 mod stability;
+mod svg;
 mod types;
 
 pub use helpers::{
     backbone_panel, histories_panel, plot_backbone, plot_histories, plot_snapshots,
     plot_space_time, plot_xy, space_time_panel, ENERGY_LABEL, FREQUENCY_LABEL,
 };
-pub use snapshots::{snapshots_panel, PlacedBar, Placement};
+pub use snapshots::{instant_colour, snapshots_panel, PlacedBar, Placement};
 pub use stability::stability_series;
 pub use types::{
-    Figure, LegendPosition, LineKind, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
+    Annotation, Figure, LegendPosition, LineKind, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
     SpaceTimeField, PALETTE,
 };
 
@@ -127,20 +131,24 @@ pub fn render_svg(path: impl AsRef<Path>, figure: &Figure) -> Result<(), PlotErr
     let rows = figure.panels.len().div_ceil(columns);
     let header = if figure.title.is_empty() { 0 } else { 40 };
     let size = (pw * columns as u32, ph * rows as u32 + header);
-    let root = SVGBackend::new(path.as_ref(), size).into_drawing_area();
-    root.fill(&WHITE).map_err(draw_err)?;
-    let body = if figure.title.is_empty() {
-        root.clone()
-    } else {
-        root.titled(&figure.title, (FONT, 24)).map_err(draw_err)?
-    };
-    let areas = body.split_evenly((rows, columns));
-    for (panel, area) in figure.panels.iter().zip(&areas) {
-        match panel {
-            Panel::Lines(p) => lines::draw_line_panel(area, p)?,
-            Panel::Map(p) => map::draw_map_panel(area, p)?,
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        let body = if figure.title.is_empty() {
+            root.clone()
+        } else {
+            root.titled(&figure.title, (FONT, 24)).map_err(draw_err)?
+        };
+        let areas = body.split_evenly((rows, columns));
+        for (panel, area) in figure.panels.iter().zip(&areas) {
+            match panel {
+                Panel::Lines(p) => lines::draw_line_panel(area, p)?,
+                Panel::Map(p) => map::draw_map_panel(area, p)?,
+            }
         }
+        root.present().map_err(draw_err)?;
     }
-    root.present().map_err(draw_err)?;
-    Ok(())
+    std::fs::write(path.as_ref(), svg::portable_text(&text))
+        .map_err(|e| PlotError::Draw(format!("writing {}: {e}", path.as_ref().display())))
 }

@@ -25,12 +25,30 @@ pub struct PlacedBar<'a> {
     pub placement: Placement,
 }
 
+/// The colour of instant `s in [0, 1]` of a snapshot plot: indigo, blue, cyan, green,
+/// yellow-green, amber, orange, crimson. Eight instants get eight hues a reader tells apart,
+/// still ordered from cool (early) to warm (late); every colour is dark enough to read on
+/// white.
+pub fn instant_colour(s: f64) -> Rgb {
+    let stops = [
+        Rgb(45, 30, 120),
+        Rgb(40, 90, 200),
+        Rgb(0, 160, 200),
+        Rgb(0, 150, 100),
+        Rgb(120, 170, 20),
+        Rgb(225, 155, 0),
+        Rgb(220, 80, 20),
+        Rgb(160, 20, 60),
+    ];
+    Rgb::along(&stops, s)
+}
+
 /// Snapshots of the displacement of one or more bars at `instants` instants evenly picked
 /// from their time grids, in a common frame: bar positions along the horizontal axis (a
 /// mirrored bar faces the other, as the paper's Fig. 3), displacements vertically (a mirrored
-/// bar's drawn as `-u`, i.e. in the common frame's direction), one colour per instant shading
-/// from blue (`t = 0`) to red (last instant), and dashed guides at `guides` (e.g. the contact
-/// interface).
+/// bar's drawn as `-u`, i.e. in the common frame's direction), one colour per instant from
+/// [`instant_colour`] (blue at `t = 0`, red at the last instant), and dashed guides at `guides`
+/// (e.g. the contact interface).
 ///
 /// # Errors
 /// [`PlotError::InvalidData`] for no bar, zero instants, or a field whose lengths do not match.
@@ -50,9 +68,8 @@ pub fn snapshots_panel(
         b.field.check("snapshot field")?;
     }
     let mut series = Vec::new();
-    let (early, late) = (Rgb(30, 90, 200), Rgb(210, 30, 40));
     for s in 0..instants {
-        let color = early.mix(late, s as f64 / (instants.max(2) - 1) as f64);
+        let color = instant_colour(s as f64 / (instants.max(2) - 1) as f64);
         for (bi, b) in bars.iter().enumerate() {
             let nt = b.field.time.len();
             let k = (s * nt / instants).min(nt - 1);
@@ -79,7 +96,7 @@ pub fn snapshots_panel(
     let names: Vec<&str> = bars.iter().map(|b| b.name).collect();
     let y_label = if bars.iter().any(|b| b.placement.mirrored) {
         format!(
-            "displacement ({}: solid, dashed; mirrored as -u)",
+            "displacement ({}: solid, dashed; mirrored as −u)",
             names.join(", ")
         )
     } else {
@@ -89,7 +106,7 @@ pub fn snapshots_panel(
         series,
         x_guides: guides.to_vec(),
         legend: if instants <= 8 {
-            LegendPosition::UpperLeft
+            LegendPosition::Auto
         } else {
             LegendPosition::Hidden
         },

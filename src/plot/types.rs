@@ -42,6 +42,19 @@ impl Rgb {
         let m = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * s).round() as u8;
         Rgb(m(self.0, other.0), m(self.1, other.1), m(self.2, other.2))
     }
+
+    /// The colour at `s in [0, 1]` of the scale through `stops`, evenly spaced (at least two),
+    /// blended linearly between neighbours; `s` is clamped, and a non-finite `s` is 0.
+    pub(super) fn along(stops: &[Rgb], s: f64) -> Rgb {
+        let s = if s.is_finite() {
+            s.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let s = s * (stops.len() - 1) as f64;
+        let i = (s.floor() as usize).min(stops.len() - 2);
+        stops[i].mix(stops[i + 1], s - i as f64)
+    }
 }
 
 /// How the points of a series are joined.
@@ -144,8 +157,16 @@ impl Series {
 /// Where the legend of a line panel goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LegendPosition {
-    /// Upper left corner (default).
+    /// The first corner (then the middle of the upper or lower edge) of the plot where the
+    /// legend meets no drawn point or line, else outside the plot: on its right, or below it
+    /// when a strip on the right would take half the panel (default). Only a legend too large
+    /// for either strip is set inside, where it covers the fewest points.
     #[default]
+    Auto,
+    /// Outside the plot: on its right, or below it when a strip on the right would take half
+    /// the panel.
+    Outside,
+    /// Upper left corner.
     UpperLeft,
     /// Upper right corner.
     UpperRight,
@@ -186,6 +207,29 @@ pub struct LinePanel {
     pub y_guides: Vec<f64>,
     /// Legend placement.
     pub legend: LegendPosition,
+    /// Labels of points (e.g. the lettered points of a paper's figure).
+    pub annotations: Vec<Annotation>,
+}
+
+/// A text label attached to a point of a line panel. It is drawn beside its point, on a white
+/// ground, where it covers neither another label nor the legend; a label set away from its
+/// point is tied to it by a leader line.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Annotation {
+    /// The point `(x, y)` in the panel's data coordinates.
+    pub at: (f64, f64),
+    /// The label (e.g. `"b"`).
+    pub text: String,
+}
+
+impl Annotation {
+    /// The label `text` at `(x, y)`.
+    pub fn new(at: (f64, f64), text: impl Into<String>) -> Self {
+        Self {
+            at,
+            text: text.into(),
+        }
+    }
 }
 
 impl LinePanel {

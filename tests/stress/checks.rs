@@ -101,6 +101,7 @@ impl Checks {
         for p in &run.points {
             self.backbone_point(what, p);
         }
+        self.groups(what, run);
         let by_observer = run.end == EndReason::StoppedByObserver;
         if by_observer != stopped {
             self.no_end.push(format!(
@@ -108,6 +109,31 @@ impl Checks {
                 run.points.len(),
                 run.end
             ));
+        }
+    }
+
+    /// `ModeBranches::by_label` partitions the converged, labelled points: every one in exactly
+    /// one non-empty group, one group per label, the mode's own branch before any other.
+    fn groups(&mut self, what: &str, run: &ModeBranches) {
+        let groups = run.by_label();
+        let labelled = run.converged().filter(|p| p.label.is_some()).count();
+        let grouped: usize = groups.iter().map(|g| g.points.len()).sum();
+        self.expect(grouped == labelled, || {
+            format!("{what}: {grouped} points in label groups for {labelled} labelled")
+        });
+        for (i, g) in groups.iter().enumerate() {
+            let alone = groups[i + 1..].iter().all(|h| h.label != g.label);
+            let own_first = !g.is_own_branch() || groups[..i].iter().all(|h| h.is_own_branch());
+            let consistent = g.points.iter().all(|p| p.label.as_ref() == Some(&g.label));
+            self.expect(
+                !g.points.is_empty() && alone && own_first && consistent,
+                || {
+                    format!(
+                        "{what}: label group {i} ({}) is not a part of a partition",
+                        g.label
+                    )
+                },
+            );
         }
     }
 
