@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! cargo run --release --example convergence_in_m -- [--harmonics 20,40,80,160] [--out FILE]
+//!     [--ways grid,selection,...] [--selection-width C]
 //! ```
 //!
 //! Each way of computing the branch runs over the system's own period grid
@@ -21,7 +22,14 @@
 //! - `extrapolated`: `2 E_m - E_(m/2)` from the lifted runs at `m` and `m / 2`, at the
 //!   periods where both converged (an error decaying like `1/m`);
 //! - `exact-start` (the clamped bar only): Newton at each period from the exact family's own
-//!   Fourier coefficients, what the truncated equations give near the exact motion.
+//!   Fourier coefficients, what the truncated equations give near the exact motion;
+//! - `selection`: the period grid with the harmonics near a linear resonance held at zero
+//!   ([`HarmonicBalanceSettings::resonance_band`](nonsmooth_modes::system::HarmonicBalanceSettings::resonance_band)
+//!   `= C`, `--selection-width`, default [`RESONANCE_BAND`]);
+//! - `selection-exact-start` (the clamped bar only): `exact-start` with that selection.
+//!
+//! `--ways` computes only the listed rows (all by default; `grid` is always computed, and
+//! the multipliers only for `corrected` and `lifted-corrected`, which take most of the time).
 //!
 //! For each it prints and writes (CSV, `--out`, default `convergence_in_m.csv`; columns
 //! `system,way,harmonics,converged,within_2,within_5,median_error`) the converged points,
@@ -40,7 +48,7 @@ use nonsmooth_modes::reference::{
 };
 use nonsmooth_modes::solve::{NonlinearSolver, Solver};
 use nonsmooth_modes::stability::{StabilityOptions, Verdict};
-use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, NonsmoothSystem};
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, NonsmoothSystem, RESONANCE_BAND};
 use std::collections::HashMap;
 use std::error::Error;
 use std::f64::consts::PI;
@@ -159,9 +167,26 @@ fn exact_start(
     Ok(points)
 }
 
+/// `(T, E/E_g)` where Newton converges at `periods` from the clamped bar's exact
+/// The ways of computing a branch that the table can show, in its order.
+const WAYS: [&str; 10] = [
+    "grid",
+    "corrected",
+    "auto",
+    "auto-checked",
+    "lifted",
+    "lifted-corrected",
+    "extrapolated",
+    "exact-start",
+    "selection",
+    "selection-exact-start",
+];
+
 fn main() -> Result<(), Box<dyn Error>> {
     let mut harmonics = vec![20, 40, 80, 160];
+    let mut ways: Vec<String> = WAYS.iter().map(|w| w.to_string()).collect();
     let mut out = String::from("convergence_in_m.csv");
+    let mut width = RESONANCE_BAND;
     let mut args = std::env::args().skip(1);
     while let Some(flag) = args.next() {
         let value = args.next().ok_or_else(|| format!("{flag} needs a value"))?;
@@ -172,6 +197,13 @@ fn main() -> Result<(), Box<dyn Error>> {
                     .collect::<Result<_, _>>()?;
             }
             "--out" => out = value,
+            "--selection-width" => width = value.parse()?,
+            "--ways" => {
+                ways = value.split(',').map(str::to_string).collect();
+                if let Some(w) = ways.iter().find(|w| !WAYS.contains(&w.as_str())) {
+                    return Err(format!("unknown way {w} (ways: {})", WAYS.join(",")).into());
+                }
+            }
             _ => return Err(format!("unknown flag {flag}").into()),
         }
     }
@@ -204,36 +236,64 @@ fn main() -> Result<(), Box<dyn Error>> {
         let mut lifted: Option<ModeBranches> = None;
         for &m in &harmonics {
             let request = Request::new(1).harmonics(m);
-            let stability = request.clone().with_stability(StabilityOptions::default());
+            let wanted = |way: &str| ways.iter().any(|w| w == way);
+            // The exact map's corrections come with the Floquet multipliers: asked only for
+            // the rows that show them.
+            let corrections = wanted("corrected") || wanted("lifted-corrected");
+            let annotated = if corrections {
+                request.clone().with_stability(StabilityOptions::default())
+            } else {
+                request.clone()
+            };
             let check = TimeDomainCheck::for_system(&family.system);
             let by_grid = compute(
                 &family.system,
-                &stability.clone().method(Method::PeriodGrid(grid)),
+                &annotated.clone().method(Method::PeriodGrid(grid)),
             )?;
-            let auto = compute(&family.system, &request)?;
-            let checked = compute(&family.system, &request.clone().checked(check))?;
-            let mut rows = vec![
-                ("grid", row(converged(&by_grid))),
-                ("corrected", row(corrected(&by_grid))),
-                ("auto", row(converged(&auto))),
-                ("auto-checked", row(converged(&checked))),
-            ];
-            let chained = match &lifted {
-                Some(run) => lift(run, &stability)?,
-                None => by_grid,
-            };
-            rows.push(("lifted", row(converged(&chained))));
-            rows.push(("lifted-corrected", row(corrected(&chained))));
-            if let Some(coarse) = &lifted {
-                rows.push(("extrapolated", row(extrapolated(coarse, &chained))));
+            let mut rows = vec![("grid", row(converged(&by_grid)))];
+            if corrections {
+                rows.push(("corrected", row(corrected(&by_grid))));
             }
-            lifted = Some(chained);
-            if family.name == "clamped" {
+            if wanted("auto") {
+                rows.push(("auto", row(converged(&compute(&family.system, &request)?))));
+            }
+            if wanted("auto-checked") {
+                let checked = compute(&family.system, &request.clone().checked(check))?;
+                rows.push(("auto-checked", row(converged(&checked))));
+            }
+            let selected = request.clone().resonance_band(width);
+            if wanted("selection") {
+                let run = compute(
+                    &family.system,
+                    &selected.clone().method(Method::PeriodGrid(grid)),
+                )?;
+                rows.push(("selection", row(converged(&run))));
+            }
+            if family.name == "clamped" && wanted("selection-exact-start") {
+                let points = exact_start(&family.system, &periods, &selected)?;
+                rows.push(("selection-exact-start", row(points)));
+            }
+            if wanted("lifted") || wanted("lifted-corrected") || wanted("extrapolated") {
+                let chained = match &lifted {
+                    Some(run) => lift(run, &annotated)?,
+                    None => by_grid.clone(),
+                };
+                rows.push(("lifted", row(converged(&chained))));
+                if corrections {
+                    rows.push(("lifted-corrected", row(corrected(&chained))));
+                }
+                if let Some(coarse) = &lifted {
+                    rows.push(("extrapolated", row(extrapolated(coarse, &chained))));
+                }
+                lifted = Some(chained);
+            }
+            if family.name == "clamped" && wanted("exact-start") {
                 rows.push((
                     "exact-start",
                     row(exact_start(&family.system, &periods, &request)?),
                 ));
             }
+            rows.retain(|(way, _)| wanted(way));
             for (way, r) in rows {
                 let name = family.name;
                 // No converged point has no median: a dash in the table, empty in the CSV.

@@ -100,6 +100,7 @@ const FLAGS: &[(&str, Value)] = &[
     ("harmonics", Value::Count(1, 30)),
     ("samples-per-harmonic", Value::Count(2, 48)),
     ("complementarity", Value::Real(0.5, 10.0)),
+    ("resonance-band", Value::Real(0.01, 0.5)),
     ("mode", Value::Count(1, 3)),
     ("subharmonic", Value::Count(1, 3)),
     ("period-start", Value::Real(0.5, 12.0)),

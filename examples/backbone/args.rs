@@ -8,7 +8,7 @@ use nonsmooth_modes::system::HarmonicBalanceSettings;
 
 pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--robin-stiffness K]
   [--length2 L --speed2 C --stiffness-ratio R] | [--assembly FILE.toml|FILE.json]
-  [--harmonics M] [--samples-per-harmonic NH]
+  [--harmonics M] [--samples-per-harmonic NH] [--resonance-band C]
   [--complementarity AC] [--mode I] [--subharmonic K] [--repeated] [--period-start T0] [--period-end T1] [--steps S]
   [--solver newton|dogleg] [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
   [--selection first|lowest-energy] [--serial] [--out FILE]
@@ -193,6 +193,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
                 )?
             }
             Long("complementarity") => a.settings.complementarity = parser.value()?.parse()?,
+            Long("resonance-band") => a.settings.resonance_band = parser.value()?.parse()?,
             Long("mode") => a.mode = parser.value()?.parse()?,
             Long("subharmonic") => a.subharmonic = parser.value()?.parse()?,
             Long("repeated") => a.repeated = true,

@@ -4,7 +4,8 @@
 //! cargo run --release --example backbone -- [--system ds|rs|two-bar] [--gap 1e-3]
 //!     [--robin-stiffness 0.5] [--length2 0.95 --speed2 1 --stiffness-ratio 1]
 //!     [--assembly FILE]
-//!     [--harmonics 20 --samples-per-harmonic 30 --complementarity 4] [--mode 1] [--subharmonic 1]
+//!     [--harmonics 20 --samples-per-harmonic 30 --complementarity 4] [--resonance-band C]
+//!     [--mode 1] [--subharmonic 1]
 //!     [--period-start T0 --period-end T1 --steps S] [--solver newton|dogleg] [--out FILE]
 //!     [--newton fail-fast|full] [--retry-depth K] [--max-failures F]
 //!     [--selection first|lowest-energy] [--serial]
@@ -47,6 +48,13 @@
 //! 1/400 of the shortest travel time, at most 10^6 steps per point) and adds the columns
 //! `periodicity_defect,displacement_defect,max_penetration` (empty, with a message, for a
 //! point it could not check).
+//!
+//! `--resonance-band C` holds at zero every harmonic `n >= 2` whose frequency lies within
+//! `C / m` (relative) of an open- or closed-contact natural frequency
+//! (`HarmonicBalanceSettings::resonance_band`; 0, the default, keeps every harmonic, and
+//! `system::RESONANCE_BAND` = 0.1 is the measured choice): the truncation's internal
+//! resonances go, and the skeleton converges as `--harmonics` grows (`docs/theory.md`,
+//! "Harmonic selection"). A band that is not finite, negative or above `m` is a usage error.
 //!
 //! `--stability` asks the library for the Floquet multipliers of every converged point
 //! (`stability`, default options: 200 cells per shortest travel time, the state corrected to

@@ -220,6 +220,14 @@ impl Request {
         self
     }
 
+    /// The same request with harmonic selection of width `width`
+    /// ([`HarmonicBalanceSettings::resonance_band`]; `RESONANCE_BAND` is the measured
+    /// choice, 0 keeps every harmonic).
+    pub fn resonance_band(mut self, width: f64) -> Self {
+        self.settings.resonance_band = width;
+        self
+    }
+
     /// The same request for NSM `mode` sub `order`.
     pub fn subharmonic(mut self, order: usize) -> Self {
         self.subharmonic = order;

@@ -223,6 +223,7 @@ fn search_coarse<S: NonlinearSolver>(
         samples_per_harmonic: basis.samples() / basis.harmonics(),
         complementarity: problem.complementarity(),
         kink_blend: problem.description().kink_blend(),
+        resonance_band: problem.resonance_band().min(harmonics as f64),
     };
     let system = problem.system().clone();
     let mut coarse = NonsmoothSystem::new(&system, settings).ok()?;

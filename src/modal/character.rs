@@ -381,6 +381,7 @@ mod tests {
         samples_per_harmonic: 30,
         complementarity: 4.0,
         kink_blend: 0.0,
+        resonance_band: 0.0,
     };
 
     fn open_frequencies(system: &BarSystem, omega_max: f64) -> Vec<f64> {

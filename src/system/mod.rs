@@ -19,5 +19,5 @@ pub use family::{ParameterFamily, SystemFamily};
 pub use layout::Layout;
 pub use problem::{
     Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE, MAX_OFFSET,
-    MAX_PHASE,
+    MAX_PHASE, RESONANCE_BAND,
 };

@@ -28,6 +28,7 @@
 
 mod band;
 mod discretization;
+mod selection;
 mod staircase;
 mod state;
 mod step;
@@ -42,6 +43,7 @@ use crate::solve::{point_on_ray, Problem, SingularStep, Structured};
 use crate::system::rows::HarmonicRows;
 use crate::system::{BarSystem, Layout};
 use band::Banded;
+use selection::Selection;
 use state::{Frequency, Samples};
 use step::Reduced;
 
@@ -63,7 +65,19 @@ pub struct HarmonicBalanceSettings {
     /// Jacobian jumps between iterations, but branches near internal resonances are sensitive
     /// to it (`docs/performance.md` has the measurements), hence the exact default.
     pub kink_blend: f64,
+    /// Harmonic selection: the width `c` of the band `|n Omega / omega_k - 1| < c / m` around
+    /// every open- and closed-contact natural frequency `omega_k` in which a harmonic
+    /// `n >= 2` is held at zero (0, the default: every harmonic kept, the paper's equations;
+    /// [`RESONANCE_BAND`] is the measured choice; at most `m`). It removes the internal
+    /// resonances of the truncation, so that the skeleton converges as `m` grows
+    /// (`docs/theory.md`, "Harmonic selection").
+    pub resonance_band: f64,
 }
+
+/// The width `c` of [`HarmonicBalanceSettings::resonance_band`] measured on both exact
+/// families (`docs/validation.md`, "Convergence in the number of harmonics"): narrower bands
+/// let resonances through at large `m`, wider ones drop harmonics the motion needs.
+pub const RESONANCE_BAND: f64 = 0.1;
 
 impl Default for HarmonicBalanceSettings {
     fn default() -> Self {
@@ -72,6 +86,7 @@ impl Default for HarmonicBalanceSettings {
             samples_per_harmonic: 30,
             complementarity: 4.0,
             kink_blend: 0.0,
+            resonance_band: 0.0,
         }
     }
 }
@@ -102,7 +117,6 @@ impl HarmonicBalanceSettings {
 /// [`ContinuationError::Dimension`](crate::ContinuationError::Dimension) instead). Before the
 /// first [`ContinuationProblem::set_parameter`] the frequency is NaN and so is the residual
 /// (solvers report it as [`SolveError::NonFinite`](crate::SolveError::NonFinite)).
-/// (solvers report it as [`SolveError::NonFinite`](crate::SolveError::NonFinite)).
 ///
 /// # Samples reused
 /// [`Problem::residual`] at `x` depends on `x` and the frequency alone. A Jacobian-type
@@ -118,6 +132,8 @@ impl HarmonicBalanceSettings {
 pub struct NonsmoothSystem<B: Basis = CosineBasis> {
     description: Discretization<B>,
     ws: Workspace,
+    /// Harmonic selection, if asked ([`HarmonicBalanceSettings::resonance_band`]).
+    selection: Option<Selection>,
 }
 
 /// What the evaluations of a [`NonsmoothSystem`] change.
@@ -139,6 +155,7 @@ impl NonsmoothSystem<CosineBasis> {
         let mut problem =
             Self::with_basis(system, settings.cosine_basis()?, settings.complementarity)?;
         problem.set_kink_blend(settings.kink_blend)?;
+        problem.set_resonance_band(settings.resonance_band)?;
         Ok(problem)
     }
 }
@@ -159,7 +176,67 @@ impl<B: Basis> NonsmoothSystem<B> {
             reduced: Reduced::default(),
             banded: Banded::default(),
         };
-        Ok(Self { description, ws })
+        Ok(Self {
+            description,
+            ws,
+            selection: None,
+        })
+    }
+
+    /// Sets [`HarmonicBalanceSettings::resonance_band`] (0: every harmonic kept).
+    ///
+    /// # Errors
+    /// [`SettingsError::OutOfRange`] for a width that is not finite, negative or above `m`.
+    pub fn set_resonance_band(&mut self, width: f64) -> Result<(), SettingsError> {
+        let m = self.description.basis().harmonics();
+        if !(width.is_finite() && (0.0..=m as f64).contains(&width)) {
+            return Err(SettingsError::OutOfRange {
+                what: "resonance band",
+                value: width,
+                min: 0.0,
+                max: m as f64,
+            });
+        }
+        self.selection = Selection::new(width, m);
+        let omega = self.ws.frequency.omega;
+        if let Some(s) = &mut self.selection {
+            s.select(&self.description, omega);
+        }
+        self.ws.samples.invalidate();
+        Ok(())
+    }
+
+    /// The width `c` of the harmonic selection's band `c / m`
+    /// ([`HarmonicBalanceSettings::resonance_band`]; 0 without selection).
+    pub fn resonance_band(&self) -> f64 {
+        self.selection.as_ref().map_or(0.0, |s| s.width)
+    }
+
+    /// The harmonics held at zero at the current frequency by the harmonic selection
+    /// ([`HarmonicBalanceSettings::resonance_band`]), ascending; empty without it.
+    pub fn dropped_harmonics(&self) -> Vec<usize> {
+        self.selection
+            .as_ref()
+            .map_or_else(Vec::new, |s| s.dropped_harmonics(&self.description))
+    }
+
+    /// The selection when it drops a harmonic at the current frequency.
+    fn active_selection(&self) -> Option<&Selection> {
+        self.selection.as_ref().filter(|s| s.active())
+    }
+
+    /// `eval` at `x`, or at `x` with the dropped harmonics zeroed while the selection drops
+    /// some.
+    fn at_selected<R>(&mut self, x: &[f64], eval: impl FnOnce(&mut Self, &[f64]) -> R) -> R {
+        let masked = match self.selection.as_mut().filter(|s| s.active()) {
+            Some(s) => s.mask(&self.description, x),
+            None => return eval(self, x),
+        };
+        let out = eval(self, &masked);
+        if let Some(s) = &mut self.selection {
+            s.restore(masked);
+        }
+        out
     }
 
     /// Sets [`HarmonicBalanceSettings::kink_blend`] (0 for the exact generalised Jacobian).
@@ -222,6 +299,9 @@ impl<B: Basis> NonsmoothSystem<B> {
     fn prepare(&mut self, omega: f64) {
         if self.ws.frequency.prepare(&self.description, omega) {
             self.ws.samples.invalidate();
+            if let Some(s) = &mut self.selection {
+                s.select(&self.description, omega);
+            }
         }
     }
 
@@ -277,13 +357,35 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
 
     /// From a synthesis of `x`: the value depends on `x` and `Omega` alone.
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
+        self.at_selected(x, |p, y| p.full_residual(y, f));
+        if let Some(s) = self.active_selection() {
+            s.residual(&self.description, x, f);
+        }
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+        self.at_selected(x, |p, y| p.full_jacobian(y, jac));
+        if let Some(s) = self.active_selection() {
+            s.jacobian(&self.description, jac);
+        }
+    }
+
+    fn structure(&mut self) -> Option<&mut dyn Structured> {
+        Some(self)
+    }
+}
+
+impl<B: Basis> NonsmoothSystem<B> {
+    /// The residual of every harmonic at `x`.
+    fn full_residual(&mut self, x: &[f64], f: &mut [f64]) {
         let (d, rows) = (&self.description, &self.ws.frequency.rows);
         d.linear_block(rows, x, false, f);
         self.ws.samples.synthesis(d, rows, x);
         self.ws.samples.project(d, f);
     }
 
-    fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
+    /// The generalised Jacobian of every harmonic at `x`.
+    fn full_jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
         self.sample_laws(x);
         let d = &self.description;
         let Workspace {
@@ -320,10 +422,6 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
             }
         }
     }
-
-    fn structure(&mut self) -> Option<&mut dyn Structured> {
-        Some(self)
-    }
 }
 
 impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
@@ -339,10 +437,15 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
     }
 
     fn parameter_derivative(&mut self, x: &[f64], df: &mut [f64]) {
-        self.sample_laws(x);
-        let (d, rows) = (&self.description, &self.ws.frequency.rows);
-        d.linear_block(rows, x, true, df);
-        self.ws.samples.law_derivative((d, rows), x, df);
+        self.at_selected(x, |p, y| {
+            p.sample_laws(y);
+            let (d, rows) = (&p.description, &p.ws.frequency.rows);
+            d.linear_block(rows, y, true, df);
+            p.ws.samples.law_derivative((d, rows), y, df);
+        });
+        if let Some(s) = self.active_selection() {
+            s.parameter_derivative(&self.description, df);
+        }
     }
 }
 
@@ -363,6 +466,10 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         rhs: &mut [f64],
         columns: usize,
     ) -> Option<Result<(), SingularStep>> {
+        // The condensed and banded steps solve every harmonic's equations.
+        if self.active_selection().is_some() {
+            return None;
+        }
         self.sample_laws(x);
         let Workspace {
             frequency,
@@ -388,6 +495,9 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         trial: &mut [f64],
         f: &mut [f64],
     ) -> bool {
+        if self.active_selection().is_some() {
+            return false;
+        }
         point_on_ray(x, dx, t, trial);
         let (d, rows) = (&self.description, &self.ws.frequency.rows);
         self.ws.samples.along((d, rows), (x, dx, t), trial, f);
@@ -408,8 +518,10 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     }
 
     fn active_set(&mut self, x: &[f64]) -> Option<Vec<usize>> {
-        self.sample_laws(x);
-        Some(self.ws.samples.active_set(&self.description))
+        self.at_selected(x, |p, y| {
+            p.sample_laws(y);
+            Some(p.ws.samples.active_set(&p.description))
+        })
     }
 }
 

@@ -98,6 +98,11 @@ pub(crate) fn settings(d: &mut Draw) -> HarmonicBalanceSettings {
         } else {
             0.0
         },
+        resonance_band: if d.flag("selection", 0.3) {
+            d.real("resonance_band", 0.0..=0.5)
+        } else {
+            0.0
+        },
     }
 }
 

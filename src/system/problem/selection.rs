@@ -1,0 +1,299 @@
+//! Harmonic selection: the harmonic-balance equations without the harmonics that sit on a
+//! linear resonance ([`HarmonicBalanceSettings::resonance_band`](super::HarmonicBalanceSettings::resonance_band)).
+//!
+//! # Why
+//! The truncated complementarity law is satisfied only in a weighted sense: the residual it
+//! leaves in each harmonic is of the order of `R^(m) = O(1/m)` (the paper's eq. (32) and
+//! Fig. 5). Harmonic `n` of a bar answers a forcing of its frequency `n Omega` through its
+//! dynamic stiffness, which vanishes at every natural frequency `omega_k` of the open or the
+//! closed contact: the answer is amplified by about `1 / |1 - n Omega / omega_k|`. Where that
+//! amplification reaches `m / c`, the truncation error it amplifies is of order one, and the
+//! truncated equations have solutions (internal resonances of the truncation) that are not
+//! near the motions of the bars. The exact families carry every harmonic with an amplitude
+//! that decays like `1/n^2`, so leaving out a few harmonics costs little, while keeping them
+//! costs the branch.
+//!
+//! # What
+//! At the fundamental frequency `Omega`, harmonic `n >= 2` is *dropped* when
+//! `|n Omega / omega_k - 1| < c / m` for a natural frequency `omega_k > 0` of the system with
+//! every contact open or every contact closed ([`crate::modal::ContactState`]). A dropped
+//! harmonic's unknowns are held at zero: its equations (linear rows and law projections) are
+//! replaced by the rows `x_i = 0`, and the other equations see it as zero. The constant and
+//! the fundamental are never dropped. The set changes with `Omega`; the problem keeps its
+//! dimension, so continuation drivers follow it unchanged. While a harmonic is dropped, the
+//! Newton step factorises the masked dense Jacobian (the condensed step solves the full
+//! equations).
+
+use super::discretization::Discretization;
+use crate::fourier::Basis;
+use crate::linalg::DenseMatrix;
+use crate::modal::linear::{natural_frequency_values, Resolution};
+use crate::modal::ContactState;
+
+/// The selection state of a problem: the band, the natural frequencies it is measured from,
+/// and the coefficients dropped at the current frequency.
+#[derive(Debug, Clone)]
+pub(super) struct Selection {
+    /// The width `c`.
+    pub(super) width: f64,
+    /// The relative band `c / m`.
+    band: f64,
+    /// Open- and closed-contact natural frequencies up to `covered`, ascending.
+    natural: Vec<f64>,
+    covered: f64,
+    /// Basis coefficients dropped at the current frequency, ascending.
+    dropped: Vec<usize>,
+    /// Scratch for `x` with the dropped unknowns zeroed.
+    masked: Vec<f64>,
+}
+
+impl Selection {
+    /// The selection of band `width / m` (`None` for a zero width: no selection).
+    pub(super) fn new(width: f64, harmonics: usize) -> Option<Self> {
+        (width > 0.0).then(|| Self {
+            width,
+            band: width / harmonics.max(1) as f64,
+            natural: Vec::new(),
+            covered: 0.0,
+            dropped: Vec::new(),
+            masked: Vec::new(),
+        })
+    }
+
+    /// Whether a harmonic is dropped at the current frequency.
+    pub(super) fn active(&self) -> bool {
+        !self.dropped.is_empty()
+    }
+
+    /// The harmonics dropped at the current frequency, ascending.
+    pub(super) fn dropped_harmonics<B: Basis>(&self, d: &Discretization<B>) -> Vec<usize> {
+        self.dropped
+            .iter()
+            .map(|&i| d.basis().harmonic(i))
+            .collect()
+    }
+
+    /// Recomputes the dropped coefficients at `omega`, extending the natural frequencies when
+    /// `omega` needs higher ones.
+    pub(super) fn select<B: Basis>(&mut self, d: &Discretization<B>, omega: f64) {
+        self.dropped.clear();
+        if !(omega.is_finite() && omega > 0.0) {
+            return;
+        }
+        let basis = d.basis();
+        let needed = (basis.harmonics() as f64 + 1.0) * omega * (1.0 + self.band);
+        if needed > self.covered {
+            let bound = 2.0 * needed;
+            let mut natural = Vec::new();
+            for state in [ContactState::Open, ContactState::Closed] {
+                // A scan that cannot run leaves this state out: fewer harmonics dropped.
+                if let Ok(values) =
+                    natural_frequency_values(d.system(), state, bound, Resolution::FULL)
+                {
+                    natural.extend(values.into_iter().filter(|w| *w > 0.0));
+                }
+            }
+            natural.sort_by(f64::total_cmp);
+            self.natural = natural;
+            self.covered = bound;
+        }
+        let band = self.band;
+        let natural = &self.natural;
+        self.dropped = (0..basis.len())
+            .filter(|&i| {
+                let n = basis.harmonic(i);
+                n >= 2
+                    && natural
+                        .iter()
+                        .any(|w| (n as f64 * omega / w - 1.0).abs() < band)
+            })
+            .collect();
+    }
+
+    /// `x` with the dropped unknowns set to zero (the scratch is handed out; give it back with
+    /// [`Selection::restore`]).
+    pub(super) fn mask<B: Basis>(&mut self, d: &Discretization<B>, x: &[f64]) -> Vec<f64> {
+        let mut masked = std::mem::take(&mut self.masked);
+        masked.clear();
+        masked.extend_from_slice(x);
+        let per = d.unknowns;
+        for &i in &self.dropped {
+            masked[i * per..(i + 1) * per].fill(0.0);
+        }
+        masked
+    }
+
+    /// Takes back the scratch of [`Selection::mask`].
+    pub(super) fn restore(&mut self, masked: Vec<f64>) {
+        self.masked = masked;
+    }
+
+    /// The pairs (equation row, unknown) of coefficient `i`: its linear rows, then its
+    /// projection of each law, in the order of the problem's residual.
+    fn rows<B: Basis>(d: &Discretization<B>, i: usize) -> impl Iterator<Item = (usize, usize)> {
+        let (per, linear, len, laws) = (d.unknowns, d.linear_count, d.basis().len(), d.laws);
+        let base = len * linear;
+        (0..linear)
+            .map(move |r| (i * linear + r, i * per + r))
+            .chain((0..laws).map(move |l| (base + l * len + i, i * per + linear + l)))
+    }
+
+    /// Replaces the equations of the dropped coefficients by `x_i = 0` in the residual `f`.
+    pub(super) fn residual<B: Basis>(&self, d: &Discretization<B>, x: &[f64], f: &mut [f64]) {
+        for &i in &self.dropped {
+            for (r, u) in Self::rows(d, i) {
+                f[r] = x[u];
+            }
+        }
+    }
+
+    /// The Jacobian of [`Selection::residual`] from the full one at the masked point: the
+    /// dropped unknowns' columns are zero, their equations' rows those of the identity.
+    pub(super) fn jacobian<B: Basis>(&self, d: &Discretization<B>, jac: &mut DenseMatrix) {
+        let n = d.dimension();
+        let per = d.unknowns;
+        for &i in &self.dropped {
+            for c in i * per..(i + 1) * per {
+                for r in 0..n {
+                    jac[(r, c)] = 0.0;
+                }
+            }
+            for (r, u) in Self::rows(d, i) {
+                for c in 0..n {
+                    jac[(r, c)] = 0.0;
+                }
+                jac[(r, u)] = 1.0;
+            }
+        }
+    }
+
+    /// Zeroes the frequency derivative of the dropped coefficients' equations (`x_i = 0` does
+    /// not depend on `Omega`).
+    pub(super) fn parameter_derivative<B: Basis>(&self, d: &Discretization<B>, df: &mut [f64]) {
+        for &i in &self.dropped {
+            for (r, _) in Self::rows(d, i) {
+                df[r] = 0.0;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::continuation::ContinuationProblem;
+    use crate::linalg::DenseMatrix;
+    use crate::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
+    use crate::solve::{residual_scale, NonlinearSolver, Problem, Solver};
+    use crate::system::{HarmonicBalanceSettings, NonsmoothSystem};
+    use std::f64::consts::PI;
+
+    fn problem(m: usize, width: f64, period: f64) -> NonsmoothSystem {
+        let settings = HarmonicBalanceSettings {
+            harmonics: m,
+            resonance_band: width,
+            ..HarmonicBalanceSettings::default()
+        };
+        let mut p =
+            NonsmoothSystem::new(&clamped_bar_with_obstacle(1e-3).unwrap(), settings).unwrap();
+        p.set_parameter(2.0 * PI / period);
+        p
+    }
+
+    #[test]
+    fn a_zero_band_keeps_the_full_problem() {
+        let (mut full, mut none) = (problem(10, 0.0, 3.5), problem(10, 0.0, 3.5));
+        none.set_resonance_band(0.0).unwrap();
+        assert!(none.dropped_harmonics().is_empty());
+        assert_eq!(none.resonance_band(), 0.0);
+        let x = ClampedFirstMode::new(1e-3, 3.5).unknowns(10);
+        let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+        full.residual(&x, &mut a);
+        none.residual(&x, &mut b);
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn dropped_harmonics_sit_on_resonances_and_solve_to_zero() {
+        let m = 20;
+        // T = 3.5: 7 Omega = 4 pi, a natural frequency of the closed contact.
+        let mut p = problem(m, 0.5, 3.5);
+        let omega = p.parameter();
+        let band = 0.5 / m as f64;
+        let dropped = p.dropped_harmonics();
+        assert!(dropped.contains(&7), "{dropped:?}");
+        for &n in &dropped {
+            // Clamped–free (open) and clamped–clamped (closed) frequencies of the unit bar.
+            let near = (1..200).any(|k| {
+                let (open, closed) = ((2 * k - 1) as f64 * PI / 2.0, k as f64 * PI);
+                [open, closed]
+                    .iter()
+                    .any(|w| (n as f64 * omega / w - 1.0).abs() < band)
+            });
+            assert!(near && n >= 2, "harmonic {n} dropped away from a resonance");
+        }
+        let mut x = ClampedFirstMode::new(1e-3, 3.5).unknowns(m);
+        Solver::default().solve(&mut p, &mut x).unwrap();
+        let per = p.dimension() / (m + 1);
+        for &n in &dropped {
+            assert!(x[n * per..(n + 1) * per].iter().all(|v| *v == 0.0));
+        }
+        // Tolerances stay relative to the largest gap.
+        let mut full = problem(m, 0.0, 3.5);
+        assert_eq!(residual_scale(&mut p), residual_scale(&mut full));
+    }
+
+    #[test]
+    fn the_jacobian_and_the_frequency_derivative_match_finite_differences() {
+        let t = 3.5;
+        let mut p = problem(8, 0.5, t);
+        assert!(!p.dropped_harmonics().is_empty());
+        // Away from the law's kinks: a motion scaled into the open contact.
+        let x: Vec<f64> = (ClampedFirstMode::new(1e-3, t).unknowns(8).iter())
+            .map(|v| 0.3 * v)
+            .collect();
+        let n = p.dimension();
+        let mut jac = DenseMatrix::zeros(n, n);
+        p.jacobian(&x, &mut jac);
+        let (mut f0, mut f1) = (vec![0.0; n], vec![0.0; n]);
+        p.residual(&x, &mut f0);
+        let h = 1e-9;
+        for c in 0..n {
+            let mut y = x.clone();
+            y[c] += h;
+            p.residual(&y, &mut f1);
+            for r in 0..n {
+                let fd = (f1[r] - f0[r]) / h;
+                assert!(
+                    (fd - jac[(r, c)]).abs() < 1e-4 * (1.0 + fd.abs()),
+                    "({r}, {c})"
+                );
+            }
+        }
+        let mut df = vec![0.0; n];
+        p.parameter_derivative(&x, &mut df);
+        let omega = p.parameter();
+        let dw = 1e-7 * omega;
+        let dropped = p.dropped_harmonics();
+        p.set_parameter(omega + dw);
+        assert_eq!(p.dropped_harmonics(), dropped);
+        p.residual(&x, &mut f1);
+        for r in 0..n {
+            let fd = (f1[r] - f0[r]) / dw;
+            assert!((fd - df[r]).abs() < 1e-4 * (1.0 + fd.abs()), "row {r}");
+        }
+    }
+
+    #[test]
+    fn bad_bands_are_typed_errors() {
+        let mut p = problem(20, 0.0, 3.5);
+        for width in [f64::NAN, f64::INFINITY, -0.1, 21.0] {
+            assert!(p.set_resonance_band(width).is_err(), "{width}");
+        }
+        let settings = HarmonicBalanceSettings {
+            resonance_band: -1.0,
+            ..HarmonicBalanceSettings::default()
+        };
+        let system = clamped_bar_with_obstacle(1e-3).unwrap();
+        assert!(NonsmoothSystem::new(&system, settings).is_err());
+    }
+}
