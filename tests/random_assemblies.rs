@@ -15,7 +15,8 @@
 //! - `random_assembly_census` (`#[ignore]`): the figures of `docs/assemblies.md`, at the
 //!   harmonics `RANDOM_HARMONICS` (default 20) over `RANDOM_COUNT` (default 50) held
 //!   assemblies from seed `RANDOM_SEED_OFFSET` (default 0), by the methods of
-//!   `RANDOM_METHODS` (default `grid`): `cargo test --release --all-features --test
+//!   `RANDOM_METHODS` (default `grid`), with the harmonic selection's band
+//!   `RANDOM_RESONANCE_BAND` (default 0: none): `cargo test --release --all-features --test
 //!   random_assemblies -- --ignored --nocapture`.
 
 use nonsmooth_modes::bar::Bar;
@@ -215,6 +216,7 @@ impl Way {
 fn run(system: &BarSystem, method: Way, harmonics: usize, verify: bool) -> Outcome {
     let settings = HarmonicBalanceSettings {
         harmonics,
+        resonance_band: env_real("RANDOM_RESONANCE_BAND", 0.0),
         ..HarmonicBalanceSettings::default()
     };
     let result = method.backbone(system, settings);
@@ -295,6 +297,14 @@ fn the_energy_backbone_refuses_drifting_assemblies() {
         refused += 1;
     }
     assert!(refused > 0);
+}
+
+/// The number in environment variable `name`, or `default` if unset or unreadable.
+fn env_real(name: &str, default: f64) -> f64 {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(default)
 }
 
 fn env_number(name: &str, default: usize) -> usize {

@@ -76,7 +76,9 @@ pub struct HarmonicBalanceSettings {
 
 /// The width `c` of [`HarmonicBalanceSettings::resonance_band`] measured on both exact
 /// families (`docs/validation.md`, "Convergence in the number of harmonics"): narrower bands
-/// let resonances through at large `m`, wider ones drop harmonics the motion needs.
+/// let resonances through at large `m`, wider ones drop harmonics the motion needs. On chains
+/// of several bars, whose natural frequencies are dense, it drops too many
+/// (`docs/assemblies.md`, the census).
 pub const RESONANCE_BAND: f64 = 0.1;
 
 impl Default for HarmonicBalanceSettings {
