@@ -4,7 +4,7 @@
 
 use crate::runs::Run;
 use crate::summary::Item;
-use nonsmooth_modes::branches::{group_by_label, BackbonePoint};
+use nonsmooth_modes::branches::BackbonePoint;
 use nonsmooth_modes::continuation::Event;
 use nonsmooth_modes::fourier::CosineBasis;
 use nonsmooth_modes::io::{write_branches_csv, write_columns_csv, LabelledBranch};
@@ -208,26 +208,20 @@ pub fn series(run: &Run, omega_1: f64, color: Rgb, marker: Marker) -> Series {
         .with_marker(marker)
 }
 
-/// The runs' converged points grouped by label (`branches::group_by_label`): each run's own
-/// branch (skeleton or subharmonic, and any point without a label) as markers in its colour
-/// and marker, named by the run; then each run's internal resonances as small rings in the
-/// same colour, one legend entry for them all.
+/// The runs' converged points split by label: each run's own branch (skeleton or subharmonic,
+/// and any point without a label) as markers in its colour and marker, named by the run; then
+/// each run's internal resonances as small rings in the same colour, one legend entry for them
+/// all.
 pub fn labelled_series(runs: &[(&Run, Rgb, Marker)], omega_1: f64) -> Vec<Series> {
     let at = |p: &BackbonePoint| (p.omega / omega_1, p.energy_normalized);
     let mut own = Vec::new();
     let mut apart = Vec::new();
     for &(run, color, marker) in runs {
-        let groups = group_by_label(&run.points);
-        let resonant: Vec<(f64, f64)> = groups
-            .iter()
-            .filter(|g| matches!(g.label, Label::InternalResonance { .. }))
-            .flat_map(|g| g.points.iter().map(|p| at(p)))
-            .collect();
-        let branch: Vec<(f64, f64)> = run
+        let (resonant, branch): (Vec<&BackbonePoint>, Vec<&BackbonePoint>) = run
             .converged()
-            .filter(|p| !matches!(p.label, Some(Label::InternalResonance { .. })))
-            .map(at)
-            .collect();
+            .partition(|p| matches!(p.label, Some(Label::InternalResonance { .. })));
+        let points = |ps: Vec<&BackbonePoint>| ps.into_iter().map(at).collect::<Vec<_>>();
+        let (resonant, branch) = (points(resonant), points(branch));
         own.push(
             Series::markers(run.label.clone(), branch)
                 .with_color(color)

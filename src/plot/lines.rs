@@ -145,11 +145,16 @@ where
     let panel = lines.panel;
     let entries = lines.entries();
     let size = legend_size(&entries);
-    let outside = match panel.legend {
-        _ if entries.is_empty() => false,
-        LegendPosition::Outside => true,
-        LegendPosition::Auto => !fits_inside(area, lines, size, x_spec(), y_spec())?,
-        _ => false,
+    // An automatic legend's free place, if it has one, found on a scratch chart of the same
+    // size: the real chart is built once the legend's place is known.
+    let (outside, free) = match panel.legend {
+        _ if entries.is_empty() => (false, None),
+        LegendPosition::Outside => (true, None),
+        LegendPosition::Auto => {
+            let free = free_place(area, lines, size, x_spec(), y_spec())?;
+            (free.is_none(), free)
+        }
+        _ => (false, None),
     };
     let side = outside.then(|| strip_side(area, size)).flatten();
     let (chart_area, legend_area) = match side {
@@ -218,10 +223,11 @@ where
                 StripSide::Below => PixelBox::at(plot.x0, y + 0.5 * INSET, size.0, size.1),
             })
         }
-        (None, LegendPosition::Auto | LegendPosition::Outside) => {
+        // The chart fills `area` here, as the scratch chart did: its free place holds.
+        (None, LegendPosition::Auto | LegendPosition::Outside) => free.or_else(|| {
             let drawn = lines.drawn_pixels(|p| chart.backend_coord(p));
-            free_box(&plot, size, &drawn).or_else(|| least_covered_box(&plot, size, &drawn))
-        }
+            least_covered_box(&plot, size, &drawn)
+        }),
         (None, position) => fixed_box(position, &plot, size),
     };
     let mut taken: Vec<PixelBox> = legend_box.iter().cloned().collect();
@@ -277,16 +283,15 @@ fn strip_side(area: &Area<'_>, size: (f64, f64)) -> Option<StripSide> {
     }
 }
 
-/// Whether a legend of `size` has a free place in the plot of `lines` laid out on `area`, found
-/// on a scratch chart of the same size (the real one is built once the legend's place, inside
-/// or in a strip beside the plot, is known).
-fn fits_inside<X, Y>(
+/// The free place in screen pixels ([`free_box`]) of a legend of `size` in the plot of
+/// `lines` laid out on the whole of `area`, found on a scratch chart of the same size.
+fn free_place<X, Y>(
     area: &Area<'_>,
     lines: &Lines<'_>,
     size: (f64, f64),
     x_spec: X,
     y_spec: Y,
-) -> Result<bool, PlotError>
+) -> Result<Option<PixelBox>, PlotError>
 where
     X: AsRangedCoord<Value = f64>,
     Y: AsRangedCoord<Value = f64>,
@@ -309,7 +314,7 @@ where
         x1: plot.x1 + dx,
         y1: plot.y1 + dy,
     };
-    Ok(free_box(&plot, size, &drawn).is_some())
+    Ok(free_box(&plot, size, &drawn))
 }
 
 /// Width of the label area left of a line panel's vertical axis, in pixels.

@@ -199,7 +199,7 @@ impl<B: Basis> NonsmoothSystem<B> {
                 max: m as f64,
             });
         }
-        self.selection = Selection::new(width, m);
+        self.selection = Selection::new(width);
         let omega = self.ws.frequency.omega;
         if let Some(s) = &mut self.selection {
             s.select(&self.description, omega);

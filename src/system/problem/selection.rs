@@ -34,10 +34,8 @@ use crate::modal::ContactState;
 /// and the coefficients dropped at the current frequency.
 #[derive(Debug, Clone)]
 pub(super) struct Selection {
-    /// The width `c`.
+    /// The width `c` of the relative band `c / m`.
     pub(super) width: f64,
-    /// The relative band `c / m`.
-    band: f64,
     /// Open- and closed-contact natural frequencies up to `covered`, ascending.
     natural: Vec<f64>,
     covered: f64,
@@ -49,10 +47,9 @@ pub(super) struct Selection {
 
 impl Selection {
     /// The selection of band `width / m` (`None` for a zero width: no selection).
-    pub(super) fn new(width: f64, harmonics: usize) -> Option<Self> {
+    pub(super) fn new(width: f64) -> Option<Self> {
         (width > 0.0).then(|| Self {
             width,
-            band: width / harmonics.max(1) as f64,
             natural: Vec::new(),
             covered: 0.0,
             dropped: Vec::new(),
@@ -81,7 +78,8 @@ impl Selection {
             return;
         }
         let basis = d.basis();
-        let needed = (basis.harmonics() as f64 + 1.0) * omega * (1.0 + self.band);
+        let band = self.width / basis.harmonics().max(1) as f64;
+        let needed = (basis.harmonics() as f64 + 1.0) * omega * (1.0 + band);
         if needed > self.covered {
             let bound = 2.0 * needed;
             let mut natural = Vec::new();
@@ -97,7 +95,6 @@ impl Selection {
             self.natural = natural;
             self.covered = bound;
         }
-        let band = self.band;
         let natural = &self.natural;
         self.dropped = (0..basis.len())
             .filter(|&i| {
