@@ -159,6 +159,13 @@ pub enum SettingsError {
     /// The system has no unilateral condition, so it has no nonsmooth mode to compute.
     #[error("the system has no unilateral contact condition")]
     NoContact,
+    /// A phase reference that does not move fixes no phase: the derivative in time of
+    /// `what` is zero (a state of rest, or one whose contacts stay still).
+    #[error("the phase reference fixes no phase: {what} do not move in time")]
+    StillReference {
+        /// Which part of the reference is still.
+        what: &'static str,
+    },
     /// The linear mode used for a seed or a normalisation moves no contact gap.
     #[error("the linear mode at omega = {omega} moves no contact gap, so it never grazes")]
     NoGrazing {

@@ -127,6 +127,7 @@ const FLAGS: &[(&str, Value)] = &[
     ("progress", Value::Switch),
     ("verify", Value::Switch),
     ("stability", Value::Switch),
+    ("basis", Value::Word(&["cosine", "full"])),
 ];
 
 /// Edge values tried for any flag that takes a value.
@@ -481,12 +482,23 @@ fn fuzz(name: &str, lines: usize, seed: u64) {
     let stderr_path = dir.0.join("stderr.txt");
     let mut rng = Rng(seed);
     let mut report = Report::default();
+    let mut slowest = (Duration::ZERO, String::new());
     for index in 0..lines {
         let args = command_line(&mut rng, &dir.0, index);
+        let start = Instant::now();
         let outcome = run_line(&binary, &args, &dir.0, &stderr_path);
-        report.record(&shell_line(&binary, &args), &outcome);
+        let line = shell_line(&binary, &args);
+        if start.elapsed() > slowest.0 {
+            slowest = (start.elapsed(), line.clone());
+        }
+        report.record(&line, &outcome);
     }
     println!("{} (seed {seed})", report.summary());
+    println!(
+        "slowest line, {:.1} s: {}",
+        slowest.0.as_secs_f64(),
+        slowest.1
+    );
     for failure in &report.failures {
         println!("FAILED: {failure}");
     }

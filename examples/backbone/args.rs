@@ -15,7 +15,7 @@ pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--r
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI] [--switch-at N[:SIDE]]
   [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
-  [--energy-range LO:HI] [--progress] [--verify] [--stability]";
+  [--energy-range LO:HI] [--progress] [--verify] [--stability] [--basis cosine|full]";
 
 /// Largest `--steps` and `--max-steps`.
 pub const MAX_POINTS: usize = 1_000_000;
@@ -56,6 +56,8 @@ pub struct Args {
     pub subharmonic: usize,
     /// With `--subharmonic K > 1`: keep the `K`-fold repeated branch, do not switch off it.
     pub repeated: bool,
+    /// `--basis full`: the branch continued in the constant + cosine + sine basis.
+    pub full_basis: bool,
     pub period_start: Option<f64>,
     pub period_end: Option<f64>,
     pub steps: usize,
@@ -155,6 +157,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         progress: false,
         verify: false,
         stability: false,
+        full_basis: false,
     };
     let mut assembly = None;
     let mut system_given = false;
@@ -255,6 +258,13 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("progress") => a.progress = true,
             Long("verify") => a.verify = true,
             Long("stability") => a.stability = true,
+            Long("basis") => {
+                a.full_basis = match parser.value()?.string()?.as_str() {
+                    "cosine" => false,
+                    "full" => true,
+                    other => return Err(format!("unknown basis `{other}`").into()),
+                }
+            }
             Short('h') | Long("help") => return Ok(None),
             _ => return Err(arg.unexpected()),
         }
@@ -276,6 +286,18 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
     }
     if a.switch.is_some() && a.arclength != Some(true) {
         return Err("--switch-at needs --method arclength".into());
+    }
+    if a.full_basis
+        && (a.parameter != Parameter::Omega
+            || a.arclength == Some(true)
+            || a.subharmonic != 1
+            || a.stability)
+    {
+        return Err(
+            "--basis full runs sequentially in the period (--parameter omega, no --method \
+             arclength) for --subharmonic 1, without --stability"
+                .into(),
+        );
     }
     if a.parameter == Parameter::Energy && a.arclength == Some(true) {
         return Err("--parameter energy is sequential: it takes no --method arclength".into());

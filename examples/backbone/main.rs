@@ -12,6 +12,7 @@
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--switch-at N[:SIDE]] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify] [--stability]
+//!     [--basis cosine|full]
 //! ```
 //!
 //! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
@@ -81,6 +82,18 @@
 //! a point that did not converge); the index of the branch within the run (one more after
 //! each jump); the harmonic holding the most energy.
 //!
+//! `--basis full` continues the branch in the constant + cosine + sine basis
+//! (`branches::full_basis_branch`, with the phase condition of `system::PhaseLocked`): the
+//! period grid is run in the cosine basis (`--basis cosine`, the default) for its first
+//! converged point, which starts the full-basis run over the same periods. Its columns are
+//! `step,period,omega,energy,energy_normalized,converged,status,unfolding,sine_share,
+//! asymmetry,residual_norm,iterations` (`status`: `converged`, `rejected`, or
+//! `before-start` for the periods before the cosine run's first converged one; `unfolding`
+//! is the phase-locked system's `mu`, `sine_share` and `asymmetry` say how far the motion is
+//! from even about `t = 0` and about any instant), and with `--verify`
+//! `periodicity_defect,displacement_defect`. It takes `--parameter omega`, sequential
+//! steps, `--subharmonic 1` and no `--stability`; other combinations are usage errors.
+//!
 //! `--subharmonic K > 1` (sequential runs in the period): the seed on harmonic `K` gives the
 //! mode of period `T/K` traced `K` times, a subspace Newton's method never leaves; the run
 //! follows it until a point can be left along the most singular direction off the multiples
@@ -144,6 +157,7 @@
 //! [`MAX_SAMPLES_PER_HARMONIC`]: args::MAX_SAMPLES_PER_HARMONIC
 
 mod args;
+mod full;
 mod output;
 mod runs;
 mod systems;

@@ -2,6 +2,7 @@
 //! chosen by the library), and continuation in a system parameter.
 
 use crate::args::{Args, Parameter};
+use crate::full::run_full_basis;
 use crate::output::{header, Sink};
 use crate::systems::{build_system, clamped_gap, default_periods, parameter_value};
 use nonsmooth_modes::branches::{
@@ -23,6 +24,9 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         _ => default_periods(a)?,
     };
     let (t0, t1) = (a.period_start.unwrap_or(t0), a.period_end.unwrap_or(t1));
+    if a.full_basis {
+        return run_full_basis(a, &system, &request(a, &system, (t0, t1))?, (t0, t1), out);
+    }
     writeln!(out, "{}", header(a.verify, a.subharmonic, a.stability))?;
     let mut sink = Sink {
         out,
@@ -131,9 +135,10 @@ fn request(
             None => Method::Arclength(options),
         }
     } else if (a.subharmonic > 1 && a.repeated)
-        || (a.arclength == Some(false) && a.subharmonic == 1)
+        || ((a.arclength == Some(false) || a.full_basis) && a.subharmonic == 1)
     {
-        // The repeated branch of a subharmonic, or the grid asked for.
+        // The repeated branch of a subharmonic, or the grid asked for (a full-basis run
+        // continues the grid).
         Method::PeriodGrid(grid)
     } else {
         Method::Auto(Some(grid))
@@ -146,7 +151,7 @@ fn request(
         speculation: (!a.serial && cores >= 2).then(Speculation::default),
         ..Request::new(a.mode).subharmonic(a.subharmonic)
     };
-    if a.verify {
+    if a.verify && !a.full_basis {
         request.check = Some(TimeDomainCheck::for_system(system));
     }
     if a.stability {

@@ -214,27 +214,36 @@ pub fn series(run: &Run, omega_1: f64, color: Rgb, marker: Marker) -> Series {
 /// all.
 pub fn labelled_series(runs: &[(&Run, Rgb, Marker)], omega_1: f64) -> Vec<Series> {
     let at = |p: &BackbonePoint| (p.omega / omega_1, p.energy_normalized);
+    let resonant = |p: &BackbonePoint| matches!(p.label, Some(Label::InternalResonance { .. }));
     let mut own = Vec::new();
     let mut apart = Vec::new();
     for &(run, color, marker) in runs {
-        let (resonant, branch): (Vec<&BackbonePoint>, Vec<&BackbonePoint>) = run
-            .converged()
-            .partition(|p| matches!(p.label, Some(Label::InternalResonance { .. })));
+        let (resonances, branch): (Vec<&BackbonePoint>, Vec<&BackbonePoint>) =
+            run.converged().partition(|p| resonant(p));
         let points = |ps: Vec<&BackbonePoint>| ps.into_iter().map(at).collect::<Vec<_>>();
-        let (resonant, branch) = (points(resonant), points(branch));
+        let (resonances, branch) = (points(resonances), points(branch));
+        // The branch is a line through its consecutive points, broken where a step failed,
+        // met a resonance or jumped; its markers carry the legend entry.
+        for piece in pieces(run, |p| !resonant(p)) {
+            own.push(
+                Series::line("", piece.into_iter().map(at).collect())
+                    .with_color(color)
+                    .with_size(1),
+            );
+        }
         own.push(
             Series::markers(run.label.clone(), branch)
                 .with_color(color)
                 .with_marker(marker),
         );
-        if !resonant.is_empty() {
+        if !resonances.is_empty() {
             let label = if apart.is_empty() {
                 "internal resonances (rings, branch colour)"
             } else {
                 ""
             };
             apart.push(
-                Series::markers(label, resonant)
+                Series::markers(label, resonances)
                     .with_color(color)
                     .with_marker(Marker::Ring)
                     .with_size(3),
@@ -243,6 +252,25 @@ pub fn labelled_series(runs: &[(&Run, Rgb, Marker)], omega_1: f64) -> Vec<Series
     }
     own.extend(apart);
     own
+}
+
+/// The pieces of `run`'s line: its maximal runs of consecutive converged points that `keep`
+/// takes, on one branch (a step that did not converge, a point left out or a jump to another
+/// branch ends a piece), with at least two points.
+fn pieces(run: &Run, keep: impl Fn(&BackbonePoint) -> bool) -> Vec<Vec<&BackbonePoint>> {
+    let mut pieces: Vec<Vec<&BackbonePoint>> = vec![Vec::new()];
+    for p in &run.points {
+        let joins = p.converged && keep(p);
+        let last = pieces.last_mut().expect("one piece at least");
+        let same_branch = last.last().is_none_or(|q| q.branch == p.branch);
+        if joins && same_branch {
+            last.push(p);
+        } else {
+            pieces.push(if joins { vec![p] } else { Vec::new() });
+        }
+    }
+    pieces.retain(|piece| piece.len() >= 2);
+    pieces
 }
 
 /// A thin dashed black line: a reference curve.

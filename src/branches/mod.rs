@@ -10,6 +10,7 @@ mod convergence;
 mod defaults;
 mod energy_backbone;
 mod escape;
+mod full_basis;
 mod groups;
 mod guesses;
 mod level;
@@ -36,6 +37,10 @@ pub use energy_backbone::{
     SLOPE_COLLAPSE, SLOPE_MEMORY,
 };
 pub use escape::{EscapingArclength, StallEscape};
+pub use full_basis::{
+    asymmetry, even_part, full_basis_branch, full_basis_system, shift_origin, symmetry_instant,
+    to_full_basis, with_harmonics, FullBasisBranch, FullBasisPoint,
+};
 pub use groups::{group_by_label, PointGroup};
 pub use level::EnergyLevel;
 pub use lift::lift;

@@ -2,13 +2,16 @@
 //! the generalised Jacobian cheap.
 //!
 //! The system never touches trigonometric tables directly: everything in time goes through a
-//! [`Basis`]. [`CosineBasis`] is the paper's constant + cosine basis; a sine + cosine basis
-//! (odd motions, with a phase condition) fits the same trait.
+//! [`Basis`]. [`CosineBasis`] is the paper's constant + cosine basis; [`SineCosineBasis`]
+//! adds the sines, for motions that are not even in time (with a phase condition,
+//! [`crate::system::PhaseLocked`]).
 
 mod even;
+mod full;
 
 use crate::error::{OverBudget, SettingsError};
 use even::{Buffers, EvenTransform};
+pub use full::SineCosineBasis;
 use std::cell::Cell;
 use std::fmt::Debug;
 use std::sync::Arc;
@@ -290,25 +293,13 @@ impl CosineBasis {
     /// `n_h < 3`; [`SettingsError::TooLarge`] if the basis does not fit in the budget (the
     /// error carries the bytes it would need).
     pub fn new(harmonics: usize, samples_per_harmonic: usize) -> Result<Self, SettingsError> {
-        if harmonics == 0 {
-            return Err(SettingsError::ZeroHarmonics);
-        }
-        if samples_per_harmonic < 3 {
-            return Err(SettingsError::TooFewSamples {
-                got: samples_per_harmonic,
-                min: 3,
-            });
-        }
-        // Sizes in floating point first: their products cannot overflow there.
-        let len = harmonics as f64 + 1.0;
-        let samples = harmonics as f64 * samples_per_harmonic as f64;
         let what = "a cosine basis (its Gram matrix, tables and FFT buffers)";
-        let doubles = len * len + BASIS_DOUBLES_PER_SAMPLE * samples;
-        check_memory(what, doubles)?;
-        // Within the budget `N` fits in `usize`; checked all the same.
-        let n = harmonics
-            .checked_mul(samples_per_harmonic)
-            .ok_or_else(|| over_budget(what, doubles))?;
+        let n = checked_samples(
+            what,
+            harmonics,
+            samples_per_harmonic,
+            harmonics as f64 + 1.0,
+        )?;
         Ok(Self {
             harmonics,
             samples: n,
@@ -411,6 +402,36 @@ impl CosineBasis {
             row[0] *= constant_half(0);
         }
     }
+}
+
+/// The number of samples `N = n_h m` of a basis of `m = harmonics` harmonics and `len`
+/// coefficients per signal (a float: `m + 1` may not fit in `usize`), checked: at least one harmonic, `n_h >= 3` (the discrete products
+/// of two harmonics are orthogonal only for `2m < N`), and its Gram matrix (`len^2` doubles)
+/// with [`BASIS_DOUBLES_PER_SAMPLE`] doubles per sample within the memory budget; `what`
+/// names the basis in the error.
+fn checked_samples(
+    what: &'static str,
+    harmonics: usize,
+    samples_per_harmonic: usize,
+    len: f64,
+) -> Result<usize, SettingsError> {
+    if harmonics == 0 {
+        return Err(SettingsError::ZeroHarmonics);
+    }
+    if samples_per_harmonic < 3 {
+        return Err(SettingsError::TooFewSamples {
+            got: samples_per_harmonic,
+            min: 3,
+        });
+    }
+    // Sizes in floating point first: their products cannot overflow there.
+    let samples = harmonics as f64 * samples_per_harmonic as f64;
+    let doubles = len * len + BASIS_DOUBLES_PER_SAMPLE * samples;
+    check_memory(what, doubles)?;
+    // Within the budget `N` fits in `usize`; checked all the same.
+    harmonics
+        .checked_mul(samples_per_harmonic)
+        .ok_or_else(|| over_budget(what, doubles).into())
 }
 
 /// Weight of coefficient `i` in the synthesis: `1/2` for the constant term, 1 otherwise.

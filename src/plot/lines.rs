@@ -265,18 +265,23 @@ fn strip_width(size: (f64, f64)) -> u32 {
     (size.0 + 2.0 * INSET).ceil() as u32
 }
 
+/// The least height, in pixels, a legend strip below a plot leaves it.
+const MIN_PLOT_HEIGHT: u32 = 240;
+
 /// Height of a strip below the plot holding a legend of `size`.
 fn strip_height(size: (f64, f64)) -> u32 {
     (size.1 + INSET).ceil() as u32
 }
 
 /// The side of `area` a legend strip of `size` takes: the right if it leaves the plot at
-/// least half the width, else below if it leaves two thirds of the height; `None` if neither.
+/// least half the width, else below if it leaves at least half the height and
+/// [`MIN_PLOT_HEIGHT`] (a shorter plot beats a legend over its data, down to a height that
+/// still reads); `None` if neither.
 fn strip_side(area: &Area<'_>, size: (f64, f64)) -> Option<StripSide> {
     let (w, h) = area.dim_in_pixel();
     if strip_width(size) < w / 2 {
         Some(StripSide::Right)
-    } else if strip_height(size) < h / 3 {
+    } else if strip_height(size) < h / 2 && h - strip_height(size) >= MIN_PLOT_HEIGHT {
         Some(StripSide::Below)
     } else {
         None

@@ -11,12 +11,14 @@ pub mod assembly;
 mod condense;
 pub mod family;
 mod layout;
+mod phase;
 pub mod problem;
 pub mod rows;
 
 pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};
 pub use layout::Layout;
+pub use phase::PhaseLocked;
 pub use problem::{
     Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE, MAX_OFFSET,
     MAX_PHASE, RESONANCE_BAND,

@@ -3,6 +3,7 @@
 
 mod backbones;
 mod drivers;
+mod full_basis;
 mod model;
 mod post;
 mod solvers;
@@ -33,10 +34,11 @@ pub(crate) enum Kind {
     ParameterBranch,
     PostProcessing,
     Request,
+    FullBasis,
 }
 
 /// Every kind, drawn uniformly by each case.
-pub(crate) const KINDS: [Kind; 10] = [
+pub(crate) const KINDS: [Kind; 11] = [
     Kind::Assembly,
     Kind::Settings,
     Kind::Solver,
@@ -47,6 +49,7 @@ pub(crate) const KINDS: [Kind; 10] = [
     Kind::ParameterBranch,
     Kind::PostProcessing,
     Kind::Request,
+    Kind::FullBasis,
 ];
 
 impl Kind {
@@ -62,6 +65,7 @@ impl Kind {
             Kind::ParameterBranch => backbones::parameter_case(d, c),
             Kind::PostProcessing => post::post_processing(d, c),
             Kind::Request => backbones::request_case(d, c),
+            Kind::FullBasis => full_basis::full_basis_case(d, c),
         }
     }
 }

@@ -1,0 +1,245 @@
+//! A search for periodic motions that are not even in time, in the full Fourier basis.
+//!
+//! ```text
+//! cargo run --release --example odd_motions -- [--harmonics 20] [--periods 12]
+//! ```
+//!
+//! The paper's cosine basis holds only motions with an instant at which the whole velocity
+//! field vanishes. A motion without one needs sines; this example looks for it from seeds
+//! that combine two linear modes in quadrature. On the clamped bar and the two-bar
+//! configurations 1 and 2, at `--periods` periods of the first nonsmooth mode's grid
+//! (`BackboneOptions::for_mode`), each seed is the first mode's grazing seed on harmonic 1
+//! (scaled by 1 or 2) plus the seed of mode `j = 2..4` on the harmonic `n` nearest to its
+//! frequency, put in quadrature (on the sine of harmonic `n`), scaled by 0.1, 0.3, 1 or 3
+//! relative to it. Each is solved once on the phase-locked system
+//! (`branches::full_basis_branch` over one period).
+//!
+//! A converged point is *even* when its [`asymmetry`](nonsmooth_modes::branches::asymmetry)
+//! (the smallest sine share over the time shifts) is below `1e-8`; the others are checked
+//! in the time domain (`verify::periodicity_check`, the backbone's check) and printed with
+//! their displacement defect. The last lines count, per system, the seeds that converged,
+//! reached the state of rest, converged to even motions and to motions that are not even,
+//! and how many of those pass the check (displacement defect at most 5 %).
+
+use nonsmooth_modes::branches::{
+    full_basis_branch, full_basis_system, with_harmonics, BackboneOptions, FullBasisPoint,
+    TimeDomainCheck,
+};
+use nonsmooth_modes::continuation::linspace;
+use nonsmooth_modes::fourier::{frequency_of_period, Basis};
+use nonsmooth_modes::modal::{branch_seed, open_mode};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, paper_second_bar, two_bars_in_contact,
+};
+use nonsmooth_modes::solve::Solver;
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
+use nonsmooth_modes::verify::periodicity_check;
+
+/// Below this asymmetry a motion is even about some instant (rounding and the solver's
+/// tolerance leave about `1e-20`).
+const EVEN: f64 = 1e-8;
+
+/// An asymmetry that falls below this fraction of the first solve's on a refined
+/// problem was made by the coarser one.
+const SHRINK: f64 = 0.1;
+
+/// What the seeds of one system gave.
+#[derive(Default)]
+struct Tally {
+    seeds: usize,
+    converged: usize,
+    even: usize,
+    /// Not even, but even (or 10 times less asymmetric) once solved again on a time grid 4
+    /// times finer: the grid's sampling of the law broke the symmetry.
+    even_on_finer_grid: usize,
+    /// Not even on either time grid.
+    odd: usize,
+    /// Of those, still not even (at least a tenth of the asymmetry) once solved again with
+    /// `2m` harmonics.
+    odd_lifted: usize,
+    /// Of those, passing the time-domain check at `2m` harmonics.
+    odd_verified: usize,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let (mut harmonics, mut periods) = (20usize, 12usize);
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    for pair in args.chunks(2) {
+        let value = pair.get(1).ok_or("missing value")?;
+        match pair[0].as_str() {
+            "--harmonics" => harmonics = value.parse()?,
+            "--periods" => periods = value.parse()?,
+            other => return Err(format!("unknown flag `{other}`").into()),
+        }
+    }
+    let settings = HarmonicBalanceSettings {
+        harmonics,
+        ..Default::default()
+    };
+    let systems: [(&str, BarSystem); 3] = [
+        ("clamped", clamped_bar_with_obstacle(1e-3)?),
+        (
+            "two-bar 1",
+            two_bars_in_contact(paper_second_bar(0.95, 1.0, 1.0)?, 1e-3)?,
+        ),
+        (
+            "two-bar 2",
+            two_bars_in_contact(paper_second_bar(3.8, 4.0, 4.0)?, 1e-3)?,
+        ),
+    ];
+    println!(
+        "system,period,mode,harmonic,scale,ratio,energy_normalized,asymmetry,displacement_defect"
+    );
+    let mut tallies = Vec::new();
+    for (name, system) in &systems {
+        let tally = search(name, system, &settings, periods)?;
+        tallies.push((name, tally));
+    }
+    for (name, t) in tallies {
+        println!(
+            "# {name}: {} seeds, {} converged ({} at rest or failed), {} even, {} even on a \
+             finer time grid, {} not even; of those, {} still not even with 2m harmonics, {} of \
+             which pass the time-domain check there",
+            t.seeds,
+            t.converged,
+            t.seeds - t.converged,
+            t.even,
+            t.even_on_finer_grid,
+            t.odd,
+            t.odd_lifted,
+            t.odd_verified
+        );
+    }
+    Ok(())
+}
+
+/// Solves every seed of `system` at `periods` periods of its grid.
+fn search(
+    name: &str,
+    system: &BarSystem,
+    settings: &HarmonicBalanceSettings,
+    periods: usize,
+) -> Result<Tally, Box<dyn std::error::Error>> {
+    let grid = BackboneOptions::for_mode(system, 1, 1)?.grid;
+    let mut problem = full_basis_system(system, settings)?;
+    let m = problem.basis().harmonics();
+    let check = TimeDomainCheck::for_system(system);
+    let mut tally = Tally::default();
+    for period in linspace(grid.start, grid.end, periods)? {
+        let omega = frequency_of_period(period);
+        let first = branch_seed(&mut problem, 1, 1, omega)?;
+        for mode in 2..=4 {
+            let n = (open_mode(system, mode)?.omega / omega).round() as usize;
+            if n < 1 || n > m {
+                continue;
+            }
+            let other = quadrature(&branch_seed(&mut problem, mode, n, omega)?, m, n);
+            for scale in [1.0, 2.0] {
+                for ratio in [0.1, 0.3, 1.0, 3.0] {
+                    tally.seeds += 1;
+                    let start: Vec<f64> = (first.iter().zip(&other))
+                        .map(|(a, b)| scale * (a + ratio * b))
+                        .collect();
+                    let run = full_basis_branch(
+                        system,
+                        settings,
+                        &start,
+                        vec![period],
+                        Solver::default(),
+                    );
+                    let Some(p) = run.ok().and_then(|r| r.points.into_iter().next()) else {
+                        continue;
+                    };
+                    tally.converged += 1;
+                    if p.asymmetry < EVEN {
+                        tally.even += 1;
+                        continue;
+                    }
+                    let finer =
+                        refined(system, settings, &p, 4 * settings.samples_per_harmonic, m)?;
+                    // An asymmetry the grid made shrinks with it.
+                    let vanishes = |a: f64| a < EVEN.max(SHRINK * p.asymmetry);
+                    if finer.is_some_and(|r| vanishes(r.asymmetry)) {
+                        tally.even_on_finer_grid += 1;
+                        continue;
+                    }
+                    tally.odd += 1;
+                    let defect =
+                        periodicity_check(system, problem.basis(), &p.x, omega, &check.options)
+                            .map_or_else(
+                                |e| format!("not checked: {e}"),
+                                |r| format!("{:e}", r.displacement_defect),
+                            );
+                    let more = refined(system, settings, &p, settings.samples_per_harmonic, 2 * m)?;
+                    if let Some(r) = more.filter(|r| !vanishes(r.asymmetry)) {
+                        tally.odd_lifted += 1;
+                        if r.displacement_defect <= check.max_displacement_defect {
+                            tally.odd_verified += 1;
+                        }
+                    }
+                    let show = |r: &Option<Refined>| match r {
+                        Some(r) => format!(
+                            "{},{:e},{:e}",
+                            r.energy_normalized, r.asymmetry, r.displacement_defect
+                        ),
+                        None => ",,".into(),
+                    };
+                    println!(
+                        "{name},{period},{mode},{n},{scale},{ratio},{},{:e},{defect},{},{}",
+                        p.energy_normalized,
+                        p.asymmetry,
+                        show(&finer),
+                        show(&more)
+                    );
+                }
+            }
+        }
+    }
+    Ok(tally)
+}
+
+/// A point solved again on a refined problem.
+#[derive(Clone, Copy)]
+struct Refined {
+    energy_normalized: f64,
+    asymmetry: f64,
+    displacement_defect: f64,
+}
+
+/// `p` solved again with `samples_per_harmonic` samples per harmonic and `harmonics`
+/// harmonics (its coefficients kept, the new ones zero): `(E / E_g, asymmetry,
+/// displacement defect)`, or `None` where the solve fails or the check cannot run.
+fn refined(
+    system: &BarSystem,
+    settings: &HarmonicBalanceSettings,
+    p: &FullBasisPoint,
+    samples_per_harmonic: usize,
+    harmonics: usize,
+) -> Result<Option<Refined>, Box<dyn std::error::Error>> {
+    let finer = HarmonicBalanceSettings {
+        harmonics,
+        samples_per_harmonic,
+        ..*settings
+    };
+    let start = with_harmonics(&p.x, settings.harmonics, harmonics);
+    let run = full_basis_branch(system, &finer, &start, vec![p.period], Solver::default());
+    let Some(q) = run.ok().and_then(|r| r.points.into_iter().next()) else {
+        return Ok(None);
+    };
+    let basis = full_basis_system(system, &finer)?;
+    let check = TimeDomainCheck::for_system(system);
+    let report = periodicity_check(system, basis.basis(), &q.x, q.omega, &check.options);
+    Ok(report.ok().map(|r| Refined {
+        energy_normalized: q.energy_normalized,
+        asymmetry: q.asymmetry,
+        displacement_defect: r.displacement_defect,
+    }))
+}
+
+/// The seed `x` (on the cosine of harmonic `n`) moved to the sine of harmonic `n`.
+fn quadrature(x: &[f64], m: usize, n: usize) -> Vec<f64> {
+    let per = x.len() / (2 * m + 1);
+    let mut y = vec![0.0; x.len()];
+    y[(m + n) * per..(m + n + 1) * per].copy_from_slice(&x[n * per..(n + 1) * per]);
+    y
+}

@@ -1,0 +1,286 @@
+//! Backbones in the full Fourier basis: constant, cosines and sines, with a phase condition.
+//!
+//! The paper's cosine basis keeps only motions that are even in time. In the full basis
+//! ([`SineCosineBasis`]) a branch is continued in the period on the [`PhaseLocked`] system,
+//! whose phase reference moves to each accepted point. Every even solution of the cosine
+//! basis is one of the full basis (its sines solve to zero), so a branch started from a
+//! cosine point ([`to_full_basis`]) reproduces the cosine backbone; a start with sines
+//! follows motions the cosine basis cannot hold. [`FullBasisPoint::sine_share`] tells the
+//! two apart.
+
+use crate::continuation::{
+    EndReason, PeriodParametrised, Rejection, Sequential, SequentialOptions, Step,
+};
+use crate::error::Error;
+use crate::fourier::{frequency_of_period, Basis, SineCosineBasis};
+use crate::modal::{energy, grazing_energy};
+use crate::solve::NonlinearSolver;
+use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem, PhaseLocked};
+
+/// Energies below this fraction of `E_g` are the state of rest, which is no point of a
+/// backbone (it solves the equations at every period).
+const REST: f64 = 1e-6;
+
+/// One converged point of a branch in the full basis.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct FullBasisPoint {
+    /// Step number in the period grid.
+    pub step: usize,
+    /// Period `T`.
+    pub period: f64,
+    /// Fundamental angular frequency `Omega = 2 pi / T`.
+    pub omega: f64,
+    /// Mechanical energy at `t = 0` (kinetic and potential: with sines, velocities need
+    /// not vanish there).
+    pub energy: f64,
+    /// `E / E_g`.
+    pub energy_normalized: f64,
+    /// The unfolding unknown `mu` of the phase-locked system: of the order of the solver's
+    /// tolerance on a solution of the harmonic balance itself.
+    pub unfolding: f64,
+    /// The share of the sines in the state, `|x_sin|^2 / |x|^2`: 0 for a motion even in
+    /// time about `t = 0`.
+    pub sine_share: f64,
+    /// How far the motion is from even in time about any instant: the smallest share of
+    /// the sines over the time shifts of the state ([`asymmetry`]). 0 for an even motion,
+    /// whatever its phase; a motion the cosine basis cannot hold has it well above the
+    /// rounding level.
+    pub asymmetry: f64,
+    /// `|(F + mu w, u . x)|_2`.
+    pub residual_norm: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// The unknowns (layout of [`NonsmoothSystem`] with a [`SineCosineBasis`]).
+    pub x: Vec<f64>,
+}
+
+/// A branch in the full basis: its converged points and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FullBasisBranch {
+    /// The converged points, in the order of the grid.
+    pub points: Vec<FullBasisPoint>,
+    /// The steps that did not join the branch (the solver failed, or reached the state of
+    /// rest), with their periods and reasons.
+    pub rejected: Vec<Rejection>,
+    /// Why the run ended.
+    pub end: EndReason,
+}
+
+/// The harmonic-balance system of `system` in the full basis with `settings`' harmonics,
+/// samples, complementarity parameter and kink blend (the harmonic selection of
+/// [`HarmonicBalanceSettings::resonance_band`] is a cosine-basis setting and is not used).
+///
+/// # Errors
+/// As [`SineCosineBasis::new`] and [`NonsmoothSystem::with_basis`].
+pub fn full_basis_system(
+    system: &BarSystem,
+    settings: &HarmonicBalanceSettings,
+) -> Result<NonsmoothSystem<SineCosineBasis>, Error> {
+    let basis = SineCosineBasis::new(settings.harmonics, settings.samples_per_harmonic)?;
+    let mut problem = NonsmoothSystem::with_basis(system, basis, settings.complementarity)?;
+    problem.set_kink_blend(settings.kink_blend)?;
+    Ok(problem)
+}
+
+/// A state of the cosine basis with `harmonics` harmonics as one of the full basis: the
+/// cosine coefficients first, then zero sines (both layouts are coefficient-major).
+pub fn to_full_basis(x: &[f64], harmonics: usize) -> Vec<f64> {
+    let per_coefficient = x.len() / (harmonics + 1);
+    let mut y = x.to_vec();
+    y.resize(per_coefficient * (2 * harmonics + 1), 0.0);
+    y
+}
+
+/// A full-basis state of `harmonics` harmonics written with `to >= harmonics` of them (the
+/// added cosines and sines zero), as a start at more harmonics.
+pub fn with_harmonics(x: &[f64], harmonics: usize, to: usize) -> Vec<f64> {
+    let per = x.len() / (2 * harmonics + 1);
+    let mut y = vec![0.0; per * (2 * to.max(harmonics) + 1)];
+    let (cosines, sines) = x.split_at(per * (harmonics + 1));
+    y[..cosines.len()].copy_from_slice(cosines);
+    let at = per * (to.max(harmonics) + 1);
+    y[at..at + sines.len()].copy_from_slice(sines);
+    y
+}
+
+/// The share `|x_sin|^2 / |x|^2` of the sine coefficients in a full-basis state.
+fn sine_share(x: &[f64], harmonics: usize) -> f64 {
+    let split = x.len() / (2 * harmonics + 1) * (harmonics + 1);
+    let (cosines, sines) = x.split_at(split.min(x.len()));
+    let (c, s) = (
+        cosines.iter().map(|v| v * v).sum::<f64>(),
+        sines.iter().map(|v| v * v).sum::<f64>(),
+    );
+    if c + s > 0.0 {
+        s / (c + s)
+    } else {
+        0.0
+    }
+}
+
+/// The coefficients `(c', s')` about `theta0` of `c cos(n theta) + s sin(n theta)`, from
+/// `(sin, cos)` of `n theta0`.
+fn rotate(c: f64, s: f64, (sin, cos): (f64, f64)) -> (f64, f64) {
+    (c * cos + s * sin, s * cos - c * sin)
+}
+
+/// The sine share of the state shifted to `theta0`: every harmonic `n` of every signal,
+/// `c cos(n theta) + s sin(n theta)`, has the sine `s cos(n theta0) - c sin(n theta0)` about
+/// `theta0`.
+fn share_about(x: &[f64], harmonics: usize, theta0: f64) -> f64 {
+    let per = x.len() / (2 * harmonics + 1);
+    let (mut odd, mut all) = (0.0, 0.0);
+    for n in 1..=harmonics {
+        let turn = (n as f64 * theta0).sin_cos();
+        for k in 0..per {
+            let (c, s) = (x[n * per + k], x[(harmonics + n) * per + k]);
+            let (_, sine) = rotate(c, s, turn);
+            odd += sine * sine;
+            all += c * c + s * s;
+        }
+    }
+    all += x[..per].iter().map(|v| v * v).sum::<f64>();
+    if all > 0.0 {
+        odd / all
+    } else {
+        0.0
+    }
+}
+
+/// How far a full-basis state is from even in time about any instant: the smallest sine
+/// share `|x_sin|^2 / |x|^2` over the shifts of its time origin ([`symmetry_instant`]).
+pub fn asymmetry(x: &[f64], harmonics: usize) -> f64 {
+    symmetry_instant(x, harmonics).1
+}
+
+/// The phase `theta0` about which a full-basis state is closest to even, and its sine share
+/// about it.
+///
+/// A motion even about `theta0` is even about `theta0 + pi` too, so the search covers
+/// `[0, pi)`: a scan of `8 m` instants (the share varies on the scale `pi / m` of the
+/// highest harmonic), then a golden-section refinement around the best of them.
+pub fn symmetry_instant(x: &[f64], harmonics: usize) -> (f64, f64) {
+    if harmonics == 0 || x.len() < 2 * harmonics + 1 {
+        return (0.0, 0.0);
+    }
+    let scan = 8 * harmonics;
+    let h = std::f64::consts::PI / scan as f64;
+    let share = |t: f64| share_about(x, harmonics, t);
+    let best = (0..scan)
+        .map(|k| k as f64 * h)
+        .min_by(|a, b| share(*a).total_cmp(&share(*b)))
+        .unwrap_or(0.0);
+    let (mut a, mut b) = (best - h, best + h);
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..60 {
+        let (c, d) = (b - ratio * (b - a), a + ratio * (b - a));
+        if share(c) < share(d) {
+            b = d;
+        } else {
+            a = c;
+        }
+    }
+    let refined = 0.5 * (a + b);
+    if share(refined) < share(best) {
+        (refined, share(refined))
+    } else {
+        (best, share(best))
+    }
+}
+
+/// The full-basis state `x` with its time origin moved to `theta0`: every signal
+/// `s(theta)` becomes `s(theta + theta0)`.
+pub fn shift_origin(x: &[f64], harmonics: usize, theta0: f64) -> Vec<f64> {
+    let per = x.len() / (2 * harmonics + 1);
+    let mut y = x.to_vec();
+    for n in 1..=harmonics {
+        let turn = (n as f64 * theta0).sin_cos();
+        for k in 0..per {
+            let (c, s) = (x[n * per + k], x[(harmonics + n) * per + k]);
+            (y[n * per + k], y[(harmonics + n) * per + k]) = rotate(c, s, turn);
+        }
+    }
+    y
+}
+
+/// The cosine-basis state of the even part of `x` about `theta0`: the cosines of `x` with
+/// its origin moved there ([`shift_origin`]), its sines dropped.
+pub fn even_part(x: &[f64], harmonics: usize, theta0: f64) -> Vec<f64> {
+    let per = x.len() / (2 * harmonics + 1);
+    let mut y = shift_origin(x, harmonics, theta0);
+    y.truncate(per * (harmonics + 1));
+    y
+}
+
+/// Continues a branch of `system` in the full basis over `periods`, natural-parameter, from
+/// `start` (a full-basis state near the branch at `periods[0]`: [`to_full_basis`] of a
+/// cosine point, or a state with sines). The phase is locked to the start, then to each
+/// accepted point. Points at rest (`E < 1e-6 E_g`) or with an energy that is not finite are
+/// rejected.
+///
+/// # Errors
+/// Bad settings, a system without contact, a start of the wrong length or one that does not
+/// move ([`PhaseLocked::new`]), an invalid grid ([`Sequential::new`]). A run that stops
+/// part-way returns its points and [`FullBasisBranch::end`].
+pub fn full_basis_branch<S: NonlinearSolver>(
+    system: &BarSystem,
+    settings: &HarmonicBalanceSettings,
+    start: &[f64],
+    periods: Vec<f64>,
+    solver: S,
+) -> Result<FullBasisBranch, Error> {
+    let inner = full_basis_system(system, settings)?;
+    let harmonics = inner.basis().harmonics();
+    let first = periods.first().copied().unwrap_or(f64::NAN);
+    let locked = PhaseLocked::new(inner, start, frequency_of_period(first))?;
+    let (e_g, _) = grazing_energy(system)?;
+    let basis = locked.inner().basis().clone();
+    let n = locked.inner().dimension();
+    // The state of rest, or an energy beyond the range of numbers: no point of a branch.
+    let in_motion = |y: &[f64], period: f64| {
+        let e = energy(system, &basis, &y[..n], frequency_of_period(period));
+        e.is_finite() && e >= REST * e_g
+    };
+    let problem = PeriodParametrised::new(locked);
+    let mut driver = Sequential::new(
+        problem,
+        solver,
+        PhaseLocked::lift(start),
+        periods,
+        SequentialOptions::default(),
+    )?
+    .with_acceptance(in_motion);
+    let (mut points, mut rejected) = (Vec::new(), Vec::new());
+    let end = loop {
+        match driver.step() {
+            Step::Accepted(p) => {
+                let omega = frequency_of_period(p.parameter);
+                let x = p.x[..n].to_vec();
+                let e = energy(system, &basis, &x, omega);
+                // The accepted point moves, or it would have been at rest.
+                let _ = driver.problem_mut().inner_mut().set_reference(&x, omega);
+                points.push(FullBasisPoint {
+                    step: p.step,
+                    period: p.parameter,
+                    omega,
+                    energy: e,
+                    energy_normalized: e / e_g,
+                    unfolding: PhaseLocked::unfolding(&p.x),
+                    sine_share: sine_share(&x, harmonics),
+                    asymmetry: asymmetry(&x, harmonics),
+                    residual_norm: p.residual_norm,
+                    iterations: p.iterations,
+                    x,
+                });
+            }
+            Step::Rejected(r) => rejected.push(r),
+            Step::Finished(end) => break end,
+        }
+    };
+    Ok(FullBasisBranch {
+        points,
+        rejected,
+        end,
+    })
+}
