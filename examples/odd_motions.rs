@@ -17,12 +17,16 @@
 //! A converged point is *even* when its [`asymmetry`](nonsmooth_modes::branches::asymmetry)
 //! (the smallest sine share over the time shifts) is below `1e-8`; the others are checked
 //! in the time domain (`verify::periodicity_check`, the backbone's check) and printed with
-//! their displacement defect. The last lines count, per system, the seeds that converged,
+//! their displacement defect, then solved again on a time grid 4 times finer and with `2m`
+//! harmonics (the `fine_*` and `lifted_*` columns). One that stays not even at `2m` is
+//! continued in the period both ways, 40 steps of `5e-4` each (the phase following the
+//! branch), and `not_even_from`, `not_even_to` give the periods between which it stays not
+//! even. The last lines count, per system, the seeds that converged,
 //! reached the state of rest, converged to even motions and to motions that are not even,
 //! and how many of those pass the check (displacement defect at most 5 %).
 
 use nonsmooth_modes::branches::{
-    full_basis_branch, full_basis_system, with_harmonics, BackboneOptions, FullBasisPoint,
+    full_basis_branch, full_basis_system, with_harmonics, BackboneOptions, FullBasisPoint, Request,
     TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::linspace;
@@ -31,7 +35,7 @@ use nonsmooth_modes::modal::{branch_seed, open_mode};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, paper_second_bar, two_bars_in_contact,
 };
-use nonsmooth_modes::solve::Solver;
+
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::verify::periodicity_check;
 
@@ -88,7 +92,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
     ];
     println!(
-        "system,period,mode,harmonic,scale,ratio,energy_normalized,asymmetry,displacement_defect"
+        "system,period,mode,harmonic,scale,ratio,energy_normalized,asymmetry,\
+         displacement_defect,fine_energy_normalized,fine_asymmetry,fine_displacement_defect,\
+         lifted_energy_normalized,lifted_asymmetry,lifted_displacement_defect,\
+         not_even_from,not_even_to"
     );
     let mut tallies = Vec::new();
     for (name, system) in &systems {
@@ -142,10 +149,9 @@ fn search(
                         .collect();
                     let run = full_basis_branch(
                         system,
-                        settings,
+                        &Request::new(1).settings(*settings),
                         &start,
                         vec![period],
-                        Solver::default(),
                     );
                     let Some(p) = run.ok().and_then(|r| r.points.into_iter().next()) else {
                         continue;
@@ -164,18 +170,25 @@ fn search(
                         continue;
                     }
                     tally.odd += 1;
-                    let defect =
-                        periodicity_check(system, problem.basis(), &p.x, omega, &check.options)
-                            .map_or_else(
-                                |e| format!("not checked: {e}"),
-                                |r| format!("{:e}", r.displacement_defect),
-                            );
+                    let defect = periodicity_check(
+                        system,
+                        problem.basis(),
+                        &p.point.x,
+                        omega,
+                        &check.options,
+                    )
+                    .map_or_else(
+                        |e| format!("not checked: {e}"),
+                        |r| format!("{:e}", r.displacement_defect),
+                    );
                     let more = refined(system, settings, &p, settings.samples_per_harmonic, 2 * m)?;
+                    let mut extent = None;
                     if let Some(r) = more.filter(|r| !vanishes(r.asymmetry)) {
                         tally.odd_lifted += 1;
                         if r.displacement_defect <= check.max_displacement_defect {
                             tally.odd_verified += 1;
                         }
+                        extent = Some(not_even_extent(system, settings, &p)?);
                     }
                     let show = |r: &Option<Refined>| match r {
                         Some(r) => format!(
@@ -184,9 +197,12 @@ fn search(
                         ),
                         None => ",,".into(),
                     };
+                    let (from, to) = extent.map_or((String::new(), String::new()), |(a, b)| {
+                        (a.to_string(), b.to_string())
+                    });
                     println!(
-                        "{name},{period},{mode},{n},{scale},{ratio},{},{:e},{defect},{},{}",
-                        p.energy_normalized,
+                        "{name},{period},{mode},{n},{scale},{ratio},{},{:e},{defect},{},{},{from},{to}",
+                        p.point.energy_normalized,
                         p.asymmetry,
                         show(&finer),
                         show(&more)
@@ -197,6 +213,40 @@ fn search(
     }
     Ok(tally)
 }
+
+/// How far in the period a motion that is not even stays so: continued from `p` both ways
+/// by [`FOLLOW_STEPS`] steps of [`FOLLOW_STEP`] (`branches::full_basis_branch`, the phase
+/// following the branch), the periods `(from, to)` between which its points keep an
+/// asymmetry of at least a tenth of `p`'s, without a gap.
+fn not_even_extent(
+    system: &BarSystem,
+    settings: &HarmonicBalanceSettings,
+    p: &FullBasisPoint,
+) -> Result<(f64, f64), Box<dyn std::error::Error>> {
+    let mut extent = (p.point.period, p.point.period);
+    for direction in [-1.0, 1.0] {
+        let end = p.point.period + direction * FOLLOW_STEP * FOLLOW_STEPS as f64;
+        let periods = linspace(p.point.period, end, FOLLOW_STEPS + 1)?;
+        let run = full_basis_branch(
+            system,
+            &Request::new(1).settings(*settings),
+            &p.point.x,
+            periods,
+        )?;
+        for (expected, q) in run.points.iter().enumerate() {
+            if q.point.step != expected || q.asymmetry < SHRINK * p.asymmetry {
+                break;
+            }
+            extent = (extent.0.min(q.point.period), extent.1.max(q.point.period));
+        }
+    }
+    Ok(extent)
+}
+
+/// Steps of a continuation from a motion that is not even, each way.
+const FOLLOW_STEPS: usize = 40;
+/// Their period step.
+const FOLLOW_STEP: f64 = 5e-4;
 
 /// A point solved again on a refined problem.
 #[derive(Clone, Copy)]
@@ -221,16 +271,27 @@ fn refined(
         samples_per_harmonic,
         ..*settings
     };
-    let start = with_harmonics(&p.x, settings.harmonics, harmonics);
-    let run = full_basis_branch(system, &finer, &start, vec![p.period], Solver::default());
+    let start = with_harmonics(&p.point.x, settings.harmonics, harmonics);
+    let run = full_basis_branch(
+        system,
+        &Request::new(1).settings(finer),
+        &start,
+        vec![p.point.period],
+    );
     let Some(q) = run.ok().and_then(|r| r.points.into_iter().next()) else {
         return Ok(None);
     };
     let basis = full_basis_system(system, &finer)?;
     let check = TimeDomainCheck::for_system(system);
-    let report = periodicity_check(system, basis.basis(), &q.x, q.omega, &check.options);
+    let report = periodicity_check(
+        system,
+        basis.basis(),
+        &q.point.x,
+        q.point.omega,
+        &check.options,
+    );
     Ok(report.ok().map(|r| Refined {
-        energy_normalized: q.energy_normalized,
+        energy_normalized: q.point.energy_normalized,
         asymmetry: q.asymmetry,
         displacement_defect: r.displacement_defect,
     }))

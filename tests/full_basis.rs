@@ -8,7 +8,7 @@ use nonsmooth_modes::branches::{
     BackboneOptions, BackbonePoint, FullBasisBranch, Method, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::fourier::{frequency_of_period, CosineBasis};
-use nonsmooth_modes::modal::{branch_seed, energy_at, open_mode};
+use nonsmooth_modes::modal::{branch_seed, energy_at, open_mode, Label};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, paper_second_bar, robin_bar_with_obstacle, two_bars_in_contact,
 };
@@ -41,7 +41,12 @@ fn both(system: &BarSystem) -> (Vec<BackbonePoint>, FullBasisBranch) {
         .map(|p| p.period)
         .collect();
     let start = to_full_basis(&first.x, M);
-    let full = full_basis_branch(system, &settings(), &start, periods, Solver::default());
+    let full = full_basis_branch(
+        system,
+        &Request::new(1).settings(settings()),
+        &start,
+        periods,
+    );
     (run.points, full.unwrap())
 }
 
@@ -61,17 +66,20 @@ fn the_full_basis_reproduces_the_papers_cosine_backbones() {
         let converged = cosine.iter().filter(|p| p.converged).count();
         let mut common = 0;
         for q in &full.points {
-            let Some(p) = cosine.iter().find(|p| p.converged && p.period == q.period) else {
+            let Some(p) = cosine
+                .iter()
+                .find(|p| p.converged && p.period == q.point.period)
+            else {
                 continue;
             };
             common += 1;
-            let relative = (q.energy - p.energy).abs() / p.energy;
+            let relative = (q.point.energy - p.energy).abs() / p.energy;
             assert!(
                 relative < 1e-8,
                 "{name} T = {}: cosine E = {:e}, full E = {:e}",
-                q.period,
+                q.point.period,
                 p.energy,
-                q.energy
+                q.point.energy
             );
             assert!(q.sine_share < 1e-16, "{name}: sines {:e}", q.sine_share);
             assert!(q.asymmetry < 1e-16, "{name}: asymmetry {:e}", q.asymmetry);
@@ -103,17 +111,16 @@ fn a_shifted_motion_is_the_same_motion() {
         let start = shift_origin(&even, M, phi);
         let run = full_basis_branch(
             &system,
-            &settings(),
+            &Request::new(1).settings(settings()),
             &start,
             vec![p.period],
-            Solver::default(),
         );
         (start, run.unwrap().points.remove(0))
     };
 
     let (start, q) = solve(on_grid);
     let size = start.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    for (a, b) in q.x.iter().zip(&start) {
+    for (a, b) in q.point.x.iter().zip(&start) {
         assert!((a - b).abs() < 1e-9 * size, "{a:e} vs {b:e}");
     }
     assert!(q.sine_share > 1e-3, "sines {:e}", q.sine_share);
@@ -128,18 +135,18 @@ fn a_shifted_motion_is_the_same_motion() {
         on_grid,
     );
     assert!(
-        (q.energy - moved).abs() < 1e-10 * moved,
+        (q.point.energy - moved).abs() < 1e-10 * moved,
         "{:e} vs {moved:e}",
-        q.energy
+        q.point.energy
     );
 
     let (_, q) = solve(0.7);
     assert!(q.asymmetry < 1e-5, "asymmetry {:e}", q.asymmetry);
-    assert!((q.energy_normalized / p.energy_normalized - 1.0).abs() < 0.01);
+    assert!((q.point.energy_normalized / p.energy_normalized - 1.0).abs() < 0.01);
     let full = full_basis_system(&system, &settings()).unwrap();
     let options = PeriodicityOptions::default();
     let check = |x: &[f64]| periodicity_check(&system, full.basis(), x, omega, &options).unwrap();
-    let (shifted, unshifted) = (check(&q.x), check(&even));
+    let (shifted, unshifted) = (check(&q.point.x), check(&even));
     assert!(
         shifted.displacement_defect <= 2.0 * unshifted.displacement_defect + 1e-3,
         "shifted {:e} vs even {:e}",
@@ -178,10 +185,9 @@ fn the_clamped_bar_has_motions_that_are_not_even() {
             }
             let run = full_basis_branch(
                 &system,
-                &settings(),
+                &Request::new(1).settings(settings()),
                 &start,
                 vec![period],
-                Solver::default(),
             );
             let Some(p) = run.unwrap().points.pop() else {
                 continue;
@@ -189,14 +195,24 @@ fn the_clamped_bar_has_motions_that_are_not_even() {
             if p.asymmetry < 1e-2 {
                 continue;
             }
-            let start = with_harmonics(&p.x, M, 2 * M);
-            let run = full_basis_branch(&system, &lifted, &start, vec![period], Solver::default());
+            let start = with_harmonics(&p.point.x, M, 2 * M);
+            let run = full_basis_branch(
+                &system,
+                &Request::new(1).settings(lifted),
+                &start,
+                vec![period],
+            );
             let Some(q) = run.unwrap().points.pop() else {
                 continue;
             };
-            let report =
-                periodicity_check(&system, lifted_basis.basis(), &q.x, omega, &check.options)
-                    .unwrap();
+            let report = periodicity_check(
+                &system,
+                lifted_basis.basis(),
+                &q.point.x,
+                omega,
+                &check.options,
+            )
+            .unwrap();
             if q.asymmetry > 1e-2 && report.displacement_defect < check.max_displacement_defect {
                 found += 1;
             }
@@ -213,7 +229,7 @@ fn bad_requests_are_typed_errors() {
     let full = full_basis_system(&system, &settings()).unwrap();
     let n = full.dimension();
     let run = |start: &[f64], periods: Vec<f64>, s: &HarmonicBalanceSettings| {
-        full_basis_branch(&system, s, start, periods, Solver::default())
+        full_basis_branch(&system, &Request::new(1).settings(*s), start, periods)
     };
     assert!(matches!(
         run(&vec![1e-4; n - 1], vec![3.5], &settings()),
@@ -233,4 +249,43 @@ fn bad_requests_are_typed_errors() {
         run(&vec![1e-4; n], vec![3.5], &none),
         Err(Error::Settings(SettingsError::ZeroHarmonics))
     ));
+}
+
+/// A full-basis point is annotated as `compute` annotates its points: asked for, the
+/// time-domain check runs on it, and its label is the cosine point's (an even motion is the
+/// same motion in either basis, so both checks march the same initial state).
+#[test]
+fn full_basis_points_are_checked_and_labelled_as_the_cosine_ones() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let mut options = BackboneOptions::for_mode(&system, 1, 1).unwrap();
+    options.grid = nonsmooth_modes::branches::PeriodGrid {
+        start: 3.9,
+        end: 3.5,
+        steps: 5,
+    };
+    let request = Request::for_method(Method::PeriodGrid(options))
+        .settings(settings())
+        .solver(Solver::default())
+        .checked(TimeDomainCheck::for_system(&system));
+    let cosine = compute(&system, &request).unwrap();
+    let first = cosine.points.iter().find(|p| p.converged).unwrap();
+    let periods = (cosine.points.iter())
+        .filter(|p| p.step >= first.step)
+        .map(|p| p.period)
+        .collect();
+    let start = to_full_basis(&first.x, M);
+    let full = full_basis_branch(&system, &request, &start, periods).unwrap();
+    assert!(!full.points.is_empty());
+    for q in &full.points {
+        let p = (cosine.points.iter())
+            .find(|p| p.period == q.point.period)
+            .unwrap();
+        assert_eq!(q.point.label, p.label, "T = {}", p.period);
+        assert_eq!(q.point.label, Some(Label::Skeleton), "T = {}", p.period);
+        let (a, b) = (q.point.time_domain.unwrap(), p.time_domain.unwrap());
+        assert!(
+            (a.displacement_defect - b.displacement_defect).abs() < 1e-9,
+            "{a:?} vs {b:?}"
+        );
+    }
 }

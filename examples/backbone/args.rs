@@ -288,14 +288,11 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         return Err("--switch-at needs --method arclength".into());
     }
     if a.full_basis
-        && (a.parameter != Parameter::Omega
-            || a.arclength == Some(true)
-            || a.subharmonic != 1
-            || a.stability)
+        && (a.parameter != Parameter::Omega || a.arclength == Some(true) || a.subharmonic != 1)
     {
         return Err(
             "--basis full runs sequentially in the period (--parameter omega, no --method \
-             arclength) for --subharmonic 1, without --stability"
+             arclength) for --subharmonic 1"
                 .into(),
         );
     }

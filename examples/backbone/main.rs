@@ -87,13 +87,14 @@
 //! period grid is run in the cosine basis (`--basis cosine`, the default) for its first
 //! converged point, which starts the full-basis run over the same periods. Its columns are
 //! `step,period,omega,energy,energy_normalized,converged,status,unfolding,sine_share,
-//! asymmetry,residual_norm,iterations` (`status`: `converged`, `rejected`, or
+//! asymmetry,residual_norm,iterations,label` (`status`: `converged`, `rejected`, or
 //! `before-start` for the periods before the cosine run's first converged one; `unfolding`
 //! is the phase-locked system's `mu`, `sine_share` and `asymmetry` say how far the motion is
-//! from even about `t = 0` and about any instant), and with `--verify`
-//! `periodicity_defect,displacement_defect`. It takes `--parameter omega`, sequential
-//! steps, `--subharmonic 1` and no `--stability`; other combinations are usage errors.
-//!
+//! from even about `t = 0` and about any instant; `label` as below), then with `--verify`
+//! `periodicity_defect,displacement_defect,max_penetration` and with `--stability`
+//! `stable,max_multiplier`, as for the cosine basis. It takes `--parameter omega`,
+//! sequential steps and `--subharmonic 1`; other combinations are usage errors.
+
 //! `--subharmonic K > 1` (sequential runs in the period): the seed on harmonic `K` gives the
 //! mode of period `T/K` traced `K` times, a subspace Newton's method never leaves; the run
 //! follows it until a point can be left along the most singular direction off the multiples

@@ -91,26 +91,12 @@ impl Sink<'_> {
         cells
     }
 
-    /// `periodicity_defect,displacement_defect,max_penetration` of a point (the library's
-    /// time-domain check of the run), or empty cells where it was not checked.
+    /// [`verification_cells`], or nothing without `--verify`.
     fn verification(&self, p: &BackbonePoint) -> String {
-        if !self.verify {
-            return String::new();
-        }
-        match (p.time_domain, p.converged) {
-            (Some(r), _) => format!(
-                ",{:.6e},{:.6e},{:.6e}",
-                r.defect, r.displacement_defect, r.max_penetration
-            ),
-            (None, true) => {
-                eprintln!(
-                    "backbone: step {} not checked in the time domain (its march is over the \
-                     check's budget, or failed): unverified",
-                    p.step
-                );
-                ",,,".to_string()
-            }
-            (None, false) => ",,,".to_string(),
+        if self.verify {
+            verification_cells(p)
+        } else {
+            String::new()
         }
     }
 
@@ -130,27 +116,12 @@ impl Sink<'_> {
         format!(",{label},{},{harmonic}", p.branch)
     }
 
-    /// `,stable,max_multiplier` of a point: `true`, `false` or `unresolved` and
-    /// `Floquet::max_multiplier`; empty for a point without multipliers (with a message when it
-    /// converged).
+    /// [`stability_cells`], or nothing without `--stability`.
     fn stability(&self, p: &BackbonePoint) -> String {
-        if !self.stability {
-            return String::new();
-        }
-        match &p.stability {
-            Some(Ok(f)) => {
-                let stable = match f.verdict {
-                    Verdict::Stable => "true",
-                    Verdict::Unstable(_) => "false",
-                    Verdict::Unresolved => "unresolved",
-                };
-                format!(",{stable},{:.10e}", f.max_multiplier)
-            }
-            Some(Err(e)) => {
-                eprintln!("backbone: no multipliers for step {}: {e}", p.step);
-                ",,".to_string()
-            }
-            None => ",,".to_string(),
+        if self.stability {
+            stability_cells(p)
+        } else {
+            String::new()
         }
     }
 
@@ -206,5 +177,47 @@ impl Sink<'_> {
                 ControlFlow::Break(())
             }
         }
+    }
+}
+
+/// `,periodicity_defect,displacement_defect,max_penetration` of a point (the library's
+/// time-domain check of the run), or empty cells where it was not checked (with a message
+/// when it converged).
+pub fn verification_cells(p: &BackbonePoint) -> String {
+    match (p.time_domain, p.converged) {
+        (Some(r), _) => format!(
+            ",{:.6e},{:.6e},{:.6e}",
+            r.defect, r.displacement_defect, r.max_penetration
+        ),
+        (None, true) => {
+            eprintln!(
+                "backbone: step {} not checked in the time domain (its march is over the \
+                 check's budget, or failed): unverified",
+                p.step
+            );
+            ",,,".to_string()
+        }
+        (None, false) => ",,,".to_string(),
+    }
+}
+
+/// `,stable,max_multiplier` of a point: `true`, `false` or `unresolved` and
+/// `Floquet::max_multiplier`; empty for a point without multipliers (with a message when it
+/// converged).
+pub fn stability_cells(p: &BackbonePoint) -> String {
+    match &p.stability {
+        Some(Ok(f)) => {
+            let stable = match f.verdict {
+                Verdict::Stable => "true",
+                Verdict::Unstable(_) => "false",
+                Verdict::Unresolved => "unresolved",
+            };
+            format!(",{stable},{:.10e}", f.max_multiplier)
+        }
+        Some(Err(e)) => {
+            eprintln!("backbone: no multipliers for step {}: {e}", p.step);
+            ",,".to_string()
+        }
+        None => ",,".to_string(),
     }
 }

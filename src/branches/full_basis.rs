@@ -8,34 +8,32 @@
 //! follows motions the cosine basis cannot hold. [`FullBasisPoint::sine_share`] tells the
 //! two apart.
 
+use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
+use crate::branches::request::Request;
+use crate::branches::result::Annotator;
 use crate::continuation::{
     EndReason, PeriodParametrised, Rejection, Sequential, SequentialOptions, Step,
 };
 use crate::error::Error;
 use crate::fourier::{frequency_of_period, Basis, SineCosineBasis};
 use crate::modal::{energy, grazing_energy};
-use crate::solve::NonlinearSolver;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem, PhaseLocked};
+use std::ops::ControlFlow;
 
 /// Energies below this fraction of `E_g` are the state of rest, which is no point of a
 /// backbone (it solves the equations at every period).
 const REST: f64 = 1e-6;
 
-/// One converged point of a branch in the full basis.
+/// One converged point of a branch in the full basis: the point as every backbone reports it
+/// (its unknowns in the layout of [`NonsmoothSystem`] with a [`SineCosineBasis`]; its
+/// energy at `t = 0`, kinetic and potential, since with sines velocities need not vanish
+/// there; its character, label and time-domain check where the request asks), and how far
+/// the motion is from even in time.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FullBasisPoint {
-    /// Step number in the period grid.
-    pub step: usize,
-    /// Period `T`.
-    pub period: f64,
-    /// Fundamental angular frequency `Omega = 2 pi / T`.
-    pub omega: f64,
-    /// Mechanical energy at `t = 0` (kinetic and potential: with sines, velocities need
-    /// not vanish there).
-    pub energy: f64,
-    /// `E / E_g`.
-    pub energy_normalized: f64,
+    /// The point, annotated as [`compute`](crate::branches::compute) annotates its points.
+    pub point: BackbonePoint,
     /// The unfolding unknown `mu` of the phase-locked system: of the order of the solver's
     /// tolerance on a solution of the harmonic balance itself.
     pub unfolding: f64,
@@ -47,12 +45,6 @@ pub struct FullBasisPoint {
     /// whatever its phase; a motion the cosine basis cannot hold has it well above the
     /// rounding level.
     pub asymmetry: f64,
-    /// `|(F + mu w, u . x)|_2`.
-    pub residual_norm: f64,
-    /// Solver iterations.
-    pub iterations: usize,
-    /// The unknowns (layout of [`NonsmoothSystem`] with a [`SineCosineBasis`]).
-    pub x: Vec<f64>,
 }
 
 /// A branch in the full basis: its converged points and why it ended.
@@ -219,20 +211,29 @@ pub fn even_part(x: &[f64], harmonics: usize, theta0: f64) -> Vec<f64> {
 /// accepted point. Points at rest (`E < 1e-6 E_g`) or with an energy that is not finite are
 /// rejected.
 ///
+/// `request` gives the harmonic-balance settings, the solver (full semismooth Newton when
+/// it names none) and what each converged point gets, as in
+/// [`compute`](crate::branches::compute): its character and label, the time-domain check
+/// of [`Request::check`] and the multipliers of [`Request::stability`]. Its method is not
+/// used: the periods are the grid. The harmonic selection of
+/// [`HarmonicBalanceSettings::resonance_band`] is a cosine-basis setting and is not used.
+///
 /// # Errors
 /// Bad settings, a system without contact, a start of the wrong length or one that does not
 /// move ([`PhaseLocked::new`]), an invalid grid ([`Sequential::new`]). A run that stops
 /// part-way returns its points and [`FullBasisBranch::end`].
-pub fn full_basis_branch<S: NonlinearSolver>(
+pub fn full_basis_branch(
     system: &BarSystem,
-    settings: &HarmonicBalanceSettings,
+    request: &Request,
     start: &[f64],
     periods: Vec<f64>,
-    solver: S,
 ) -> Result<FullBasisBranch, Error> {
-    let inner = full_basis_system(system, settings)?;
+    let inner = full_basis_system(system, &request.settings)?;
     let harmonics = inner.basis().harmonics();
     let first = periods.first().copied().unwrap_or(f64::NAN);
+    let annotator = Annotator::new(inner.clone(), request, |_: &BackbonePoint| {
+        ControlFlow::Continue(())
+    });
     let locked = PhaseLocked::new(inner, start, frequency_of_period(first))?;
     let (e_g, _) = grazing_energy(system)?;
     let basis = locked.inner().basis().clone();
@@ -243,6 +244,7 @@ pub fn full_basis_branch<S: NonlinearSolver>(
         e.is_finite() && e >= REST * e_g
     };
     let problem = PeriodParametrised::new(locked);
+    let solver = request.solver.unwrap_or_default();
     let mut driver = Sequential::new(
         problem,
         solver,
@@ -251,33 +253,58 @@ pub fn full_basis_branch<S: NonlinearSolver>(
         SequentialOptions::default(),
     )?
     .with_acceptance(in_motion);
-    let (mut points, mut rejected) = (Vec::new(), Vec::new());
+    let mut annotator = annotator;
+    let (mut measures, mut rejected) = (Vec::new(), Vec::new());
     let end = loop {
         match driver.step() {
             Step::Accepted(p) => {
-                let omega = frequency_of_period(p.parameter);
+                let time = Timescale::of_period(p.parameter);
                 let x = p.x[..n].to_vec();
-                let e = energy(system, &basis, &x, omega);
+                let e = energy(system, &basis, &x, time.omega);
                 // The accepted point moves, or it would have been at rest.
-                let _ = driver.problem_mut().inner_mut().set_reference(&x, omega);
-                points.push(FullBasisPoint {
+                let _ = driver
+                    .problem_mut()
+                    .inner_mut()
+                    .set_reference(&x, time.omega);
+                measures.push((
+                    PhaseLocked::unfolding(&p.x),
+                    sine_share(&x, harmonics),
+                    asymmetry(&x, harmonics),
+                ));
+                let _ = annotator.point(BackbonePoint {
                     step: p.step,
-                    period: p.parameter,
-                    omega,
+                    period: time.period,
+                    omega: time.omega,
                     energy: e,
                     energy_normalized: e / e_g,
-                    unfolding: PhaseLocked::unfolding(&p.x),
-                    sine_share: sine_share(&x, harmonics),
-                    asymmetry: asymmetry(&x, harmonics),
+                    converged: true,
+                    status: PointStatus::Converged,
                     residual_norm: p.residual_norm,
                     iterations: p.iterations,
                     x,
+                    step_size: p.step_size,
+                    events: p.events,
+                    branch: 0,
+                    time_domain: None,
+                    character: None,
+                    label: None,
+                    stability: None,
                 });
             }
             Step::Rejected(r) => rejected.push(r),
             Step::Finished(end) => break end,
         }
     };
+    let points = (annotator.into_points().into_iter().zip(measures))
+        .map(
+            |(point, (unfolding, sine_share, asymmetry))| FullBasisPoint {
+                point,
+                unfolding,
+                sine_share,
+                asymmetry,
+            },
+        )
+        .collect();
     Ok(FullBasisBranch {
         points,
         rejected,

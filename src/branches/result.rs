@@ -6,6 +6,7 @@ use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
+use crate::fourier::{Basis, CosineBasis};
 use crate::modal::linear::{natural_frequency_values, Resolution};
 use crate::modal::{character, label, nearest_mode, ContactState};
 use crate::solution::Solution;
@@ -93,8 +94,8 @@ impl ModeBranches {
 
 /// Annotates each point a driver hands over (branch index, character, time-domain check,
 /// label) before the user's observer sees it, and keeps it.
-pub(crate) struct Annotator<O> {
-    problem: NonsmoothSystem,
+pub(crate) struct Annotator<O, B: Basis = CosineBasis> {
+    problem: NonsmoothSystem<B>,
     check: Option<TimeDomainCheck>,
     stability: Option<StabilityOptions>,
     /// The verdict of the last converged point whose multipliers were computed, and its
@@ -110,9 +111,9 @@ pub(crate) struct Annotator<O> {
     natural_up_to: f64,
 }
 
-impl<O: BackboneObserver> Annotator<O> {
+impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
     /// The annotator of the points of `problem` asked by `request`.
-    pub(crate) fn new(problem: NonsmoothSystem, request: &Request, observer: O) -> Self {
+    pub(crate) fn new(problem: NonsmoothSystem<B>, request: &Request, observer: O) -> Self {
         Self {
             problem,
             check: request.check,
@@ -166,9 +167,9 @@ impl<O: BackboneObserver> Annotator<O> {
         end
     }
 
-    /// The points kept, in order, and the problem they were annotated on.
-    pub(crate) fn into_parts(self) -> (Vec<BackbonePoint>, NonsmoothSystem) {
-        (self.points, self.problem)
+    /// The points kept, in order.
+    pub(crate) fn into_points(self) -> Vec<BackbonePoint> {
+        self.points
     }
 
     /// The converged points so far.
@@ -271,6 +272,13 @@ impl<O: BackboneObserver> Annotator<O> {
             self.natural_up_to = up_to;
         }
         changed
+    }
+}
+
+impl<O: BackboneObserver> Annotator<O> {
+    /// The points kept, in order, and the problem they were annotated on.
+    pub(crate) fn into_parts(self) -> (Vec<BackbonePoint>, NonsmoothSystem) {
+        (self.points, self.problem)
     }
 
     /// The result of the run.

@@ -1,11 +1,13 @@
 //! Branches in the full Fourier basis (`branches::full_basis_branch`) from any start, over
 //! any periods, with any settings and solver.
 
-use super::solvers::solver;
+use super::solvers::request_solver;
 use super::{reference_system, settings};
 use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
-use nonsmooth_modes::branches::{full_basis_branch, full_basis_system, to_full_basis};
+use nonsmooth_modes::branches::{
+    full_basis_branch, full_basis_system, to_full_basis, Request, TimeDomainCheck,
+};
 use nonsmooth_modes::fourier::frequency_of_period;
 use nonsmooth_modes::modal::branch_seed;
 use nonsmooth_modes::system::NonsmoothSystem;
@@ -44,27 +46,34 @@ pub(crate) fn full_basis_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
             start
         }
     };
-    let solver = solver(d, c)?;
+    let mut request = Request::new(1).settings(s);
+    request.solver = request_solver(d, c)?;
+    if d.flag("time-domain check", 0.2) {
+        request = request.checked(TimeDomainCheck::for_system(&system));
+    }
     let run = typed(
         c,
         "full basis branch",
-        full_basis_branch(&system, &s, &start, periods.clone(), solver),
+        full_basis_branch(&system, &request, &start, periods.clone()),
     )?;
     for p in &run.points {
         let numbers = [
-            p.period,
-            p.omega,
-            p.energy,
-            p.energy_normalized,
+            p.point.period,
+            p.point.omega,
+            p.point.energy,
+            p.point.energy_normalized,
             p.unfolding,
             p.sine_share,
             p.asymmetry,
-            p.residual_norm,
+            p.point.residual_norm,
         ];
         c.finite("full basis point", &numbers);
-        c.finite("full basis point x", &p.x);
-        c.expect(periods.get(p.step) == Some(&p.period), || {
-            format!("full basis point of step {} at T = {}", p.step, p.period)
+        c.finite("full basis point x", &p.point.x);
+        c.expect(periods.get(p.point.step) == Some(&p.point.period), || {
+            format!(
+                "full basis point of step {} at T = {}",
+                p.point.step, p.point.period
+            )
         });
     }
     c.expect(
