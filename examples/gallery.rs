@@ -14,16 +14,32 @@
 //!   columns `period,omega_normalized,energy_normalized,verdict,max_multiplier,
 //!   energy_correction` (`verdict`: 1 stable, -1 unstable, 0 unresolved).
 //!
+//! - `not_even_clamped.svg` and `.csv`: a periodic motion of the clamped bar that is not
+//!   even in time, which the paper's cosine basis cannot hold. At `T = 3.089` (a period of
+//!   the grid `3.95 -> 3.05` in 24 steps), seeds that put modes 2 to 4 in quadrature with
+//!   mode 1 are solved in the full basis (`branches::full_basis_branch`) at `m = 20`, lifted
+//!   to `m = 40` and solved again, checked in the time domain; the most asymmetric one that
+//!   passes the check is drawn: its field `u(x, t) / g0` and its contact end's displacement
+//!   over one period beside its mirror image about the instant where it is closest to even
+//!   (an even motion would lie on its mirror). CSV columns `time,displacement,mirror,
+//!   contact_force` (`time` from that instant, displacements over `g0`).
+//!
 //! `--quick` uses 100 cells per travel time for the multipliers instead of 200 (for CI).
 
-use nonsmooth_modes::branches::{compute, BackbonePoint, Request};
+use nonsmooth_modes::branches::{
+    compute, full_basis_branch, full_basis_system, quadrature_start, shift_origin,
+    symmetry_instant, with_harmonics, BackbonePoint, FullBasisPoint, Request, TimeDomainCheck,
+};
+use nonsmooth_modes::fourier::frequency_of_period;
 use nonsmooth_modes::io::write_columns_csv;
+use nonsmooth_modes::modal::end_history;
 use nonsmooth_modes::plot::{
-    backbone_panel, render_svg, stability_series, Figure, LinePanel, Rgb, Series, FREQUENCY_LABEL,
-    PALETTE,
+    backbone_panel, render_svg, space_time_panel, stability_series, Figure, LinePanel, Rgb, Series,
+    SpaceTimeField, FREQUENCY_LABEL, PALETTE,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
 use nonsmooth_modes::stability::StabilityOptions;
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use std::error::Error;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -123,6 +139,125 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
     Ok(())
 }
 
+/// The most asymmetric motion of the clamped bar at `period` found from seeds with modes 2
+/// to 4 in quadrature with mode 1 at `m = 20`, solved again at `m = 40` and passing the
+/// time-domain check there.
+fn not_even_motion(system: &BarSystem, period: f64) -> Res<Option<FullBasisPoint>> {
+    let coarse = HarmonicBalanceSettings {
+        harmonics: 20,
+        ..HarmonicBalanceSettings::default()
+    };
+    let fine = HarmonicBalanceSettings {
+        harmonics: 40,
+        ..coarse
+    };
+    let m = coarse.harmonics;
+    let omega = frequency_of_period(period);
+    let mut problem = full_basis_system(system, &coarse)?;
+    let check = TimeDomainCheck::for_system(system);
+    let checked = Request::new(1).settings(fine).checked(check);
+    let mut best: Option<FullBasisPoint> = None;
+    for mode in 2..=4 {
+        for ratio in [0.1, 0.3, 1.0, 3.0] {
+            let (start, _) = quadrature_start(&mut problem, mode, ratio, omega)?;
+            let request = Request::new(1).settings(coarse);
+            let Some(p) = full_basis_branch(system, &request, &start, vec![period])?
+                .points
+                .pop()
+            else {
+                continue;
+            };
+            let lifted = with_harmonics(&p.point.x, m, fine.harmonics);
+            let Some(q) = full_basis_branch(system, &checked, &lifted, vec![period])?
+                .points
+                .pop()
+            else {
+                continue;
+            };
+            let verified = (q.point.time_domain)
+                .is_some_and(|r| r.displacement_defect <= check.max_displacement_defect);
+            if verified && best.as_ref().is_none_or(|b| q.asymmetry > b.asymmetry) {
+                best = Some(q);
+            }
+        }
+    }
+    Ok(best)
+}
+
+/// A motion of the clamped bar that is not even in time: its field and its contact end
+/// beside the end's mirror image.
+fn not_even_clamped(out: &std::path::Path) -> Res<()> {
+    let gap = 1e-3;
+    let system = clamped_bar_with_obstacle(gap)?;
+    let period = 3.95 - 22.0 * (3.95 - 3.05) / 23.0;
+    let Some(p) = not_even_motion(&system, period)? else {
+        return Err(format!("no motion that is not even found at T = {period}").into());
+    };
+    let q = &p.point;
+    let m = 40;
+    let basis = full_basis_system(
+        &system,
+        &HarmonicBalanceSettings {
+            harmonics: m,
+            ..HarmonicBalanceSettings::default()
+        },
+    )?
+    .basis()
+    .clone();
+    let (theta0, _) = symmetry_instant(&q.x, m);
+    let about = shift_origin(&q.x, m, theta0);
+    let samples = 400;
+    let end = system.bar_id(0).ok_or("no bar 1")?.right();
+    let h = end_history(&system, &basis, &about, q.omega, end, samples);
+    let v: Vec<f64> = h.displacement.iter().map(|u| u / gap).collect();
+    let mirror: Vec<f64> = (0..samples).map(|k| v[(samples - k) % samples]).collect();
+    let grid =
+        nonsmooth_modes::modal::displacement_grid(&system, &basis, &about, q.omega, 0, 41, 81);
+    let field = SpaceTimeField {
+        position: grid.position,
+        time: grid.time,
+        values: grid.displacement.iter().map(|u| u / gap).collect(),
+    };
+    let title = format!(
+        "T = {:.3}, E/E_g = {:.1}, m = {m}: u(x, t)/g₀",
+        q.period, q.energy_normalized
+    );
+    let map = space_time_panel(title, &field, "u/g₀")?;
+    let points = |values: &[f64]| h.time.iter().copied().zip(values.iter().copied()).collect();
+    let mut history = LinePanel::new(
+        format!("contact end, asymmetry {:.1} %", 100.0 * p.asymmetry),
+        "t (from the instant closest to even)",
+        "u(1, t)/g₀",
+    );
+    history.series = vec![
+        Series::line("u(1, t)", points(&v)).with_color(PALETTE[0]),
+        Series::line("u(1, −t): its mirror image", points(&mirror))
+            .with_color(PALETTE[1])
+            .dashed(),
+        Series::line("gap", vec![(0.0, 1.0), (q.period, 1.0)])
+            .with_color(Rgb::BLACK)
+            .with_size(1),
+    ];
+    let figure = Figure {
+        title: "A motion of the clamped bar that is not even in time".into(),
+        columns: 2,
+        panel_size: (640, 480),
+        panels: vec![map.into(), history.into()],
+    };
+    render_svg(out.join("not_even_clamped.svg"), &figure)?;
+    let names = ["time", "displacement", "mirror", "contact_force"];
+    let force: Vec<f64> = h.contact_force.clone();
+    let columns: [&[f64]; 4] = [&h.time, &v, &mirror, &force];
+    let file = std::fs::File::create(out.join("not_even_clamped.csv"))?;
+    write_columns_csv(&names, &columns, std::io::BufWriter::new(file))?;
+    let defect = q.time_domain.map_or(f64::NAN, |r| r.displacement_defect);
+    println!(
+        "not_even_clamped: T = {:.4}, E/E_g = {:.2}, asymmetry {:.3}, displacement defect {:.3}",
+        q.period, q.energy_normalized, p.asymmetry, defect
+    );
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let mut out = PathBuf::from("gallery");
     let mut quick = false;
@@ -145,6 +280,7 @@ fn main() -> ExitCode {
     }
     let run = || -> Res<()> {
         std::fs::create_dir_all(&out)?;
+        not_even_clamped(&out)?;
         stability_clamped(&out, if quick { 100.0 } else { 200.0 })
     };
     match run() {

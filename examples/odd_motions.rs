@@ -26,12 +26,11 @@
 //! and how many of those pass the check (displacement defect at most 5 %).
 
 use nonsmooth_modes::branches::{
-    full_basis_branch, full_basis_system, with_harmonics, BackboneOptions, FullBasisPoint, Request,
-    TimeDomainCheck,
+    full_basis_branch, full_basis_system, quadrature_start, with_harmonics, BackboneOptions,
+    FullBasisPoint, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::linspace;
 use nonsmooth_modes::fourier::{frequency_of_period, Basis};
-use nonsmooth_modes::modal::{branch_seed, open_mode};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, paper_second_bar, two_bars_in_contact,
 };
@@ -134,19 +133,14 @@ fn search(
     let mut tally = Tally::default();
     for period in linspace(grid.start, grid.end, periods)? {
         let omega = frequency_of_period(period);
-        let first = branch_seed(&mut problem, 1, 1, omega)?;
         for mode in 2..=4 {
-            let n = (open_mode(system, mode)?.omega / omega).round() as usize;
-            if n < 1 || n > m {
-                continue;
-            }
-            let other = quadrature(&branch_seed(&mut problem, mode, n, omega)?, m, n);
             for scale in [1.0, 2.0] {
                 for ratio in [0.1, 0.3, 1.0, 3.0] {
+                    let Ok((start, n)) = quadrature_start(&mut problem, mode, ratio, omega) else {
+                        continue;
+                    };
                     tally.seeds += 1;
-                    let start: Vec<f64> = (first.iter().zip(&other))
-                        .map(|(a, b)| scale * (a + ratio * b))
-                        .collect();
+                    let start: Vec<f64> = start.iter().map(|v| scale * v).collect();
                     let run = full_basis_branch(
                         system,
                         &Request::new(1).settings(*settings),
@@ -295,12 +289,4 @@ fn refined(
         asymmetry: q.asymmetry,
         displacement_defect: r.displacement_defect,
     }))
-}
-
-/// The seed `x` (on the cosine of harmonic `n`) moved to the sine of harmonic `n`.
-fn quadrature(x: &[f64], m: usize, n: usize) -> Vec<f64> {
-    let per = x.len() / (2 * m + 1);
-    let mut y = vec![0.0; x.len()];
-    y[(m + n) * per..(m + n + 1) * per].copy_from_slice(&x[n * per..(n + 1) * per]);
-    y
 }

@@ -4,11 +4,12 @@
 //! time-domain check.
 
 use nonsmooth_modes::branches::{
-    compute, full_basis_branch, full_basis_system, shift_origin, to_full_basis, with_harmonics,
-    BackboneOptions, BackbonePoint, FullBasisBranch, Method, Request, TimeDomainCheck,
+    compute, full_basis_branch, full_basis_system, quadrature_start, shift_origin, to_full_basis,
+    with_harmonics, BackboneOptions, BackbonePoint, FullBasisBranch, Method, Request,
+    TimeDomainCheck,
 };
 use nonsmooth_modes::fourier::{frequency_of_period, CosineBasis};
-use nonsmooth_modes::modal::{branch_seed, energy_at, open_mode, Label};
+use nonsmooth_modes::modal::{energy_at, Label};
 use nonsmooth_modes::reference::{
     clamped_bar_with_obstacle, paper_second_bar, robin_bar_with_obstacle, two_bars_in_contact,
 };
@@ -166,7 +167,6 @@ fn the_clamped_bar_has_motions_that_are_not_even() {
     let period = 3.95 - 22.0 * (3.95 - 3.05) / 23.0;
     let omega = frequency_of_period(period);
     let mut full = full_basis_system(&system, &settings()).unwrap();
-    let first = branch_seed(&mut full, 1, 1, omega).unwrap();
     let lifted = HarmonicBalanceSettings {
         harmonics: 2 * M,
         ..settings()
@@ -175,14 +175,8 @@ fn the_clamped_bar_has_motions_that_are_not_even() {
     let lifted_basis = full_basis_system(&system, &lifted).unwrap();
     let mut found = 0;
     for mode in 2..=4 {
-        let n = (open_mode(&system, mode).unwrap().omega / omega).round() as usize;
-        let other = branch_seed(&mut full, mode, n, omega).unwrap();
-        let per = other.len() / (2 * M + 1);
         for ratio in [0.1, 0.3, 1.0, 3.0] {
-            let mut start = first.clone();
-            for k in 0..per {
-                start[(M + n) * per + k] += ratio * other[n * per + k];
-            }
+            let (start, _) = quadrature_start(&mut full, mode, ratio, omega).unwrap();
             let run = full_basis_branch(
                 &system,
                 &Request::new(1).settings(settings()),
@@ -288,4 +282,37 @@ fn full_basis_points_are_checked_and_labelled_as_the_cosine_ones() {
             "{a:?} vs {b:?}"
         );
     }
+}
+
+/// A quadrature start is the first mode's seed on the cosine of harmonic 1 plus the other
+/// mode's on the sine of the harmonic nearest its frequency, scaled by the ratio; a harmonic
+/// beyond the basis is a typed error.
+#[test]
+fn a_quadrature_start_puts_the_second_mode_on_a_sine() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let omega = frequency_of_period(3.9);
+    let mut full = full_basis_system(&system, &settings()).unwrap();
+    let (unit, n) = quadrature_start(&mut full, 2, 1.0, omega).unwrap();
+    let (half, m) = quadrature_start(&mut full, 2, 0.5, omega).unwrap();
+    assert_eq!((n, m), (3, 3), "mode 2 (3 pi / 2) is nearest harmonic 3 at T = 3.9");
+    let per = unit.len() / (2 * M + 1);
+    let sine = (M + n) * per..(M + n + 1) * per;
+    for (i, (a, b)) in unit.iter().zip(&half).enumerate() {
+        if sine.contains(&i) {
+            assert!((a - 2.0 * b).abs() <= 1e-15 * a.abs(), "{a} vs {b}");
+            assert!(a.abs() > 0.0 || b.abs() == 0.0);
+        } else {
+            assert_eq!(a, b, "coefficient {i} is the first mode's");
+        }
+    }
+    assert!(unit[sine].iter().any(|v| *v != 0.0));
+    let few = HarmonicBalanceSettings {
+        harmonics: 2,
+        ..settings()
+    };
+    let mut small = full_basis_system(&system, &few).unwrap();
+    assert!(matches!(
+        quadrature_start(&mut small, 4, 1.0, omega),
+        Err(Error::Settings(SettingsError::HarmonicOutOfRange { harmonics: 2, .. }))
+    ));
 }

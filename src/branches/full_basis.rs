@@ -14,9 +14,9 @@ use crate::branches::result::Annotator;
 use crate::continuation::{
     EndReason, PeriodParametrised, Rejection, Sequential, SequentialOptions, Step,
 };
-use crate::error::Error;
+use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, Basis, SineCosineBasis};
-use crate::modal::{energy, grazing_energy};
+use crate::modal::{branch_seed, energy, grazing_energy, open_mode};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem, PhaseLocked};
 use std::ops::ControlFlow;
 
@@ -94,6 +94,44 @@ pub fn with_harmonics(x: &[f64], harmonics: usize, to: usize) -> Vec<f64> {
     let at = per * (to.max(harmonics) + 1);
     y[at..at + sines.len()].copy_from_slice(sines);
     y
+}
+
+/// A start for motions that are not even in time: the grazing seed of the first linear
+/// mode on harmonic 1 (a cosine, [`branch_seed`]) plus `ratio` times that of linear mode
+/// `mode` on the sine of the harmonic `n` nearest its frequency (`n Omega ~ omega_mode`):
+/// two modes in quadrature, at the fundamental frequency `omega`. Returns the start and `n`.
+///
+/// # Errors
+/// As [`branch_seed`] and [`open_mode`]; [`SettingsError::HarmonicOutOfRange`] when `n` is
+/// 0 or beyond the basis.
+pub fn quadrature_start(
+    problem: &mut NonsmoothSystem<SineCosineBasis>,
+    mode: usize,
+    ratio: f64,
+    omega: f64,
+) -> Result<(Vec<f64>, usize), Error> {
+    let m = problem.basis().harmonics();
+    let n = (open_mode(problem.system(), mode)?.omega / omega).round();
+    if !(n >= 1.0 && n <= m as f64) {
+        return Err(SettingsError::HarmonicOutOfRange {
+            subharmonic: if n.is_finite() && n >= 0.0 {
+                n as usize
+            } else {
+                0
+            },
+            harmonics: m,
+        }
+        .into());
+    }
+    let n = n as usize;
+    let mut start = branch_seed(problem, 1, 1, omega)?;
+    let other = branch_seed(problem, mode, n, omega)?;
+    let per = other.len() / (2 * m + 1);
+    let (cosine, sine) = (n * per, (m + n) * per);
+    for k in 0..per {
+        start[sine + k] += ratio * other[cosine + k];
+    }
+    Ok((start, n))
 }
 
 /// The share `|x_sin|^2 / |x|^2` of the sine coefficients in a full-basis state.
