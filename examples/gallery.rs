@@ -21,7 +21,7 @@
 //!   to `m = 40` and solved again, checked in the time domain; the most asymmetric one that
 //!   passes the check is drawn: its field `u(x, t) / g0` and its contact end's displacement
 //!   over one period beside its mirror image about the instant where it is closest to even
-//!   (an even motion would lie on its mirror). CSV columns `time,displacement,mirror,
+//!   (an even motion would lie on its mirror); its Floquet verdict is printed. CSV columns `time,displacement,mirror,
 //!   contact_force` (`time` from that instant, displacements over `g0`).
 //!
 //! `--quick` uses 100 cells per travel time for the multipliers instead of 200 (for CI).
@@ -38,7 +38,7 @@ use nonsmooth_modes::plot::{
     SpaceTimeField, FREQUENCY_LABEL, PALETTE,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
-use nonsmooth_modes::stability::StabilityOptions;
+use nonsmooth_modes::stability::{floquet, StabilityOptions};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings};
 use std::error::Error;
 use std::path::PathBuf;
@@ -186,7 +186,7 @@ fn not_even_motion(system: &BarSystem, period: f64) -> Res<Option<FullBasisPoint
 
 /// A motion of the clamped bar that is not even in time: its field and its contact end
 /// beside the end's mirror image.
-fn not_even_clamped(out: &std::path::Path) -> Res<()> {
+fn not_even_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
     let gap = 1e-3;
     let system = clamped_bar_with_obstacle(gap)?;
     let period = 3.95 - 22.0 * (3.95 - 3.05) / 23.0;
@@ -251,8 +251,20 @@ fn not_even_clamped(out: &std::path::Path) -> Res<()> {
     let file = std::fs::File::create(out.join("not_even_clamped.csv"))?;
     write_columns_csv(&names, &columns, std::io::BufWriter::new(file))?;
     let defect = q.time_domain.map_or(f64::NAN, |r| r.displacement_defect);
+    let options = StabilityOptions {
+        cells_per_travel: cells,
+        ..StabilityOptions::default()
+    };
+    let verdict = match floquet(&system, &basis, &q.x, q.omega, &options) {
+        Ok(f) => format!(
+            "{:?} at {cells} cells per travel time, largest multiplier {:.4}",
+            f.verdict, f.max_multiplier
+        ),
+        Err(e) => format!("no multipliers: {e}"),
+    };
     println!(
-        "not_even_clamped: T = {:.4}, E/E_g = {:.2}, asymmetry {:.3}, displacement defect {:.3}",
+        "not_even_clamped: T = {:.4}, E/E_g = {:.2}, asymmetry {:.3}, displacement defect \
+         {:.3}; {verdict}",
         q.period, q.energy_normalized, p.asymmetry, defect
     );
     Ok(())
@@ -280,8 +292,9 @@ fn main() -> ExitCode {
     }
     let run = || -> Res<()> {
         std::fs::create_dir_all(&out)?;
-        not_even_clamped(&out)?;
-        stability_clamped(&out, if quick { 100.0 } else { 200.0 })
+        let cells = if quick { 100.0 } else { 200.0 };
+        not_even_clamped(&out, cells)?;
+        stability_clamped(&out, cells)
     };
     match run() {
         Ok(()) => ExitCode::SUCCESS,

@@ -294,7 +294,11 @@ fn a_quadrature_start_puts_the_second_mode_on_a_sine() {
     let mut full = full_basis_system(&system, &settings()).unwrap();
     let (unit, n) = quadrature_start(&mut full, 2, 1.0, omega).unwrap();
     let (half, m) = quadrature_start(&mut full, 2, 0.5, omega).unwrap();
-    assert_eq!((n, m), (3, 3), "mode 2 (3 pi / 2) is nearest harmonic 3 at T = 3.9");
+    assert_eq!(
+        (n, m),
+        (3, 3),
+        "mode 2 (3 pi / 2) is nearest harmonic 3 at T = 3.9"
+    );
     let per = unit.len() / (2 * M + 1);
     let sine = (M + n) * per..(M + n + 1) * per;
     for (i, (a, b)) in unit.iter().zip(&half).enumerate() {
@@ -313,6 +317,9 @@ fn a_quadrature_start_puts_the_second_mode_on_a_sine() {
     let mut small = full_basis_system(&system, &few).unwrap();
     assert!(matches!(
         quadrature_start(&mut small, 4, 1.0, omega),
-        Err(Error::Settings(SettingsError::HarmonicOutOfRange { harmonics: 2, .. }))
+        Err(Error::Settings(SettingsError::HarmonicOutOfRange {
+            harmonics: 2,
+            ..
+        }))
     ));
 }
