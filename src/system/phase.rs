@@ -74,6 +74,7 @@ impl PhaseLocked {
     /// # Errors
     /// [`SettingsError::Length`] for a reference of the wrong length;
     /// [`SettingsError::NotPositive`] for a frequency that is not positive and finite;
+    /// [`SettingsError::NotFinite`] for a reference with a value that is not;
     /// [`SettingsError::StillReference`] for a reference whose signals do not move (a
     /// state of rest fixes no phase) or whose gaps do not.
     pub fn new(
@@ -110,6 +111,13 @@ impl PhaseLocked {
             return Err(SettingsError::NotPositive {
                 what: "frequency of the phase reference",
                 value: omega,
+            }
+            .into());
+        }
+        if let Some(v) = reference.iter().find(|v| !v.is_finite()) {
+            return Err(SettingsError::NotFinite {
+                what: "phase reference",
+                value: *v,
             }
             .into());
         }
@@ -344,8 +352,14 @@ mod tests {
             Err(Error::Settings(SettingsError::Length { .. }))
         ));
         assert!(matches!(
-            PhaseLocked::new(full, &x, f64::NAN),
+            PhaseLocked::new(full.clone(), &x, f64::NAN),
             Err(Error::Settings(SettingsError::NotPositive { .. }))
+        ));
+        let mut bad = x.clone();
+        bad[3] = f64::NAN;
+        assert!(matches!(
+            PhaseLocked::new(full, &bad, omega),
+            Err(Error::Settings(SettingsError::NotFinite { .. }))
         ));
     }
 }
