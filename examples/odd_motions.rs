@@ -266,25 +266,14 @@ fn refined(
         ..*settings
     };
     let start = with_harmonics(&p.point.x, settings.harmonics, harmonics);
-    let run = full_basis_branch(
-        system,
-        &Request::new(1).settings(finer),
-        &start,
-        vec![p.point.period],
-    );
+    let request = Request::new(1)
+        .settings(finer)
+        .checked(TimeDomainCheck::for_system(system));
+    let run = full_basis_branch(system, &request, &start, vec![p.point.period]);
     let Some(q) = run.ok().and_then(|r| r.points.into_iter().next()) else {
         return Ok(None);
     };
-    let basis = full_basis_system(system, &finer)?;
-    let check = TimeDomainCheck::for_system(system);
-    let report = periodicity_check(
-        system,
-        basis.basis(),
-        &q.point.x,
-        q.point.omega,
-        &check.options,
-    );
-    Ok(report.ok().map(|r| Refined {
+    Ok(q.point.time_domain.map(|r| Refined {
         energy_normalized: q.point.energy_normalized,
         asymmetry: q.asymmetry,
         displacement_defect: r.displacement_defect,

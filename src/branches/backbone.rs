@@ -279,7 +279,7 @@ fn drive_backbone<S: NonlinearSolver>(
 /// The last solution a period grid's acceptance test took: its unknowns (copied into a
 /// buffer kept from step to step), time scale and energy, for the observer and the measure
 /// to reuse instead of computing them again.
-struct Taken {
+pub(super) struct Taken {
     x: Vec<f64>,
     time: Timescale,
     energy: f64,
@@ -301,14 +301,14 @@ impl Default for Taken {
 
 impl Taken {
     /// Keeps `(x, time)` and its energy.
-    fn keep(&mut self, x: &[f64], time: Timescale, energy: f64) {
+    pub(super) fn keep(&mut self, x: &[f64], time: Timescale, energy: f64) {
         self.x.clear();
         self.x.extend_from_slice(x);
         (self.time, self.energy) = (time, energy);
     }
 
     /// The time scale and energy kept, if they are those of `x` at `period`.
-    fn time_and_energy(&self, x: &[f64], period: f64) -> Option<(Timescale, f64)> {
+    pub(super) fn time_and_energy(&self, x: &[f64], period: f64) -> Option<(Timescale, f64)> {
         (self.time.period == period && self.x == x).then_some((self.time, self.energy))
     }
 

@@ -5,9 +5,10 @@
 //! whose phase reference moves to each accepted point. Every even solution of the cosine
 //! basis is one of the full basis (its sines solve to zero), so a branch started from a
 //! cosine point ([`to_full_basis`]) reproduces the cosine backbone; a start with sines
-//! follows motions the cosine basis cannot hold. [`FullBasisPoint::sine_share`] tells the
+//! follows motions the cosine basis cannot hold. [`FullBasisPoint::asymmetry`] tells the
 //! two apart.
 
+use crate::branches::backbone::Taken;
 use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
 use crate::branches::request::Request;
 use crate::branches::result::Annotator;
@@ -18,6 +19,7 @@ use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, Basis, SineCosineBasis};
 use crate::modal::{branch_seed, energy, grazing_energy, open_mode};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem, PhaseLocked};
+use std::cell::RefCell;
 use std::ops::ControlFlow;
 
 /// Energies below this fraction of `E_g` are the state of rest, which is no point of a
@@ -134,28 +136,14 @@ pub fn quadrature_start(
     Ok((start, n))
 }
 
-/// The share `|x_sin|^2 / |x|^2` of the sine coefficients in a full-basis state.
-fn sine_share(x: &[f64], harmonics: usize) -> f64 {
-    let split = x.len() / (2 * harmonics + 1) * (harmonics + 1);
-    let (cosines, sines) = x.split_at(split.min(x.len()));
-    let (c, s) = (
-        cosines.iter().map(|v| v * v).sum::<f64>(),
-        sines.iter().map(|v| v * v).sum::<f64>(),
-    );
-    if c + s > 0.0 {
-        s / (c + s)
-    } else {
-        0.0
-    }
-}
-
 /// The coefficients `(c', s')` about `theta0` of `c cos(n theta) + s sin(n theta)`, from
 /// `(sin, cos)` of `n theta0`.
 fn rotate(c: f64, s: f64, (sin, cos): (f64, f64)) -> (f64, f64) {
     (c * cos + s * sin, s * cos - c * sin)
 }
 
-/// The sine share of the state shifted to `theta0`: every harmonic `n` of every signal,
+/// The sine share `|x_sin|^2 / |x|^2` of the state shifted to `theta0` (of the state itself
+/// at `theta0 = 0`): every harmonic `n` of every signal,
 /// `c cos(n theta) + s sin(n theta)`, has the sine `s cos(n theta0) - c sin(n theta0)` about
 /// `theta0`.
 fn share_about(x: &[f64], harmonics: usize, theta0: f64) -> f64 {
@@ -198,9 +186,9 @@ pub fn symmetry_instant(x: &[f64], harmonics: usize) -> (f64, f64) {
     let h = std::f64::consts::PI / scan as f64;
     let share = |t: f64| share_about(x, harmonics, t);
     let best = (0..scan)
-        .map(|k| k as f64 * h)
-        .min_by(|a, b| share(*a).total_cmp(&share(*b)))
-        .unwrap_or(0.0);
+        .map(|k| (k as f64 * h, share(k as f64 * h)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0.0, |(t, _)| t);
     let (mut a, mut b) = (best - h, best + h);
     let ratio = (5f64.sqrt() - 1.0) / 2.0;
     for _ in 0..60 {
@@ -211,12 +199,11 @@ pub fn symmetry_instant(x: &[f64], harmonics: usize) -> (f64, f64) {
             a = c;
         }
     }
-    let refined = 0.5 * (a + b);
-    if share(refined) < share(best) {
-        (refined, share(refined))
-    } else {
-        (best, share(best))
-    }
+    [0.5 * (a + b), best]
+        .map(|t| (t, share(t)))
+        .into_iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((best, share(best)))
 }
 
 /// The full-basis state `x` with its time origin moved to `theta0`: every signal
@@ -231,15 +218,6 @@ pub fn shift_origin(x: &[f64], harmonics: usize, theta0: f64) -> Vec<f64> {
             (y[n * per + k], y[(harmonics + n) * per + k]) = rotate(c, s, turn);
         }
     }
-    y
-}
-
-/// The cosine-basis state of the even part of `x` about `theta0`: the cosines of `x` with
-/// its origin moved there ([`shift_origin`]), its sines dropped.
-pub fn even_part(x: &[f64], harmonics: usize, theta0: f64) -> Vec<f64> {
-    let per = x.len() / (2 * harmonics + 1);
-    let mut y = shift_origin(x, harmonics, theta0);
-    y.truncate(per * (harmonics + 1));
     y
 }
 
@@ -269,65 +247,53 @@ pub fn full_basis_branch(
     let inner = full_basis_system(system, &request.settings)?;
     let harmonics = inner.basis().harmonics();
     let first = periods.first().copied().unwrap_or(f64::NAN);
-    let annotator = Annotator::new(inner.clone(), request, |_: &BackbonePoint| {
-        ControlFlow::Continue(())
-    });
+    let observer = |_: &BackbonePoint| ControlFlow::Continue(());
+    let mut annotator = Annotator::new(inner.clone(), request, observer);
     let locked = PhaseLocked::new(inner, start, frequency_of_period(first))?;
     let (e_g, _) = grazing_energy(system)?;
     let basis = locked.inner().basis().clone();
     let n = locked.inner().dimension();
-    // The state of rest, or an energy beyond the range of numbers: no point of a branch.
+    // The acceptance test computes each converged point's energy; the accepted point reuses
+    // it. The state of rest, or an energy beyond the range of numbers, is no point of a
+    // branch.
+    let taken = RefCell::new(Taken::default());
     let in_motion = |y: &[f64], period: f64| {
-        let e = energy(system, &basis, &y[..n], frequency_of_period(period));
+        let time = Timescale::of_period(period);
+        let e = energy(system, &basis, &y[..n], time.omega);
+        taken.borrow_mut().keep(y, time, e);
         e.is_finite() && e >= REST * e_g
     };
-    let problem = PeriodParametrised::new(locked);
     let solver = request.solver.unwrap_or_default();
     let mut driver = Sequential::new(
-        problem,
+        PeriodParametrised::new(locked),
         solver,
         PhaseLocked::lift(start),
         periods,
         SequentialOptions::default(),
     )?
     .with_acceptance(in_motion);
-    let mut annotator = annotator;
     let (mut measures, mut rejected) = (Vec::new(), Vec::new());
     let end = loop {
         match driver.step() {
             Step::Accepted(p) => {
-                let time = Timescale::of_period(p.parameter);
-                let x = p.x[..n].to_vec();
-                let e = energy(system, &basis, &x, time.omega);
+                let known = taken.borrow().time_and_energy(&p.x, p.parameter);
+                let (time, e) = known.unwrap_or_else(|| {
+                    let time = Timescale::of_period(p.parameter);
+                    (time, energy(system, &basis, &p.x[..n], time.omega))
+                });
+                let x = &p.x[..n];
                 // The accepted point moves, or it would have been at rest.
                 let _ = driver
                     .problem_mut()
                     .inner_mut()
-                    .set_reference(&x, time.omega);
+                    .set_reference(x, time.omega);
                 measures.push((
                     PhaseLocked::unfolding(&p.x),
-                    sine_share(&x, harmonics),
-                    asymmetry(&x, harmonics),
+                    share_about(x, harmonics, 0.0),
+                    asymmetry(x, harmonics),
                 ));
-                let _ = annotator.point(BackbonePoint {
-                    step: p.step,
-                    period: time.period,
-                    omega: time.omega,
-                    energy: e,
-                    energy_normalized: e / e_g,
-                    converged: true,
-                    status: PointStatus::Converged,
-                    residual_norm: p.residual_norm,
-                    iterations: p.iterations,
-                    x,
-                    step_size: p.step_size,
-                    events: p.events,
-                    branch: 0,
-                    time_domain: None,
-                    character: None,
-                    label: None,
-                    stability: None,
-                });
+                let point = BackbonePoint::from_parts(&p, (x, time), e, e_g, PointStatus::of(&p));
+                let _ = annotator.point(point);
             }
             Step::Rejected(r) => rejected.push(r),
             Step::Finished(end) => break end,

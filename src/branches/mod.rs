@@ -38,7 +38,7 @@ pub use energy_backbone::{
 };
 pub use escape::{EscapingArclength, StallEscape};
 pub use full_basis::{
-    asymmetry, even_part, full_basis_branch, full_basis_system, quadrature_start, shift_origin,
+    asymmetry, full_basis_branch, full_basis_system, quadrature_start, shift_origin,
     symmetry_instant, to_full_basis, with_harmonics, FullBasisBranch, FullBasisPoint,
 };
 pub use groups::{group_by_label, PointGroup};

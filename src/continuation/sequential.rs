@@ -5,7 +5,7 @@ use super::{
     Branch, ContinuationProblem, EndReason, Observer, Point, RejectReason, Rejection, Step,
 };
 use crate::error::{ContinuationError, SolveError};
-use crate::solve::{norm, NonlinearSolver, SolveInfo};
+use crate::solve::{failed_point, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
 
 /// How the next starting guess is formed.
@@ -404,17 +404,9 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
                     Err(e) => (Some(e), None),
                 };
                 self.failures += 1;
-                let mut f = vec![0.0; x.len()];
                 self.problem.set_parameter(lambda);
-                self.problem.residual(&x, &mut f);
-                // A solve that diverged leaves an iterate without a finite residual: the
-                // point reports the last converged solution instead (at `lambda`).
-                let x = if norm(&f).is_finite() {
-                    x
-                } else {
-                    self.problem.residual(&self.last, &mut f);
-                    self.last.clone()
-                };
+                // A solve that diverged reports the last converged solution (at `lambda`).
+                let (x, residual_norm) = failed_point(&mut self.problem, x, &self.last);
                 let iterations = match (&error, solved) {
                     (_, Some(info)) => info.iterations,
                     (Some(SolveError::MaxIterations { iterations, .. }), _) => *iterations,
@@ -441,7 +433,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
                     step,
                     parameter: lambda,
                     x,
-                    residual_norm: norm(&f),
+                    residual_norm,
                     iterations,
                     converged: false,
                     error,

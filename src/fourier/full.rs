@@ -1,9 +1,10 @@
 //! The full Fourier basis: constant, cosines and sines, for motions that are not even in time.
 
-use super::{checked_samples, constant_half, Basis};
+use super::{checked_samples, constant_half, with_buffers, Basis};
 use crate::error::SettingsError;
 use num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+use std::cell::Cell;
 use std::fmt::Debug;
 use std::sync::Arc;
 
@@ -93,33 +94,50 @@ impl SineCosineBasis {
     }
 
     /// The forward transform `Y_l = sum_k x_k exp(-i l theta_k)`, `l = 0..=N/2`, scaled by
-    /// `2/N`: `(sigma_l, -tau_l)` of the moments of `x`.
-    fn scaled_spectrum(&self, x: &[f64]) -> Vec<Complex<f64>> {
-        let mut input = x.to_vec();
-        let mut spectrum = self.forward.make_output_vec();
+    /// `2/N` into `buffers.spectrum`: `(sigma_l, -tau_l)` of the moments of `x`.
+    fn scaled_spectrum(&self, x: &[f64], buffers: &mut Buffers) {
+        let Buffers {
+            real,
+            spectrum,
+            fft,
+        } = buffers;
+        real.clear();
+        real.extend_from_slice(x);
+        spectrum.resize(self.samples / 2 + 1, Complex::default());
+        fft.resize(self.forward.get_scratch_len(), Complex::default());
         self.forward
-            .process(&mut input, &mut spectrum)
+            .process_with_scratch(real, spectrum, fft)
             .expect("buffers sized by the plan");
         let scale = 2.0 / self.samples as f64;
         spectrum.iter_mut().for_each(|y| *y *= scale);
-        spectrum
     }
 
-    /// The moments `(sigma_l, tau_l)` for `l = 0..=2m` of the weights whose scaled spectrum
-    /// is `spectrum` (above `N/2`, `Y_l = conj(Y_(N-l))`).
-    fn moments(&self, spectrum: &[Complex<f64>]) -> Vec<(f64, f64)> {
+    /// The moment `(sigma_l, tau_l)`, `|l| <= 2m`, from the scaled spectrum (above `N/2`,
+    /// `Y_l = conj(Y_(N-l))`; `tau_(-l) = -tau_l`).
+    fn moment(&self, spectrum: &[Complex<f64>], l: isize) -> (f64, f64) {
         let n = self.samples;
-        (0..=2 * self.harmonics)
-            .map(|l| {
-                let l = l % n;
-                if l <= n / 2 {
-                    (spectrum[l].re, -spectrum[l].im)
-                } else {
-                    (spectrum[n - l].re, spectrum[n - l].im)
-                }
-            })
-            .collect()
+        let sign = l.signum() as f64;
+        let l = l.unsigned_abs() % n;
+        let (sigma, tau) = if l <= n / 2 {
+            (spectrum[l].re, -spectrum[l].im)
+        } else {
+            (spectrum[n - l].re, spectrum[n - l].im)
+        };
+        (sigma, sign * tau)
     }
+}
+
+/// Reused buffers of the transforms: a period of samples, a half spectrum and the FFT's
+/// scratch.
+#[derive(Default)]
+struct Buffers {
+    real: Vec<f64>,
+    spectrum: Vec<Complex<f64>>,
+    fft: Vec<Complex<f64>>,
+}
+
+thread_local! {
+    static BUFFERS: Cell<Buffers> = Cell::new(Buffers::default());
 }
 
 impl Basis for SineCosineBasis {
@@ -166,62 +184,69 @@ impl Basis for SineCosineBasis {
         self.assert_coefficients(coefficients.len());
         self.assert_samples(samples.len());
         let m = self.harmonics;
-        let mut spectrum = self.inverse.make_input_vec();
-        spectrum
-            .iter_mut()
-            .for_each(|y| *y = Complex::new(0.0, 0.0));
-        spectrum[0] = Complex::new(0.5 * coefficients[0], 0.0);
-        for n in 1..=m {
-            spectrum[n] = Complex::new(0.5 * coefficients[n], -0.5 * coefficients[m + n]);
-        }
-        // `x_k = sum_n X_n exp(i n theta_k)` over the whole spectrum: the Hermitian half
-        // counts twice, which the halves above undo.
-        self.inverse
-            .process(&mut spectrum, samples)
-            .expect("a half spectrum with real ends (2m < N)");
+        with_buffers(&BUFFERS, |b| {
+            let Buffers { spectrum, fft, .. } = b;
+            spectrum.clear();
+            spectrum.resize(self.samples / 2 + 1, Complex::default());
+            spectrum[0] = Complex::new(0.5 * coefficients[0], 0.0);
+            for n in 1..=m {
+                spectrum[n] = Complex::new(0.5 * coefficients[n], -0.5 * coefficients[m + n]);
+            }
+            fft.resize(self.inverse.get_scratch_len(), Complex::default());
+            // `x_k = sum_n X_n exp(i n theta_k)` over the whole spectrum: the Hermitian half
+            // counts twice, which the halves above undo.
+            self.inverse
+                .process_with_scratch(spectrum, samples, fft)
+                .expect("a half spectrum with real ends (2m < N)");
+        });
     }
     fn project(&self, samples: &[f64], coefficients: &mut [f64]) {
         self.assert_samples(samples.len());
         self.assert_coefficients(coefficients.len());
         let m = self.harmonics;
-        let spectrum = self.scaled_spectrum(samples);
-        for j in 0..=m {
-            coefficients[j] = spectrum[j].re;
-        }
-        for j in 1..=m {
-            coefficients[m + j] = -spectrum[j].im;
-        }
+        with_buffers(&BUFFERS, |b| {
+            self.scaled_spectrum(samples, b);
+            let (cosines, sines) = coefficients.split_at_mut(m + 1);
+            for (c, y) in cosines.iter_mut().zip(&b.spectrum) {
+                *c = y.re;
+            }
+            for (s, y) in sines.iter_mut().zip(&b.spectrum[1..]) {
+                *s = -y.im;
+            }
+        });
     }
     fn weighted_gram(&self, weights: &[f64], gram: &mut [f64]) {
         self.assert_samples(weights.len());
         let len = self.len();
         assert_eq!(gram.len(), len * len, "a square matrix of coefficients");
         let m = self.harmonics as isize;
-        let moments = self.moments(&self.scaled_spectrum(weights));
-        let sigma = |l: isize| moments[l.unsigned_abs()].0;
-        let tau = |l: isize| l.signum() as f64 * moments[l.unsigned_abs()].1;
-        // (sine?, harmonic) of coefficient i.
-        let kind = |i: usize| {
-            let i = i as isize;
-            if i <= m {
-                (false, i)
-            } else {
-                (true, i - m)
+        with_buffers(&BUFFERS, |b| {
+            self.scaled_spectrum(weights, b);
+            let sigma = |l: isize| self.moment(&b.spectrum, l).0;
+            let tau = |l: isize| self.moment(&b.spectrum, l).1;
+            // (sine?, harmonic) of coefficient i.
+            let kind = |i: usize| {
+                let i = i as isize;
+                if i <= m {
+                    (false, i)
+                } else {
+                    (true, i - m)
+                }
+            };
+            for (j, row) in gram.chunks_exact_mut(len).enumerate() {
+                let (test_sine, a) = kind(j);
+                for (i, g) in row.iter_mut().enumerate() {
+                    let (sine, b) = kind(i);
+                    let value = match (test_sine, sine) {
+                        (false, false) => 0.5 * (sigma(a - b) + sigma(a + b)),
+                        (true, true) => 0.5 * (sigma(a - b) - sigma(a + b)),
+                        (true, false) => 0.5 * (tau(a + b) + tau(a - b)),
+                        (false, true) => 0.5 * (tau(b + a) + tau(b - a)),
+                    };
+                    *g = constant_half(i) * value;
+                }
             }
-        };
-        for (j, row) in gram.chunks_exact_mut(len).enumerate() {
-            let (test_sine, a) = kind(j);
-            for (i, g) in row.iter_mut().enumerate() {
-                let (sine, b) = kind(i);
-                let value = match (test_sine, sine) {
-                    (false, false) => 0.5 * (sigma(a - b) + sigma(a + b)),
-                    (true, true) => 0.5 * (sigma(a - b) - sigma(a + b)),
-                    (true, false) => 0.5 * (tau(a + b) + tau(a - b)),
-                    (false, true) => 0.5 * (tau(b + a) + tau(b - a)),
-                };
-                *g = constant_half(i) * value;
-            }
-        }
+        });
     }
 }
 

@@ -270,12 +270,28 @@ thread_local! {
     static SCRATCH: Cell<Scratch> = const { Cell::new(Scratch::new()) };
 }
 
+impl Default for Scratch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// Runs `f` with this thread's buffers (a fresh set if they are already in use).
 fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
-    SCRATCH.with(|cell| {
-        let mut scratch = cell.replace(Scratch::new());
-        let result = f(&mut scratch);
-        cell.set(scratch);
+    with_buffers(&SCRATCH, f)
+}
+
+/// Runs `f` with this thread's buffers held in `key` (a fresh set if they are already in
+/// use, as in a nested call), then puts them back: transforms reuse them and allocate
+/// nothing after their first call on a thread.
+fn with_buffers<S: Default, R>(
+    key: &'static std::thread::LocalKey<Cell<S>>,
+    f: impl FnOnce(&mut S) -> R,
+) -> R {
+    key.with(|cell| {
+        let mut buffers = cell.take();
+        let result = f(&mut buffers);
+        cell.set(buffers);
         result
     })
 }
@@ -405,10 +421,10 @@ impl CosineBasis {
 }
 
 /// The number of samples `N = n_h m` of a basis of `m = harmonics` harmonics and `len`
-/// coefficients per signal (a float: `m + 1` may not fit in `usize`), checked: at least one harmonic, `n_h >= 3` (the discrete products
-/// of two harmonics are orthogonal only for `2m < N`), and its Gram matrix (`len^2` doubles)
-/// with [`BASIS_DOUBLES_PER_SAMPLE`] doubles per sample within the memory budget; `what`
-/// names the basis in the error.
+/// coefficients per signal (a float: `m + 1` may not fit in `usize`), checked: at least one
+/// harmonic, `n_h >= 3` (the discrete products of two harmonics are orthogonal only for
+/// `2m < N`), and its Gram matrix (`len^2` doubles) with [`BASIS_DOUBLES_PER_SAMPLE`]
+/// doubles per sample within the memory budget; `what` names the basis in the error.
 fn checked_samples(
     what: &'static str,
     harmonics: usize,

@@ -229,6 +229,23 @@ pub(crate) fn point_on_ray(x: &[f64], dx: &[f64], t: f64, out: &mut [f64]) {
     }
 }
 
+/// Where a failed solve leaves a point, with its residual norm: the solver's last iterate
+/// `x`, or `fallback` (the last converged solution) when the iterate's residual is not finite
+/// (a solve that diverged), so that a reported point never carries a NaN norm.
+pub(crate) fn failed_point(
+    problem: &mut (impl Problem + ?Sized),
+    x: Vec<f64>,
+    fallback: &[f64],
+) -> (Vec<f64>, f64) {
+    let mut f = vec![0.0; x.len()];
+    problem.residual(&x, &mut f);
+    if norm(&f).is_finite() {
+        return (x, norm(&f));
+    }
+    problem.residual(fallback, &mut f);
+    (fallback.to_vec(), norm(&f))
+}
+
 /// The Euclidean norm, finite whenever the entries are: the plain sum of squares, and when it
 /// overflows (entries beyond about `1e154`) the sum rescaled by the largest entry. Bit for bit
 /// the plain formula wherever that is finite.

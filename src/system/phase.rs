@@ -30,7 +30,8 @@ use crate::continuation::{fill_bordered, ContinuationProblem};
 use crate::error::{Error, SettingsError};
 use crate::fourier::{Basis, SineCosineBasis};
 use crate::linalg::DenseMatrix;
-use crate::solve::{Problem, Structured};
+use crate::solve::{norm, Problem, Structured};
+use crate::system::rows::dot;
 use crate::system::NonsmoothSystem;
 
 /// A [`NonsmoothSystem`] with a phase condition: unknowns `y = (x, mu)`, equations
@@ -46,20 +47,24 @@ pub struct PhaseLocked {
     jacobian: DenseMatrix,
 }
 
-/// `D c` for the coefficients `c` of one signal in `basis`: the coefficients of its
-/// derivative in `theta` (cosine `n` at `n`, sine `n` at `m + n`).
-fn shift_of(basis: &SineCosineBasis, c: &[f64], out: &mut [f64]) {
-    let m = basis.harmonics();
+/// `D x` for a full-basis vector of `m` harmonics with `per` values per coefficient
+/// (coefficient-major, cosine `n` at `n`, sine `n` at `m + n`): each of its signals
+/// differentiated in `theta`, `(c_n, s_n) -> (n s_n, -n c_n)`.
+fn shift_of(x: &[f64], m: usize, per: usize) -> Vec<f64> {
+    let mut out = vec![0.0; x.len()];
     for n in 1..=m {
-        out[n] = n as f64 * c[m + n];
-        out[m + n] = -(n as f64) * c[n];
+        let (cosine, sine) = (n * per, (m + n) * per);
+        for k in 0..per {
+            out[cosine + k] = n as f64 * x[sine + k];
+            out[sine + k] = -(n as f64) * x[cosine + k];
+        }
     }
-    out[0] = 0.0;
+    out
 }
 
 /// `v / |v|`, or `None` when `v` is zero or not finite.
 fn unit(mut v: Vec<f64>) -> Option<Vec<f64>> {
-    let norm = v.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let norm = norm(&v);
     if !(norm.is_finite() && norm > 0.0) {
         return None;
     }
@@ -135,25 +140,8 @@ impl PhaseLocked {
     /// `D x`: every signal of `x` (each bar's two Helmholtz components) differentiated in
     /// `theta`.
     fn shift(&self, x: &[f64]) -> Vec<f64> {
-        let (basis, layout) = (self.inner.basis(), self.inner.layout());
-        let len = basis.len();
-        let mut out = vec![0.0; x.len()];
-        let (mut signal, mut derivative) = (vec![0.0; len], vec![0.0; len]);
-        for bar in 0..self.inner.system().bars().len() {
-            for which in 0..2 {
-                let at = |i: usize| layout.index(i, bar, which);
-                signal
-                    .iter_mut()
-                    .enumerate()
-                    .for_each(|(i, s)| *s = x[at(i)]);
-                shift_of(basis, &signal, &mut derivative);
-                derivative
-                    .iter()
-                    .enumerate()
-                    .for_each(|(i, d)| out[at(i)] = *d);
-            }
-        }
-        out
+        let basis = self.inner.basis();
+        shift_of(x, basis.harmonics(), x.len() / basis.len())
     }
 
     /// The residual-space column `a_c D g` in the law rows: the `theta`-derivative of each
@@ -162,22 +150,21 @@ impl PhaseLocked {
         let omega = self.inner.parameter();
         let a_c = self.inner.complementarity();
         let basis = self.inner.basis().clone();
-        let (len, n) = (basis.len(), self.inner.dimension());
+        let (len, m, n) = (basis.len(), basis.harmonics(), self.inner.dimension());
         let rows = self.inner.rows_at(omega);
         let (unknowns, linear) = (rows[0].unknowns(), rows[0].linear_count());
         let laws = unknowns - linear;
         let mut out = vec![0.0; n];
-        let (mut gaps, mut derivative) = (vec![0.0; len], vec![0.0; len]);
         for l in 0..laws {
-            for (i, g) in gaps.iter_mut().enumerate() {
-                let row = rows[basis.harmonic(i)].gap_row(l);
-                let xi = &x[i * unknowns..(i + 1) * unknowns];
-                *g = row.iter().zip(xi).map(|(r, v)| r * v).sum();
-            }
-            shift_of(&basis, &gaps, &mut derivative);
+            let gaps: Vec<f64> = (0..len)
+                .map(|i| {
+                    let xi = &x[i * unknowns..(i + 1) * unknowns];
+                    dot(rows[basis.harmonic(i)].gap_row(l), xi)
+                })
+                .collect();
             let base = len * linear + l * len;
-            for (j, d) in derivative.iter().enumerate() {
-                out[base + j] = a_c * d;
+            for (o, d) in out[base..base + len].iter_mut().zip(shift_of(&gaps, m, 1)) {
+                *o = a_c * d;
             }
         }
         out
@@ -207,7 +194,7 @@ impl PhaseLocked {
 
     /// The phase `u . x` of a state of the inner system (0 on the locked phase).
     pub fn phase_of(&self, x: &[f64]) -> f64 {
-        self.phase.iter().zip(x).map(|(u, v)| u * v).sum()
+        dot(&self.phase, x)
     }
 }
 

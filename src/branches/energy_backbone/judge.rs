@@ -9,7 +9,7 @@ use crate::fourier::period_of_frequency;
 use crate::modal::energy::energy;
 use crate::modal::linear::{seed_from_mode, LinearMode};
 use crate::modal::signature::harmonic_energies;
-use crate::solve::{NonlinearSolver, Problem, SmoothingHomotopy, Structured};
+use crate::solve::{failed_point, NonlinearSolver, SmoothingHomotopy, Structured};
 use crate::system::NonsmoothSystem;
 use std::ops::ControlFlow;
 
@@ -230,17 +230,13 @@ impl Judge {
             let mut y = last.0.clone();
             self.problem.set_parameter(omega);
             let solved = solver.solve(&mut self.problem, &mut y);
-            // A failed solve reports where it stopped, or the last accepted motion where that
-            // is not finite (a diverged solve), with its residual: never a NaN.
+            // A diverged solve reports the last accepted motion.
             let residual_norm = match &solved {
                 Ok(info) => info.residual_norm,
                 Err(_) => {
-                    let mut r = residual_norm_at(&mut self.problem, &y);
-                    if !r.is_finite() {
-                        y.clone_from(&last.0);
-                        r = residual_norm_at(&mut self.problem, &y);
-                    }
-                    r
+                    let (at, norm) = failed_point(&mut self.problem, y, &last.0);
+                    y = at;
+                    norm
                 }
             };
             let level = self.level(&y, omega);
@@ -299,13 +295,6 @@ impl Judge {
         }
         Walk::Lost
     }
-}
-
-/// `|F(y)|_2` of `problem` at its current frequency.
-fn residual_norm_at(problem: &mut NonsmoothSystem, y: &[f64]) -> f64 {
-    let mut f = vec![0.0; y.len()];
-    problem.residual(y, &mut f);
-    f.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
 /// How a walk across an internal resonance ended.
