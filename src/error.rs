@@ -719,6 +719,63 @@ pub enum StabilityError {
     },
 }
 
+/// Errors in the damping and excitation of a forced response ([`crate::forced`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ForcingError {
+    /// A forced response needs an excitation: without one its only motion is rest.
+    #[error(
+        "a forced response needs at least one excitation (a force at an end or a base motion)"
+    )]
+    NoExcitation,
+    /// The damping vector does not have one value per bar.
+    #[error("damping has {got} values, expected one per bar ({expected})")]
+    DampingLength {
+        /// Values given.
+        got: usize,
+        /// Bars of the system.
+        expected: usize,
+    },
+    /// A damping coefficient is negative or not finite.
+    #[error("the damping of bar {bar} must be finite and non-negative, got {value}")]
+    Damping {
+        /// Index of the bar (from 0).
+        bar: usize,
+        /// The rejected value.
+        value: f64,
+    },
+    /// An excitation amplitude is not finite.
+    #[error("the excitation amplitude at {end} must be finite, got {value}")]
+    Amplitude {
+        /// The excited end.
+        end: String,
+        /// The rejected value.
+        value: f64,
+    },
+    /// The end is not held by a linear condition of its own (it is free of conditions, held
+    /// by a unilateral law or shared with another end), so no row carries the excitation.
+    #[error("no linear condition holds {end} alone: {reason}")]
+    NoConditionRow {
+        /// The excited end.
+        end: String,
+        /// What holds it instead.
+        reason: String,
+    },
+    /// The condition at the end cannot feel this excitation: a force at a clamped end, or a
+    /// base motion at an end tied to no ground.
+    #[error("{what} at {end} acts on nothing: its condition `{condition}` has no {missing} term")]
+    NothingToExcite {
+        /// `a force` or `a base motion`.
+        what: &'static str,
+        /// The excited end.
+        end: String,
+        /// The condition there.
+        condition: String,
+        /// The term the excitation needs (`strain` or `displacement`).
+        missing: &'static str,
+    },
+}
+
 /// Any error of the crate.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
@@ -741,6 +798,9 @@ pub enum Error {
     /// See [`StabilityError`].
     #[error(transparent)]
     Stability(#[from] StabilityError),
+    /// See [`ForcingError`].
+    #[error(transparent)]
+    Forcing(#[from] ForcingError),
 }
 
 /// A request whose buffers would exceed the memory budget

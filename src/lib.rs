@@ -78,6 +78,7 @@ mod check;
 pub mod continuation;
 mod end;
 pub mod error;
+pub mod forced;
 pub mod fourier;
 pub mod io;
 pub mod linalg;
@@ -98,5 +99,7 @@ pub mod system;
 /// impacts resolved inside the step) and the periodicity check of computed modes.
 pub mod verify;
 
-pub use error::{ContinuationError, Error, ModelError, SettingsError, SolveError, StabilityError};
+pub use error::{
+    ContinuationError, Error, ForcingError, ModelError, SettingsError, SolveError, StabilityError,
+};
 pub use solution::Solution;

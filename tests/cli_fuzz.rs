@@ -1,6 +1,6 @@
-//! Command-line fuzz of the `backbone` example: random command lines, each run as a child
-//! process, must exit with 0 (success), 1 (run failure) or 2 (usage error), never panic, never
-//! die on a signal, explain every failure on stderr and end within [`TIMEOUT`].
+//! Command-line fuzz of the `backbone` and `frf` examples: random command lines, each run as a
+//! child process, must exit with 0 (success), 1 (run failure) or 2 (usage error), never panic,
+//! never die on a signal, explain every failure on stderr and end within [`TIMEOUT`].
 //!
 //! The tests run the example binary that cargo built next to this test
 //! (`<target>/<profile>/examples/backbone`): `cargo test --release` builds it before running
@@ -89,14 +89,18 @@ enum Value {
     File,
 }
 
-/// Every flag of the example with its cheap valid values.
-const FLAGS: &[(&str, Value)] = &[
+/// The system flags both examples share, with their cheap valid values.
+const SYSTEM_FLAGS: &[(&str, Value)] = &[
     ("system", Value::Word(&["ds", "rs", "two-bar"])),
     ("gap", Value::Real(5e-4, 2e-3)),
     ("robin-stiffness", Value::Real(0.2, 2.0)),
     ("length2", Value::Real(0.8, 1.2)),
     ("speed2", Value::Real(0.8, 1.2)),
     ("stiffness-ratio", Value::Real(0.5, 2.0)),
+];
+
+/// Every other flag of the `backbone` example with its cheap valid values.
+const FLAGS: &[(&str, Value)] = &[
     ("harmonics", Value::Count(1, 30)),
     ("samples-per-harmonic", Value::Count(2, 48)),
     ("complementarity", Value::Real(0.5, 10.0)),
@@ -128,6 +132,39 @@ const FLAGS: &[(&str, Value)] = &[
     ("verify", Value::Switch),
     ("stability", Value::Switch),
     ("basis", Value::Word(&["cosine", "full"])),
+];
+
+/// Every other flag of the `frf` example with its cheap valid values (`--steps` and
+/// `--harmonics` are appended to every line: [`frf_tail`]).
+const FRF_FLAGS: &[(&str, Value)] = &[
+    ("samples-per-harmonic", Value::Count(2, 48)),
+    ("complementarity", Value::Real(0.5, 10.0)),
+    ("resonance-band", Value::Real(0.01, 0.5)),
+    ("forcing", Value::Word(FORCINGS)),
+    ("damping", Value::Real(1e-4, 0.1)),
+    ("omega-range", Value::Range(0.3, 3.0)),
+    ("steps", Value::Count(2, 40)),
+    ("method", Value::Word(&["sequential", "arclength"])),
+    ("solver", Value::Word(&["newton", "dogleg"])),
+    ("out", Value::File),
+];
+
+/// `--forcing` values: valid ones on the shorthands' ends, and malformed or impossible ones
+/// (a force at a clamped end, a base motion at the contact end, unknown bars and sides).
+const FORCINGS: &[&str] = &[
+    "base:1.start:1e-6",
+    "base:1.start:3e-6",
+    "end:1.start:1e-6",
+    "base:2.end:1e-6",
+    "base:1.end:1e-6",
+    "end:1.end:1e-6",
+    "base:3.start:1e-6",
+    "base:1.middle:1e-6",
+    "shake:1.start:1e-6",
+    "base:1.start:nan",
+    "base:1.start:inf",
+    "base:1.start",
+    "base:1.start:0",
 ];
 
 /// Edge values tried for any flag that takes a value.
@@ -182,15 +219,21 @@ const UNKNOWN: &[&str] = &[
     "--help",
 ];
 
-/// One random command line (without the program). `dir` is where output files may go.
-fn command_line(rng: &mut Rng, dir: &Path, index: usize) -> Vec<String> {
+/// One random command line (without the program) of flags from `flags`. `dir` is where output
+/// files may go.
+fn command_line(
+    rng: &mut Rng,
+    (dir, index): (&Path, usize),
+    tables: &[&[(&'static str, Value)]],
+) -> Vec<String> {
+    let flags: Vec<(&str, Value)> = tables.iter().flat_map(|t| t.iter().copied()).collect();
     let mut args = Vec::new();
     for _ in 0..rng.below(7) {
         if rng.chance(0.04) {
             args.push(rng.pick(UNKNOWN).to_string());
             continue;
         }
-        let (name, value) = FLAGS[rng.below(FLAGS.len())];
+        let (name, value) = flags[rng.below(flags.len())];
         // `--name=value` is the same flag to the parser.
         let joined = rng.chance(0.1);
         let value = match value {
@@ -208,17 +251,9 @@ fn command_line(rng: &mut Rng, dir: &Path, index: usize) -> Vec<String> {
             args.push(value);
         }
     }
-    if args.iter().any(|a| a == "--verify" || a == "--stability") {
-        // Verification and stability march every point in time: few points keep the line
-        // cheap (later flags override earlier ones).
-        for flag in ["--steps", "--max-steps"] {
-            args.push(flag.to_string());
-            args.push(rng.between(2, 8).to_string());
-        }
-    }
     if rng.chance(0.05) {
         // A flag missing its value.
-        let valued: Vec<&str> = FLAGS
+        let valued: Vec<&str> = flags
             .iter()
             .filter(|(_, v)| !matches!(v, Value::Switch))
             .map(|(name, _)| *name)
@@ -227,6 +262,62 @@ fn command_line(rng: &mut Rng, dir: &Path, index: usize) -> Vec<String> {
     }
     args
 }
+
+/// What the `backbone` lines always end with: few points when they verify or compute
+/// multipliers, which march every point in time (later flags override earlier ones).
+fn backbone_tail(rng: &mut Rng, args: &mut Vec<String>) {
+    if args.iter().any(|a| a == "--verify" || a == "--stability") {
+        for flag in ["--steps", "--max-steps"] {
+            args.push(flag.to_string());
+            args.push(rng.between(2, 8).to_string());
+        }
+    }
+}
+
+/// What the `frf` lines always hold: mostly a forcing (the example requires one), and few
+/// harmonics and steps (its default steps follow the damping, up to many thousands).
+fn frf_tail(rng: &mut Rng, args: &mut Vec<String>) {
+    if rng.chance(0.85) {
+        // Mostly one that every shorthand takes.
+        let forcing = if rng.chance(0.7) {
+            rng.pick(&FORCINGS[..2])
+        } else {
+            rng.pick(FORCINGS)
+        };
+        args.insert(0, "--forcing".to_string());
+        args.insert(1, forcing.to_string());
+    }
+    for (flag, hi) in [("--steps", 40), ("--harmonics", 10)] {
+        args.push(flag.to_string());
+        args.push(rng.between(1, hi).to_string());
+    }
+}
+
+/// An example under fuzz: its name, its sources, its flags and what every line ends with.
+struct Cli {
+    example: &'static str,
+    source: &'static str,
+    flags: &'static [&'static [(&'static str, Value)]],
+    tail: fn(&mut Rng, &mut Vec<String>),
+    /// Exit codes that must each occur at least once.
+    codes: &'static [i32],
+}
+
+const BACKBONE: Cli = Cli {
+    example: "backbone",
+    source: "examples/backbone",
+    flags: &[SYSTEM_FLAGS, FLAGS],
+    tail: backbone_tail,
+    codes: &[0, 1, 2],
+};
+
+const FRF: Cli = Cli {
+    example: "frf",
+    source: "examples/frf.rs",
+    flags: &[SYSTEM_FLAGS, FRF_FLAGS],
+    tail: frf_tail,
+    codes: &[0, 2],
+};
 
 /// An edge value for a flag taking `value`.
 fn edge(rng: &mut Rng, value: Value) -> &'static str {
@@ -279,7 +370,7 @@ fn run_line(binary: &Path, args: &[String], dir: &Path, stderr_path: &Path) -> O
         .stdout(Stdio::null())
         .stderr(stderr_file)
         .spawn()
-        .expect("spawn the backbone example");
+        .expect("spawn the example");
     let start = Instant::now();
     let status = loop {
         if let Some(status) = child.try_wait().expect("wait for the child") {
@@ -409,12 +500,6 @@ fn newest(path: &Path) -> SystemTime {
     children.fold(own, SystemTime::max)
 }
 
-/// The `backbone` binary of this test's profile; fails the test if it is missing or older
-/// than its sources.
-fn backbone_binary() -> PathBuf {
-    example_binary("backbone", "examples/backbone")
-}
-
 /// The binary of example `name` of this test's profile; fails the test if it is missing or
 /// older than `source` (a file or folder), `src` or `Cargo.toml`.
 fn example_binary(name: &str, source: &str) -> PathBuf {
@@ -476,15 +561,16 @@ fn from_env<T: std::str::FromStr>(name: &str, default: T) -> T {
 /// Runs `lines` random lines from `seed` and fails on any panic, signal, unknown exit code,
 /// unexplained failure or hang; also fails if any of the exit codes 0, 1 and 2 never occurs
 /// (the lines would not be exercising the example).
-fn fuzz(name: &str, lines: usize, seed: u64) {
-    let binary = backbone_binary();
+fn fuzz(cli: &Cli, name: &str, lines: usize, seed: u64) {
+    let binary = example_binary(cli.example, cli.source);
     let dir = TempDir::new(name);
     let stderr_path = dir.0.join("stderr.txt");
     let mut rng = Rng(seed);
     let mut report = Report::default();
     let mut slowest = (Duration::ZERO, String::new());
     for index in 0..lines {
-        let args = command_line(&mut rng, &dir.0, index);
+        let mut args = command_line(&mut rng, (&dir.0, index), cli.flags);
+        (cli.tail)(&mut rng, &mut args);
         let start = Instant::now();
         let outcome = run_line(&binary, &args, &dir.0, &stderr_path);
         let line = shell_line(&binary, &args);
@@ -493,7 +579,7 @@ fn fuzz(name: &str, lines: usize, seed: u64) {
         }
         report.record(&line, &outcome);
     }
-    println!("{} (seed {seed})", report.summary());
+    println!("{}: {} (seed {seed})", cli.example, report.summary());
     println!(
         "slowest line, {:.1} s: {}",
         slowest.0.as_secs_f64(),
@@ -507,7 +593,7 @@ fn fuzz(name: &str, lines: usize, seed: u64) {
         "{} of {lines} lines failed (listed above)",
         report.failures.len()
     );
-    for code in 0..=2 {
+    for &code in cli.codes {
         assert!(
             report.count(code) > 0,
             "no line exited with {code}: {}",
@@ -518,14 +604,41 @@ fn fuzz(name: &str, lines: usize, seed: u64) {
 
 #[test]
 fn fuzz_short() {
-    fuzz("short", SHORT_LINES, from_env("CLI_FUZZ_SEED", 0x5eed));
+    fuzz(
+        &BACKBONE,
+        "short",
+        SHORT_LINES,
+        from_env("CLI_FUZZ_SEED", 0x5eed),
+    );
 }
 
 #[test]
 #[ignore = "long: 1,000 lines by default (CLI_FUZZ_LINES)"]
 fn fuzz_long() {
     fuzz(
+        &BACKBONE,
         "long",
+        from_env("CLI_FUZZ_LINES", LONG_LINES),
+        from_env("CLI_FUZZ_SEED", 0x1000_5eed),
+    );
+}
+
+#[test]
+fn fuzz_frf_short() {
+    fuzz(
+        &FRF,
+        "frf-short",
+        SHORT_LINES,
+        from_env("CLI_FUZZ_SEED", 0x5eed),
+    );
+}
+
+#[test]
+#[ignore = "long: 1,000 lines by default (CLI_FUZZ_LINES)"]
+fn fuzz_frf_long() {
+    fuzz(
+        &FRF,
+        "frf-long",
         from_env("CLI_FUZZ_LINES", LONG_LINES),
         from_env("CLI_FUZZ_SEED", 0x1000_5eed),
     );

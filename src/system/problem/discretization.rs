@@ -96,23 +96,7 @@ impl<B: Basis> Discretization<B> {
             return Err(SettingsError::NoContact.into());
         }
         let unknowns = system.unknowns_per_harmonic();
-        let offsets: Vec<(f64, f64)> = system
-            .laws()
-            .map(|l| (l.gap().offset, l.force().offset))
-            .collect();
-        // Motions that reach a gap beyond `MAX_OFFSET` have energies beyond `f64`.
-        if let Some(&v) = (offsets.iter())
-            .flat_map(|(g, f)| [g, f])
-            .find(|v| v.abs() > MAX_OFFSET)
-        {
-            return Err(SettingsError::OutOfRange {
-                what: "gap or force offset of a unilateral law",
-                value: v,
-                min: -MAX_OFFSET,
-                max: MAX_OFFSET,
-            }
-            .into());
-        }
+        let offsets = law_offsets(system)?;
         let len = basis.len();
         check_memory(
             "harmonic-balance problem",
@@ -398,6 +382,30 @@ impl<B: Basis> Discretization<B> {
             }
         }
         w
+    }
+}
+
+/// The offsets `(gap, force)` of every law's observables.
+///
+/// # Errors
+/// [`SettingsError::OutOfRange`] for one beyond [`MAX_OFFSET`] in magnitude: motions that
+/// reach such a gap have energies beyond `f64`.
+pub(crate) fn law_offsets(system: &BarSystem) -> Result<Vec<(f64, f64)>, SettingsError> {
+    let offsets: Vec<(f64, f64)> = system
+        .laws()
+        .map(|l| (l.gap().offset, l.force().offset))
+        .collect();
+    let beyond = (offsets.iter())
+        .flat_map(|&(g, f)| [g, f])
+        .find(|v| v.abs() > MAX_OFFSET);
+    match beyond {
+        Some(v) => Err(SettingsError::OutOfRange {
+            what: "gap or force offset of a unilateral law",
+            value: v,
+            min: -MAX_OFFSET,
+            max: MAX_OFFSET,
+        }),
+        None => Ok(offsets),
     }
 }
 

@@ -28,11 +28,12 @@
 
 mod band;
 mod discretization;
-mod selection;
+pub(crate) mod selection;
 mod staircase;
 mod state;
 mod step;
 
+pub(crate) use discretization::law_offsets;
 pub use discretization::{Discretization, COMPLEMENTARITY_RANGE, MAX_OFFSET, MAX_PHASE};
 
 use crate::continuation::ContinuationProblem;
@@ -202,7 +203,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         self.selection = Selection::new(width);
         let omega = self.ws.frequency.omega;
         if let Some(s) = &mut self.selection {
-            s.select(&self.description, omega);
+            s.select((self.description.system(), self.description.basis()), omega);
         }
         self.ws.samples.invalidate();
         Ok(())
@@ -219,7 +220,7 @@ impl<B: Basis> NonsmoothSystem<B> {
     pub fn dropped_harmonics(&self) -> Vec<usize> {
         self.selection
             .as_ref()
-            .map_or_else(Vec::new, |s| s.dropped_harmonics(&self.description))
+            .map_or_else(Vec::new, |s| s.dropped_harmonics(self.description.basis()))
     }
 
     /// The selection when it drops a harmonic at the current frequency.
@@ -231,7 +232,7 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// some.
     fn at_selected<R>(&mut self, x: &[f64], eval: impl FnOnce(&mut Self, &[f64]) -> R) -> R {
         let masked = match self.selection.as_mut().filter(|s| s.active()) {
-            Some(s) => s.mask(&self.description, x),
+            Some(s) => s.mask((&self.description).into(), x),
             None => return eval(self, x),
         };
         let out = eval(self, &masked);
@@ -302,7 +303,7 @@ impl<B: Basis> NonsmoothSystem<B> {
         if self.ws.frequency.prepare(&self.description, omega) {
             self.ws.samples.invalidate();
             if let Some(s) = &mut self.selection {
-                s.select(&self.description, omega);
+                s.select((self.description.system(), self.description.basis()), omega);
             }
         }
     }
@@ -361,14 +362,14 @@ impl<B: Basis> Problem for NonsmoothSystem<B> {
     fn residual(&mut self, x: &[f64], f: &mut [f64]) {
         self.at_selected(x, |p, y| p.full_residual(y, f));
         if let Some(s) = self.active_selection() {
-            s.residual(&self.description, x, f);
+            s.residual((&self.description).into(), x, f);
         }
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut DenseMatrix) {
         self.at_selected(x, |p, y| p.full_jacobian(y, jac));
         if let Some(s) = self.active_selection() {
-            s.jacobian(&self.description, jac);
+            s.jacobian((&self.description).into(), jac);
         }
     }
 
@@ -446,7 +447,7 @@ impl<B: Basis> ContinuationProblem for NonsmoothSystem<B> {
             p.ws.samples.law_derivative((d, rows), y, df);
         });
         if let Some(s) = self.active_selection() {
-            s.parameter_derivative(&self.description, df);
+            s.parameter_derivative((&self.description).into(), df);
         }
     }
 }

@@ -29,13 +29,42 @@ use crate::fourier::Basis;
 use crate::linalg::DenseMatrix;
 use crate::modal::linear::{natural_frequency_values, Resolution};
 use crate::modal::ContactState;
+use crate::system::BarSystem;
+
+/// The layout of a harmonic-balance problem that a selection edits: unknowns per
+/// coefficient, linear rows per coefficient, basis coefficients and laws (the equations are
+/// every coefficient's linear rows, then each law's projections).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Shape {
+    pub(crate) per: usize,
+    pub(crate) linear: usize,
+    pub(crate) len: usize,
+    pub(crate) laws: usize,
+}
+
+impl Shape {
+    fn dimension(self) -> usize {
+        self.len * self.per
+    }
+}
+
+impl<B: Basis> From<&Discretization<B>> for Shape {
+    fn from(d: &Discretization<B>) -> Self {
+        Self {
+            per: d.unknowns,
+            linear: d.linear_count,
+            len: d.basis().len(),
+            laws: d.laws,
+        }
+    }
+}
 
 /// The selection state of a problem: the band, the natural frequencies it is measured from,
 /// and the coefficients dropped at the current frequency.
 #[derive(Debug, Clone)]
-pub(super) struct Selection {
+pub(crate) struct Selection {
     /// The width `c` of the relative band `c / m`.
-    pub(super) width: f64,
+    pub(crate) width: f64,
     /// Open- and closed-contact natural frequencies up to `covered`, ascending.
     natural: Vec<f64>,
     covered: f64,
@@ -47,7 +76,7 @@ pub(super) struct Selection {
 
 impl Selection {
     /// The selection of band `width / m` (`None` for a zero width: no selection).
-    pub(super) fn new(width: f64) -> Option<Self> {
+    pub(crate) fn new(width: f64) -> Option<Self> {
         (width > 0.0).then(|| Self {
             width,
             natural: Vec::new(),
@@ -58,26 +87,22 @@ impl Selection {
     }
 
     /// Whether a harmonic is dropped at the current frequency.
-    pub(super) fn active(&self) -> bool {
+    pub(crate) fn active(&self) -> bool {
         !self.dropped.is_empty()
     }
 
     /// The harmonics dropped at the current frequency, ascending.
-    pub(super) fn dropped_harmonics<B: Basis>(&self, d: &Discretization<B>) -> Vec<usize> {
-        self.dropped
-            .iter()
-            .map(|&i| d.basis().harmonic(i))
-            .collect()
+    pub(crate) fn dropped_harmonics<B: Basis>(&self, basis: &B) -> Vec<usize> {
+        self.dropped.iter().map(|&i| basis.harmonic(i)).collect()
     }
 
     /// Recomputes the dropped coefficients at `omega`, extending the natural frequencies when
     /// `omega` needs higher ones.
-    pub(super) fn select<B: Basis>(&mut self, d: &Discretization<B>, omega: f64) {
+    pub(crate) fn select<B: Basis>(&mut self, (system, basis): (&BarSystem, &B), omega: f64) {
         self.dropped.clear();
         if !(omega.is_finite() && omega > 0.0) {
             return;
         }
-        let basis = d.basis();
         let band = self.width / basis.harmonics().max(1) as f64;
         let needed = (basis.harmonics() as f64 + 1.0) * omega * (1.0 + band);
         if needed > self.covered {
@@ -85,8 +110,7 @@ impl Selection {
             let mut natural = Vec::new();
             for state in [ContactState::Open, ContactState::Closed] {
                 // A scan that cannot run leaves this state out: fewer harmonics dropped.
-                if let Ok(values) =
-                    natural_frequency_values(d.system(), state, bound, Resolution::FULL)
+                if let Ok(values) = natural_frequency_values(system, state, bound, Resolution::FULL)
                 {
                     natural.extend(values.into_iter().filter(|w| *w > 0.0));
                 }
@@ -109,11 +133,11 @@ impl Selection {
 
     /// `x` with the dropped unknowns set to zero (the scratch is handed out; give it back with
     /// [`Selection::restore`]).
-    pub(super) fn mask<B: Basis>(&mut self, d: &Discretization<B>, x: &[f64]) -> Vec<f64> {
+    pub(crate) fn mask(&mut self, shape: Shape, x: &[f64]) -> Vec<f64> {
         let mut masked = std::mem::take(&mut self.masked);
         masked.clear();
         masked.extend_from_slice(x);
-        let per = d.unknowns;
+        let per = shape.per;
         for &i in &self.dropped {
             masked[i * per..(i + 1) * per].fill(0.0);
         }
@@ -121,14 +145,19 @@ impl Selection {
     }
 
     /// Takes back the scratch of [`Selection::mask`].
-    pub(super) fn restore(&mut self, masked: Vec<f64>) {
+    pub(crate) fn restore(&mut self, masked: Vec<f64>) {
         self.masked = masked;
     }
 
     /// The pairs (equation row, unknown) of coefficient `i`: its linear rows, then its
     /// projection of each law, in the order of the problem's residual.
-    fn rows<B: Basis>(d: &Discretization<B>, i: usize) -> impl Iterator<Item = (usize, usize)> {
-        let (per, linear, len, laws) = (d.unknowns, d.linear_count, d.basis().len(), d.laws);
+    fn rows(shape: Shape, i: usize) -> impl Iterator<Item = (usize, usize)> {
+        let Shape {
+            per,
+            linear,
+            len,
+            laws,
+        } = shape;
         let base = len * linear;
         (0..linear)
             .map(move |r| (i * linear + r, i * per + r))
@@ -136,9 +165,9 @@ impl Selection {
     }
 
     /// Replaces the equations of the dropped coefficients by `x_i = 0` in the residual `f`.
-    pub(super) fn residual<B: Basis>(&self, d: &Discretization<B>, x: &[f64], f: &mut [f64]) {
+    pub(crate) fn residual(&self, shape: Shape, x: &[f64], f: &mut [f64]) {
         for &i in &self.dropped {
-            for (r, u) in Self::rows(d, i) {
+            for (r, u) in Self::rows(shape, i) {
                 f[r] = x[u];
             }
         }
@@ -146,16 +175,16 @@ impl Selection {
 
     /// The Jacobian of [`Selection::residual`] from the full one at the masked point: the
     /// dropped unknowns' columns are zero, their equations' rows those of the identity.
-    pub(super) fn jacobian<B: Basis>(&self, d: &Discretization<B>, jac: &mut DenseMatrix) {
-        let n = d.dimension();
-        let per = d.unknowns;
+    pub(crate) fn jacobian(&self, shape: Shape, jac: &mut DenseMatrix) {
+        let n = shape.dimension();
+        let per = shape.per;
         for &i in &self.dropped {
             for c in i * per..(i + 1) * per {
                 for r in 0..n {
                     jac[(r, c)] = 0.0;
                 }
             }
-            for (r, u) in Self::rows(d, i) {
+            for (r, u) in Self::rows(shape, i) {
                 for c in 0..n {
                     jac[(r, c)] = 0.0;
                 }
@@ -166,9 +195,9 @@ impl Selection {
 
     /// Zeroes the frequency derivative of the dropped coefficients' equations (`x_i = 0` does
     /// not depend on `Omega`).
-    pub(super) fn parameter_derivative<B: Basis>(&self, d: &Discretization<B>, df: &mut [f64]) {
+    pub(crate) fn parameter_derivative(&self, shape: Shape, df: &mut [f64]) {
         for &i in &self.dropped {
-            for (r, _) in Self::rows(d, i) {
+            for (r, _) in Self::rows(shape, i) {
                 df[r] = 0.0;
             }
         }

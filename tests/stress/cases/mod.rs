@@ -3,6 +3,7 @@
 
 mod backbones;
 mod drivers;
+mod forced;
 mod full_basis;
 mod model;
 mod post;
@@ -35,10 +36,11 @@ pub(crate) enum Kind {
     PostProcessing,
     Request,
     FullBasis,
+    Forced,
 }
 
 /// Every kind, drawn uniformly by each case.
-pub(crate) const KINDS: [Kind; 11] = [
+pub(crate) const KINDS: [Kind; 12] = [
     Kind::Assembly,
     Kind::Settings,
     Kind::Solver,
@@ -50,6 +52,7 @@ pub(crate) const KINDS: [Kind; 11] = [
     Kind::PostProcessing,
     Kind::Request,
     Kind::FullBasis,
+    Kind::Forced,
 ];
 
 impl Kind {
@@ -66,6 +69,7 @@ impl Kind {
             Kind::PostProcessing => post::post_processing(d, c),
             Kind::Request => backbones::request_case(d, c),
             Kind::FullBasis => full_basis::full_basis_case(d, c),
+            Kind::Forced => forced::forced_case(d, c),
         }
     }
 }

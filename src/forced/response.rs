@@ -1,0 +1,316 @@
+//! Frequency-response curves: continuation of a [`ForcedSystem`] in the forcing frequency,
+//! natural-parameter or pseudo-arclength (through folds), from the open-contact linear
+//! response at the first frequency.
+
+use crate::branches::{PointStatus, MAX_CONSECUTIVE_FAILURES};
+use crate::continuation::{
+    linspace, Arclength, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem, EndReason,
+    Point, Predictor, Sequential, SequentialOptions, Step,
+};
+use crate::error::{ContinuationError, Error, SettingsError};
+use crate::forced::{ForcedSystem, Forcing};
+use crate::modal::grazing_energy;
+use crate::solve::{norm, Solver};
+use crate::system::{BarSystem, HarmonicBalanceSettings};
+use std::ops::ControlFlow;
+
+/// How a response curve is followed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub enum ResponseMethod {
+    /// Natural-parameter continuation over an even grid of frequencies (default); it cannot
+    /// pass a fold, where the curve turns back in frequency.
+    #[default]
+    Sequential,
+    /// Pseudo-arclength continuation in `(x, Omega)`, through folds.
+    Arclength,
+}
+
+/// What response curve to compute.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResponseRequest {
+    /// Harmonic-balance settings (harmonics, samples, `a_c`; the kink blend and the harmonic
+    /// selection do not apply).
+    pub settings: HarmonicBalanceSettings,
+    /// Damping and excitations.
+    pub forcing: Forcing,
+    /// Forcing frequencies `(lo, hi)`, `0 < lo < hi`: the curve starts at `lo`.
+    pub omega_range: (f64, f64),
+    /// Grid steps (sequential), or the number of steps the arclength is sized for: it takes
+    /// steps of about `4 / steps` of the curve's scaled length, at most `4 steps` of them.
+    pub steps: usize,
+    /// Sequential or arclength.
+    pub method: ResponseMethod,
+    /// The corrector (semismooth Newton by default).
+    pub solver: Solver,
+}
+
+/// One point of a response curve.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ResponsePoint {
+    /// Step number.
+    pub step: usize,
+    /// Forcing frequency `Omega`.
+    pub omega: f64,
+    /// Largest closure of the first law's gap over the period divided by its gap at rest
+    /// ([`ForcedSystem::amplitude`]).
+    pub amplitude: f64,
+    /// Mechanical energy averaged over the period ([`ForcedSystem::average_energy`]).
+    pub energy: f64,
+    /// `energy / E_g`, `E_g` the first grazing energy of the undamped system.
+    pub energy_normalized: f64,
+    /// `status == PointStatus::Converged`.
+    pub converged: bool,
+    /// Converged, solver failed, or a non-finite energy.
+    pub status: PointStatus,
+    /// How far the motion is from the contact laws between the samples
+    /// ([`ForcedSystem::contact_defect`]).
+    pub contact_defect: f64,
+    /// The harmonics the harmonic selection held at zero at this frequency
+    /// ([`HarmonicBalanceSettings::resonance_band`]; empty without it).
+    pub dropped_harmonics: Vec<usize>,
+    /// `|F|_2`.
+    pub residual_norm: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// The unknowns (layout of [`ForcedSystem`]).
+    pub x: Vec<f64>,
+}
+
+/// A computed response curve.
+#[derive(Debug, Clone)]
+pub struct ForcedResponse {
+    problem: ForcedSystem,
+    /// The grazing energy `E_g` the energies are normalised by.
+    pub grazing_energy: f64,
+    /// Every point computed, in order (the failed steps of a sequential run included).
+    pub points: Vec<ResponsePoint>,
+    /// Rejected corrector steps of an arclength run.
+    pub rejected_steps: usize,
+    /// Why the run ended.
+    pub end: EndReason,
+}
+
+impl ForcedResponse {
+    /// The problem the points solve (at the frequency of the last point measured).
+    pub fn problem(&self) -> &ForcedSystem {
+        &self.problem
+    }
+
+    /// The converged points.
+    pub fn converged(&self) -> impl Iterator<Item = &ResponsePoint> {
+        self.points.iter().filter(|p| p.converged)
+    }
+
+    /// The converged point of largest energy (the resonance peak), if any.
+    pub fn peak(&self) -> Option<&ResponsePoint> {
+        self.converged()
+            .max_by(|a, b| a.energy.total_cmp(&b.energy))
+    }
+}
+
+/// The frequency-response curve `request` asks for: the response of `system` under the
+/// request's forcing, continued in the forcing frequency over its range.
+///
+/// The start is the open-contact linear response at `lo`
+/// ([`ForcedSystem::open_response`]) solved with the laws. The arclength norm is scaled by
+/// the range in `Omega` and, in the state, by the largest open-contact response over the
+/// range, cut to the size that just closes the first gap: both come from the system.
+///
+/// # Errors
+/// [`SettingsError`] and [`ForcingError`](crate::ForcingError) as [`ForcedSystem::new`];
+/// [`SettingsError::NotPositive`] / [`SettingsError::OutOfRange`] for a bad range;
+/// [`ContinuationError`] for zero steps or a start that does not converge. A run that stops
+/// part-way returns its points and its [`EndReason`].
+pub fn forced_response(
+    system: &BarSystem,
+    request: &ResponseRequest,
+) -> Result<ForcedResponse, Error> {
+    let (lo, hi) = request.omega_range;
+    if !(lo.is_finite() && lo > 0.0) {
+        return Err(SettingsError::NotPositive {
+            what: "lowest forcing frequency",
+            value: lo,
+        }
+        .into());
+    }
+    if !(hi.is_finite() && hi > lo) {
+        return Err(SettingsError::OutOfRange {
+            what: "highest forcing frequency",
+            value: hi,
+            min: lo,
+            max: f64::MAX,
+        }
+        .into());
+    }
+    if request.steps == 0 {
+        return Err(ContinuationError::InvalidOption {
+            what: "steps",
+            value: 0.0,
+        }
+        .into());
+    }
+    let mut problem = ForcedSystem::new(system, request.settings, &request.forcing)?;
+    let (e_g, _) = grazing_energy(system)?;
+    let solver = request.solver;
+    problem.set_parameter(lo);
+    let start = problem.open_response()?;
+    let mut steps: Vec<Step> = Vec::new();
+    let branch = follow(&mut problem, (&solver, request), start, &mut |s: &Step| {
+        steps.push(s.clone());
+        ControlFlow::Continue(())
+    })?;
+    let points = (steps.iter().filter_map(Step::point).enumerate())
+        .map(|(step, p)| measured(&mut problem, step, p, e_g))
+        .collect();
+    Ok(ForcedResponse {
+        problem,
+        grazing_energy: e_g,
+        points,
+        rejected_steps: branch.rejections,
+        end: branch.end,
+    })
+}
+
+/// Follows the curve from `start` at the lowest frequency to the highest, by the request's
+/// method; `observer` sees every step.
+fn follow(
+    problem: &mut ForcedSystem,
+    (solver, request): (&Solver, &ResponseRequest),
+    start: Vec<f64>,
+    observer: &mut impl FnMut(&Step) -> ControlFlow<()>,
+) -> Result<Branch, Error> {
+    let (lo, hi) = request.omega_range;
+    let steps = request.steps;
+    match request.method {
+        ResponseMethod::Sequential => {
+            sweep(problem, solver, start, &linspace(lo, hi, steps)?, observer)
+        }
+        ResponseMethod::Arclength => {
+            let scale = state_scale(problem, (lo, hi), steps)?;
+            let ds_max = 4.0 / steps as f64;
+            let options = ArclengthOptions {
+                ds: 0.5 * ds_max,
+                ds_min: 1e-4 * ds_max,
+                ds_max,
+                max_steps: steps.saturating_mul(4),
+                parameter_range: (lo, hi),
+                scale: ArclengthScale::Fixed(scale, hi - lo),
+                branch_points: false,
+                ..Default::default()
+            };
+            problem.set_parameter(lo);
+            let mut driver = Arclength::new(problem, solver, start, lo, options)?;
+            Ok(driver.run(observer))
+        }
+    }
+}
+
+/// Natural-parameter continuation over `values`, as a frequency sweep of an experiment: where
+/// the branch followed ends (a resonant branch past its peak, a fold),
+/// [`MAX_CONSECUTIVE_FAILURES`] steps fail in a row (as a period grid stalls), and the sweep drops to the open-contact response at the next value
+/// and goes on from there. The branch's end reason is the last run's; its points and
+/// rejections are every run's.
+fn sweep(
+    problem: &mut ForcedSystem,
+    solver: &Solver,
+    start: Vec<f64>,
+    values: &[f64],
+    observer: &mut impl FnMut(&Step) -> ControlFlow<()>,
+) -> Result<Branch, Error> {
+    let options = SequentialOptions {
+        predictor: Predictor::Secant,
+        max_consecutive_failures: MAX_CONSECUTIVE_FAILURES,
+        ..Default::default()
+    };
+    let mut all = Branch {
+        points: Vec::new(),
+        rejections: 0,
+        end: EndReason::Completed,
+    };
+    let (mut start, mut at) = (start, 0);
+    loop {
+        let mut seen = 0;
+        let mut driver =
+            Sequential::new(&mut *problem, solver, start, values[at..].to_vec(), options)?;
+        let branch = driver.run(&mut |s: &Step| {
+            if let Step::Accepted(_) | Step::Rejected(_) = s {
+                seen += 1;
+            }
+            observer(s)
+        });
+        all.points.extend(branch.points);
+        all.rejections += branch.rejections;
+        all.end = branch.end;
+        at += seen;
+        if !matches!(all.end, EndReason::Stalled { .. }) || at >= values.len() {
+            return Ok(all);
+        }
+        problem.set_parameter(values[at]);
+        start = problem.open_response()?;
+    }
+}
+
+/// The state scale of the arclength norm: the largest open-contact response over a grid of
+/// the range, divided by its amplitude at the first contact when that exceeds 1 (contact
+/// caps the response near the gap).
+fn state_scale(
+    problem: &mut ForcedSystem,
+    (lo, hi): (f64, f64),
+    steps: usize,
+) -> Result<f64, Error> {
+    let mut largest: (f64, f64) = (0.0, 0.0);
+    for omega in linspace(lo, hi, steps.clamp(2, 64))? {
+        problem.set_parameter(omega);
+        // A frequency where the open system is singular (no damping, a natural frequency)
+        // is skipped: its neighbours size the scale.
+        if let Ok(x) = problem.open_response() {
+            let size = norm(&x);
+            if size.is_finite() && size > largest.0 {
+                largest = (size, problem.amplitude(&x));
+            }
+        }
+    }
+    let (size, amplitude) = largest;
+    let scale = if amplitude > 1.0 {
+        size / amplitude
+    } else {
+        size
+    };
+    if scale.is_finite() && scale > 0.0 {
+        Ok(scale)
+    } else {
+        Err(SettingsError::NotPositive {
+            what: "open-contact response over the frequency range",
+            value: scale,
+        }
+        .into())
+    }
+}
+
+/// `p`, step `step` of the curve, measured on `problem` (moved to its frequency).
+fn measured(problem: &mut ForcedSystem, step: usize, p: &Point, e_g: f64) -> ResponsePoint {
+    problem.set_parameter(p.parameter);
+    let energy = problem.average_energy(&p.x);
+    let energy_normalized = energy / e_g;
+    let status = match &p.error {
+        Some(e) => PointStatus::SolverFailed(e.clone()),
+        None if p.converged => PointStatus::Converged.with_energy(energy, energy_normalized),
+        None => PointStatus::Rejected,
+    };
+    ResponsePoint {
+        step,
+        omega: p.parameter,
+        amplitude: problem.amplitude(&p.x),
+        energy,
+        energy_normalized,
+        converged: status == PointStatus::Converged,
+        status,
+        contact_defect: problem.contact_defect(&p.x),
+        dropped_harmonics: problem.dropped_harmonics(),
+        residual_norm: p.residual_norm,
+        iterations: p.iterations,
+        x: p.x.clone(),
+    }
+}

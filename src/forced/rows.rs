@@ -1,0 +1,151 @@
+//! Per-harmonic rows of a damped system: the condition rows and law observables of
+//! [`crate::system::HarmonicRows`], with the bars' damped (complex) Helmholtz maps.
+//!
+//! A complex row `a` acting on the complex amplitude `Z = X_c - i X_s` of one harmonic
+//! (`X_c`, `X_s` the unknowns of its cosine and its sine) gives two real rows:
+//! `Re(a Z) = a_r X_c + a_i X_s` (the cosine's) and `-Im(a Z) = a_r X_s - a_i X_c` (the
+//! sine's), since `Re(Z e^{i n theta}) = X_c cos(n theta) + X_s sin(n theta)`. Both are
+//! `a_r x_self + sigma a_i x_partner` with `sigma = +1` for a cosine and `-1` for a sine:
+//! [`real_form`].
+
+use crate::bar::{End, EndRef};
+use crate::bc::{LinearRows, Term};
+use crate::forced::waves::{squared_wavenumber, DampedMap};
+use crate::system::rows::quantity_weights;
+use crate::system::BarSystem;
+use num_complex::Complex64;
+
+/// Dense complex rows over the `2 n_bars` Helmholtz unknowns of one harmonic, with their
+/// derivatives in the fundamental frequency `Omega`.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Block {
+    pub(super) values: Vec<Complex64>,
+    pub(super) d_omega: Vec<Complex64>,
+}
+
+impl Block {
+    fn zeros(rows: usize, unknowns: usize) -> Self {
+        let zero = Complex64::new(0.0, 0.0);
+        Self {
+            values: vec![zero; rows * unknowns],
+            d_omega: vec![zero; rows * unknowns],
+        }
+    }
+
+    /// Row `r` (values, derivative) of a block `unknowns` wide.
+    pub(super) fn row(&self, r: usize, unknowns: usize) -> (&[Complex64], &[Complex64]) {
+        let range = r * unknowns..(r + 1) * unknowns;
+        (&self.values[range.clone()], &self.d_omega[range])
+    }
+}
+
+/// The rows of harmonic `n` of a damped system at one fundamental frequency.
+#[derive(Debug, Clone, Default)]
+pub(super) struct DampedRows {
+    pub(super) linear: Block,
+    pub(super) gap: Block,
+    pub(super) force: Block,
+}
+
+/// The bars' damped maps of harmonic `n` at `omega`, with `d kappa / d Omega` of each bar.
+fn maps(system: &BarSystem, n: usize, omega: f64, damping: &[f64]) -> Vec<(DampedMap, Complex64)> {
+    system
+        .bars()
+        .iter()
+        .zip(damping)
+        .map(|(bar, &eta)| {
+            let (kappa, d_kappa) = squared_wavenumber(bar, n, omega, eta);
+            (DampedMap::new(bar.length(), kappa), d_kappa)
+        })
+        .collect()
+}
+
+/// Adds `term` (at harmonic `n`) to the complex row `row`, and its `Omega`-derivative to
+/// `d_row`.
+fn add_term(
+    term: &Term,
+    n: usize,
+    maps: &[(DampedMap, Complex64)],
+    stiffness: f64,
+    row: &mut [Complex64],
+    d_row: &mut [Complex64],
+) {
+    let b = term.end.bar.index();
+    let (wu, wp) = quantity_weights(term.quantity, term.end.end, stiffness);
+    let (iu, ip) = match term.end.end {
+        End::Left => (0, 1),
+        End::Right => (2, 3),
+    };
+    let (map, d_kappa) = &maps[b];
+    for j in 0..2 {
+        let value = map.rows[iu][j] * wu + map.rows[ip][j] * wp;
+        let d_value = (map.d_kappa[iu][j] * wu + map.d_kappa[ip][j] * wp) * d_kappa;
+        row[2 * b + j] += value * term.coefficient;
+        // The coefficient depends on the harmonic's frequency n Omega.
+        d_row[2 * b + j] += value * (n as f64 * term.d_coefficient) + d_value * term.coefficient;
+    }
+}
+
+/// A block of `terms_of`'s rows at harmonic `n`.
+fn block<'t>(
+    terms_of: impl ExactSizeIterator<Item = &'t [Term]>,
+    n: usize,
+    maps: &[(DampedMap, Complex64)],
+    system: &BarSystem,
+) -> Block {
+    let unknowns = system.unknowns_per_harmonic();
+    let mut out = Block::zeros(terms_of.len(), unknowns);
+    for (r, terms) in terms_of.enumerate() {
+        let range = r * unknowns..(r + 1) * unknowns;
+        for t in terms {
+            add_term(
+                t,
+                n,
+                maps,
+                system.stiffness_at(t.end),
+                &mut out.values[range.clone()],
+                &mut out.d_omega[range.clone()],
+            );
+        }
+    }
+    out
+}
+
+impl DampedRows {
+    /// The rows of harmonic `n` of `system` at fundamental frequency `omega`, with damping
+    /// `damping[b]` in bar `b`.
+    pub(super) fn new(system: &BarSystem, n: usize, omega: f64, damping: &[f64]) -> Self {
+        let maps = maps(system, n, omega, damping);
+        let stiffness = |e: EndRef| system.stiffness_at(e);
+        let mut rows = LinearRows::new();
+        for condition in system.conditions() {
+            condition.linear_rows(n as f64 * omega, &stiffness, &mut rows);
+        }
+        let laws: Vec<_> = system.laws().map(|l| (l.gap(), l.force())).collect();
+        Self {
+            linear: block((0..rows.len()).map(|i| rows.row(i)), n, &maps, system),
+            gap: block(
+                laws.iter().map(|(g, _)| g.terms.as_slice()),
+                n,
+                &maps,
+                system,
+            ),
+            force: block(
+                laws.iter().map(|(_, f)| f.terms.as_slice()),
+                n,
+                &maps,
+                system,
+            ),
+        }
+    }
+}
+
+/// `a_r . x_self + sigma a_i . x_partner` (module docs); `x_partner` is `None` for the
+/// constant, whose rows are real.
+pub(super) fn real_form(row: &[Complex64], x_self: &[f64], partner: Option<(&[f64], f64)>) -> f64 {
+    let own: f64 = row.iter().zip(x_self).map(|(a, x)| a.re * x).sum();
+    match partner {
+        Some((x, sigma)) => own + sigma * row.iter().zip(x).map(|(a, x)| a.im * x).sum::<f64>(),
+        None => own,
+    }
+}

@@ -1,0 +1,387 @@
+//! Forced, damped responses (`forced`): the Jacobians against finite differences, the
+//! linear response against its closed form, the undamped limit against the backbone, and
+//! typed errors.
+
+use nonsmooth_modes::bar::Bar;
+use nonsmooth_modes::continuation::ContinuationProblem;
+use nonsmooth_modes::forced::{
+    forced_response, Damping, Excitation, ForcedSystem, Forcing, ResponseMethod, ResponseRequest,
+};
+use nonsmooth_modes::linalg::DenseMatrix;
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
+use nonsmooth_modes::solve::Problem;
+use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
+use nonsmooth_modes::{Error, ForcingError};
+use num_complex::Complex64;
+
+fn settings(m: usize) -> HarmonicBalanceSettings {
+    HarmonicBalanceSettings {
+        harmonics: m,
+        ..Default::default()
+    }
+}
+
+fn clamped_base(gap: f64, eta: f64, amplitude: f64) -> (BarSystem, Forcing) {
+    let system = clamped_bar_with_obstacle(gap).unwrap();
+    let base = system.bar_id(0).unwrap().left();
+    let forcing = Forcing {
+        damping: Damping::Uniform(eta),
+        excitations: vec![Excitation::base_motion(base, amplitude)],
+    };
+    (system, forcing)
+}
+
+/// A deterministic state with every coefficient set.
+fn state(n: usize, size: f64) -> Vec<f64> {
+    (0..n)
+        .map(|i| size * ((i as f64 * 0.77).sin() + 0.3 * (i as f64 * 1.9).cos()))
+        .collect()
+}
+
+#[test]
+fn the_jacobian_and_the_frequency_derivative_match_finite_differences() {
+    let (system, forcing) = clamped_base(1e-3, 0.05, 1e-4);
+    let mut problem = ForcedSystem::new(&system, settings(6), &forcing).unwrap();
+    let omega = 1.7;
+    problem.set_parameter(omega);
+    let n = problem.dimension();
+    // A state that touches on part of the period: the law switches inside the grid.
+    let x = state(n, 4e-4);
+    let mut jac = DenseMatrix::zeros(0, 0);
+    problem.jacobian(&x, &mut jac);
+    let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
+    let h = 1e-9;
+    let mut worst: f64 = 0.0;
+    for j in 0..n {
+        let mut y = x.clone();
+        y[j] += h;
+        problem.residual(&y, &mut plus);
+        y[j] -= 2.0 * h;
+        problem.residual(&y, &mut minus);
+        for i in 0..n {
+            let fd = (plus[i] - minus[i]) / (2.0 * h);
+            worst = worst.max((fd - jac[(i, j)]).abs() / (1.0 + jac[(i, j)].abs()));
+        }
+    }
+    assert!(
+        worst < 1e-5,
+        "Jacobian: worst relative difference {worst:e}"
+    );
+    let mut df = vec![0.0; n];
+    problem.parameter_derivative(&x, &mut df);
+    let dh = 1e-6;
+    problem.set_parameter(omega + dh);
+    problem.residual(&x, &mut plus);
+    problem.set_parameter(omega - dh);
+    problem.residual(&x, &mut minus);
+    let worst = (0..n)
+        .map(|i| ((plus[i] - minus[i]) / (2.0 * dh) - df[i]).abs() / (1.0 + df[i].abs()))
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1e-6,
+        "dF/dOmega: worst relative difference {worst:e}"
+    );
+}
+
+/// The complex amplitude of the displacement at `x = l` of bar 0 at harmonic 1.
+fn tip_amplitude(problem: &ForcedSystem, x: &[f64]) -> Complex64 {
+    let tip = problem.system().bar_id(0).unwrap().right();
+    problem.end_displacement(x, tip, 1)
+}
+
+#[test]
+fn without_contact_the_response_is_the_closed_form_linear_damped_response() {
+    // The clamped bar, base-excited, with a gap no motion reaches: the tip is free and
+    // U(x) = U0 cos(k (l - x)) / cos(k l), k^2 = (Omega^2 - i eta Omega) / c^2.
+    let (u0, eta, gap) = (1e-6, 0.02, 1.0);
+    let (system, forcing) = clamped_base(gap, eta, u0);
+    let mut problem = ForcedSystem::new(&system, settings(5), &forcing).unwrap();
+    for omega in [0.4, 1.2, std::f64::consts::FRAC_PI_2, 2.9, 4.71238898] {
+        problem.set_parameter(omega);
+        let x = problem.open_response().unwrap();
+        let mut f = vec![0.0; x.len()];
+        problem.residual(&x, &mut f);
+        let residual = f.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!(residual < 1e-15, "omega {omega}: residual {residual:e}");
+        let k = Complex64::new(omega * omega, -eta * omega).sqrt();
+        let exact = u0 / k.cos();
+        let got = tip_amplitude(&problem, &x);
+        assert!(
+            (got - exact).norm() <= 1e-10 * exact.norm(),
+            "omega {omega}: {got} against {exact}"
+        );
+        let other: f64 = (2..=5)
+            .map(|n| {
+                let tip = system.bar_id(0).unwrap().right();
+                problem.end_displacement(&x, tip, n).norm()
+            })
+            .sum();
+        assert!(other < 1e-20, "omega {omega}: higher harmonics {other:e}");
+    }
+}
+
+#[test]
+fn a_force_at_a_free_end_gives_the_closed_form_response() {
+    // Bar free at x = 0 under F cos(Omega t), obstacle far beyond x = l: the tip is free and
+    // U(x) = alpha cos(k (l - x)) with EA U'(0) = -F, i.e. alpha = -F / (EA k sin(k l)).
+    let (force, eta, ea, l) = (2e-6, 0.03, 1.7, 1.3);
+    let mut b = AssemblyBuilder::new();
+    let bar = b.add_bar(Bar::new(l, 0.8, ea).unwrap());
+    b.neumann(bar.left()).unwrap();
+    b.signorini(bar.right(), 10.0).unwrap();
+    let system = b.build().unwrap();
+    let forcing = Forcing {
+        damping: Damping::PerBar(vec![eta]),
+        excitations: vec![Excitation::force(bar.left(), force)],
+    };
+    let mut problem = ForcedSystem::new(&system, settings(4), &forcing).unwrap();
+    for omega in [0.3, 1.1, 2.5] {
+        problem.set_parameter(omega);
+        let x = problem.open_response().unwrap();
+        let k = Complex64::new(omega * omega, -eta * omega).sqrt() / 0.8;
+        let exact = -force / (ea * k * (k * l).sin());
+        let got = tip_amplitude(&problem, &x);
+        assert!(
+            (got - exact).norm() <= 1e-10 * exact.norm(),
+            "omega {omega}: {got} against {exact}"
+        );
+        // Solved with the contact law, the open response is the solution: the gap is
+        // never closed and the force stays zero.
+        let mut f = vec![0.0; x.len()];
+        problem.residual(&x, &mut f);
+        assert!(f.iter().all(|v| v.abs() < 1e-15));
+    }
+}
+
+#[test]
+fn a_base_motion_through_a_spring_gives_the_closed_form_response() {
+    // Robin bar: EA p(0) + k_s (u(0) - U0) = 0 with a free tip. U = alpha cos(k (l - x)),
+    // alpha (k_s cos(kl) - EA k sin(kl)) = k_s U0 (EA = 1, l = 1, c = 1).
+    let (k_s, u0, eta) = (0.5, 1e-6, 0.01);
+    let system = robin_bar_with_obstacle(k_s, 5.0).unwrap();
+    let forcing = Forcing {
+        damping: Damping::Uniform(eta),
+        excitations: vec![Excitation::base_motion(
+            system.bar_id(0).unwrap().left(),
+            u0,
+        )],
+    };
+    let mut problem = ForcedSystem::new(&system, settings(4), &forcing).unwrap();
+    for omega in [0.3, 0.653, 1.9] {
+        problem.set_parameter(omega);
+        let x = problem.open_response().unwrap();
+        let k = Complex64::new(omega * omega, -eta * omega).sqrt();
+        let exact = k_s * u0 / (k_s * k.cos() - k * k.sin());
+        let got = tip_amplitude(&problem, &x);
+        assert!(
+            (got - exact).norm() <= 1e-10 * exact.norm(),
+            "omega {omega}: {got} against {exact}"
+        );
+    }
+}
+
+#[test]
+fn bad_forcing_is_a_typed_error() {
+    let (system, good) = clamped_base(1e-3, 0.01, 1e-6);
+    let bar = system.bar_id(0).unwrap();
+    let with = |damping: Damping, excitations: Vec<Excitation>| {
+        ForcedSystem::new(
+            &system,
+            settings(4),
+            &Forcing {
+                damping,
+                excitations,
+            },
+        )
+        .map(|_| ())
+    };
+    let excitation = good.excitations.clone();
+    let cases: Vec<(Result<(), Error>, &str)> = vec![
+        (
+            with(Damping::Uniform(-1.0), excitation.clone()),
+            "negative damping",
+        ),
+        (
+            with(Damping::Uniform(f64::NAN), excitation.clone()),
+            "NaN damping",
+        ),
+        (
+            with(Damping::PerBar(vec![0.1, 0.2]), excitation.clone()),
+            "two values, one bar",
+        ),
+        (with(Damping::Uniform(0.1), vec![]), "no excitation"),
+        (
+            with(
+                Damping::Uniform(0.1),
+                vec![Excitation::base_motion(bar.left(), f64::INFINITY)],
+            ),
+            "infinite amplitude",
+        ),
+        (
+            with(
+                Damping::Uniform(0.1),
+                vec![Excitation::force(bar.left(), 1.0)],
+            ),
+            "force at a clamped end",
+        ),
+        (
+            with(
+                Damping::Uniform(0.1),
+                vec![Excitation::base_motion(bar.right(), 1.0)],
+            ),
+            "base motion at the contact end",
+        ),
+    ];
+    for (result, what) in cases {
+        assert!(
+            matches!(result, Err(Error::Forcing(_))),
+            "{what}: {result:?}"
+        );
+    }
+    let e = with(
+        Damping::Uniform(0.1),
+        vec![Excitation::force(bar.left(), 1.0)],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, Error::Forcing(ForcingError::NothingToExcite { .. })),
+        "{e}"
+    );
+    let zero_harmonics = ForcedSystem::new(&system, settings(0), &good);
+    assert!(matches!(zero_harmonics, Err(Error::Settings(_))));
+    let bad_range = ResponseRequest {
+        settings: settings(4),
+        forcing: good,
+        omega_range: (1.0, 0.5),
+        steps: 10,
+        method: ResponseMethod::Sequential,
+        solver: Default::default(),
+    };
+    assert!(matches!(
+        forced_response(&system, &bad_range),
+        Err(Error::Settings(_))
+    ));
+}
+
+/// Without damping and with a zero excitation, a backbone point (cosine basis, padded with
+/// zero sines) solves the forced system, and its period-averaged energy is the backbone's
+/// energy: the forced problem contains the autonomous one.
+#[test]
+fn undamped_and_unforced_the_backbone_points_solve_the_forced_system_with_their_energy() {
+    use nonsmooth_modes::branches::{
+        compute, to_full_basis, BackboneOptions, Method, PeriodGrid, Request,
+    };
+    use nonsmooth_modes::fourier::CosineBasis;
+    use nonsmooth_modes::modal::energy_at;
+    let m = 12;
+    for system in [
+        clamped_bar_with_obstacle(1e-3).unwrap(),
+        robin_bar_with_obstacle(0.5, 1e-3).unwrap(),
+    ] {
+        let mut options = BackboneOptions::for_mode(&system, 1, 1).unwrap();
+        let g = options.grid;
+        options.grid = PeriodGrid {
+            start: g.start,
+            end: g.start + 0.3 * (g.end - g.start),
+            steps: 7,
+        };
+        let request = Request::for_method(Method::PeriodGrid(options)).settings(settings(m));
+        let run = compute(&system, &request).unwrap();
+        let forcing = Forcing {
+            damping: Damping::Uniform(0.0),
+            excitations: vec![Excitation::base_motion(
+                system.bar_id(0).unwrap().left(),
+                0.0,
+            )],
+        };
+        let mut problem = ForcedSystem::new(&system, settings(m), &forcing).unwrap();
+        let mut checked = 0;
+        for p in run.converged() {
+            problem.set_parameter(p.omega);
+            let x = to_full_basis(&p.x, m);
+            let mut f = vec![0.0; x.len()];
+            problem.residual(&x, &mut f);
+            let residual = f.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!(residual < 1e-11, "T {}: residual {residual:e}", p.period);
+            // The truncated motion's energy drifts over the period by the work of its
+            // complementarity residual: its mean over the period is what both must agree on.
+            let basis = CosineBasis::new(m, 30).unwrap();
+            let instants = 256;
+            let mean = (0..instants)
+                .map(|k| {
+                    let theta = 2.0 * std::f64::consts::PI * k as f64 / instants as f64;
+                    energy_at(&system, &basis, &p.x, p.omega, theta)
+                })
+                .sum::<f64>()
+                / instants as f64;
+            let energy = problem.average_energy(&x);
+            assert!(
+                (energy - mean).abs() < 1e-10 * mean,
+                "T {}: averaged {energy:e}, mean of the backbone's {mean:e}",
+                p.period,
+            );
+            checked += 1;
+        }
+        assert!(checked >= 4, "{checked} points checked");
+    }
+}
+
+/// The clamped bar's first mode, base-excited and swept up in frequency with the harmonic
+/// selection: the resonance peak lies on the backbone of the same discretisation (energy
+/// within 5 % of the backbone's at the peak frequency), on two grids and at two forcing
+/// levels, well past the band of frequencies where the selection drops most harmonics
+/// (`docs/validation.md`, "Forced response").
+#[test]
+fn the_resonance_peak_lies_on_the_backbone() {
+    use nonsmooth_modes::branches::{compute, Request};
+    use nonsmooth_modes::system::RESONANCE_BAND;
+    let m = 20;
+    let with_band = HarmonicBalanceSettings {
+        harmonics: m,
+        resonance_band: RESONANCE_BAND,
+        ..Default::default()
+    };
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let backbone = compute(&system, &Request::new(1).settings(with_band)).unwrap();
+    let skeleton: Vec<(f64, f64)> = (backbone.converged())
+        .map(|p| (p.omega, p.energy_normalized))
+        .collect();
+    let at = |omega: f64| {
+        let w = skeleton
+            .windows(2)
+            .find(|w| (w[0].0 - omega) * (w[1].0 - omega) <= 0.0)
+            .expect("the peak within the backbone's range");
+        let t = (omega - w[0].0) / (w[1].0 - w[0].0);
+        w[0].1 + t * (w[1].1 - w[0].1)
+    };
+    for (eta, u0, steps) in [(1e-3, 1e-6, 451), (1e-3, 1e-6, 901), (1e-3, 2e-6, 901)] {
+        let (_, forcing) = clamped_base(1e-3, eta, u0);
+        let request = ResponseRequest {
+            settings: with_band,
+            forcing,
+            omega_range: (1.55, 2.0),
+            steps,
+            method: ResponseMethod::Sequential,
+            solver: Default::default(),
+        };
+        let response = forced_response(&system, &request).unwrap();
+        let peak = response.peak().unwrap();
+        eprintln!(
+            "eta {eta}, U {u0}, {steps} steps: peak E/E_g {:.4} at {:.4}, backbone {:.4}",
+            peak.energy_normalized,
+            peak.omega,
+            at(peak.omega)
+        );
+        let on_backbone = at(peak.omega);
+        let ratio = peak.energy_normalized / on_backbone;
+        assert!(
+            peak.omega > 1.75 && (ratio - 1.0).abs() < 0.05,
+            "eta {eta}: peak E/E_g {} at {}, backbone {on_backbone}",
+            peak.energy_normalized,
+            peak.omega
+        );
+        // Past the peak the sweep drops to the low branch and ends the range there.
+        let last = response.points.last().unwrap();
+        assert!(last.converged && last.amplitude < 0.1 && last.omega == 2.0);
+    }
+}
