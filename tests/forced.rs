@@ -249,6 +249,14 @@ fn bad_forcing_is_a_typed_error() {
     );
     let zero_harmonics = ForcedSystem::new(&system, settings(0), &good);
     assert!(matches!(zero_harmonics, Err(Error::Settings(_))));
+    for band in [-0.1, f64::NAN, 5.0] {
+        let bad_band = HarmonicBalanceSettings {
+            resonance_band: band,
+            ..settings(4)
+        };
+        let result = ForcedSystem::new(&system, bad_band, &good);
+        assert!(matches!(result, Err(Error::Settings(_))), "band {band}");
+    }
     let bad_range = ResponseRequest {
         settings: settings(4),
         forcing: good,

@@ -29,8 +29,8 @@ pub enum ResponseMethod {
 /// What response curve to compute.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseRequest {
-    /// Harmonic-balance settings (harmonics, samples, `a_c`; the kink blend and the harmonic
-    /// selection do not apply).
+    /// Harmonic-balance settings (harmonics, samples, `a_c`, harmonic selection; the kink
+    /// blend does not apply).
     pub settings: HarmonicBalanceSettings,
     /// Damping and excitations.
     pub forcing: Forcing,
@@ -248,7 +248,12 @@ fn sweep(
             return Ok(all);
         }
         problem.set_parameter(values[at]);
-        start = problem.open_response()?;
+        match problem.open_response() {
+            Ok(x) => start = x,
+            // The open system is singular there (an undamped natural frequency): the sweep
+            // ends stalled, with what it has.
+            Err(_) => return Ok(all),
+        }
     }
 }
 

@@ -65,9 +65,9 @@ struct LawState {
 
 impl ForcedSystem {
     /// `system` with `forcing`, `settings.harmonics` harmonics of a full basis of
-    /// `settings.samples_per_harmonic` samples each, and the complementarity parameter of
-    /// `settings` (its kink blend and harmonic selection do not apply). Its frequency is NaN
-    /// until [`ContinuationProblem::set_parameter`].
+    /// `settings.samples_per_harmonic` samples each, and the complementarity parameter and
+    /// the harmonic selection of `settings` (its kink blend does not apply). Its frequency is
+    /// NaN until [`ContinuationProblem::set_parameter`].
     ///
     /// # Errors
     /// - [`SettingsError`] for bad harmonic settings, a linear system
