@@ -65,6 +65,15 @@ impl EndValues {
     }
 }
 
+/// Indices, in the end values `[u(0), p(0), u(l), p(l)]` (and the rows of the maps that give
+/// them, [`HelmholtzMap`]), of the displacement and the outward strain at `end`.
+pub(crate) fn end_indices(end: End) -> (usize, usize) {
+    match end {
+        End::Left => (0, 1),
+        End::Right => (2, 3),
+    }
+}
+
 /// The two FD-BEM rows of a bar at angular frequency `omega`, divided by `k` so that they stay
 /// finite at `omega = 0`. They act on `[u(0), p(0), u(l), p(l)]` and vanish on every exact
 /// Helmholtz solution:

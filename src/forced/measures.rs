@@ -2,8 +2,9 @@
 //! mechanical energy averaged over the period, and how well the truncated motion meets the
 //! contact laws between the samples.
 
-use crate::bar::{End, EndRef};
+use crate::bar::EndRef;
 use crate::bc::Quantity;
+use crate::bem::end_indices;
 use crate::continuation::ContinuationProblem;
 use crate::forced::waves::{squared_wavenumber, DampedMap};
 use crate::forced::ForcedSystem;
@@ -125,10 +126,8 @@ impl ForcedSystem {
         let signals: Vec<(Vec<f64>, Vec<f64>)> = ends
             .iter()
             .map(|&e| {
-                (
-                    self.end_signal(x, e, Quantity::Displacement),
-                    self.end_signal(x, e, Quantity::OutwardStrain),
-                )
+                let (u, p) = end_indices(e.end);
+                (self.end_signal(x, e, u), self.end_signal(x, e, p))
             })
             .collect();
         let mut total = 0.0;
@@ -156,31 +155,25 @@ impl ForcedSystem {
     /// The complex amplitude `Z_n` of the displacement at `end` at harmonic `n` of `x`:
     /// `u(end, t) = sum_n Re(Z_n e^{i n Omega t})` (the constant, `n = 0`, real).
     pub fn end_displacement(&self, x: &[f64], end: EndRef, n: usize) -> Complex64 {
-        self.end_value(x, end, Quantity::Displacement, n)
+        self.end_value(x, end, end_indices(end.end).0, n)
     }
 
-    /// `Z_n` of the displacement or (any other `quantity`) the outward strain at `end`.
-    fn end_value(&self, x: &[f64], end: EndRef, quantity: Quantity, n: usize) -> Complex64 {
+    /// `Z_n` of the end value `index` of `end`'s bar (in the order of `bem::end_indices`).
+    fn end_value(&self, x: &[f64], end: EndRef, index: usize, n: usize) -> Complex64 {
         let b = end.bar.index();
         let bar = self.system().bars()[b];
-        let index = match (end.end, quantity) {
-            (End::Left, Quantity::Displacement) => 0,
-            (End::Left, _) => 1,
-            (End::Right, Quantity::Displacement) => 2,
-            (End::Right, _) => 3,
-        };
         let (kappa, _) = squared_wavenumber(&bar, n, self.parameter(), self.damping()[b]);
         let map = DampedMap::new(bar.length(), kappa);
         let (a, bb) = self.amplitudes(x, n, b);
         map.rows[index][0] * a + map.rows[index][1] * bb
     }
 
-    /// Samples over one period of the displacement or the outward strain at `end`.
-    fn end_signal(&self, x: &[f64], end: EndRef, quantity: Quantity) -> Vec<f64> {
+    /// Samples over one period of the end value `index` of `end`'s bar.
+    fn end_signal(&self, x: &[f64], end: EndRef, index: usize) -> Vec<f64> {
         let m = self.basis().harmonics();
         let mut coefficients = vec![0.0; self.basis().len()];
         for n in 0..=m {
-            let z = self.end_value(x, end, quantity, n);
+            let z = self.end_value(x, end, index, n);
             if n == 0 {
                 // The basis' constant is c_0 / 2.
                 coefficients[0] = 2.0 * z.re;

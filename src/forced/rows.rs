@@ -8,8 +8,9 @@
 //! `a_r x_self + sigma a_i x_partner` with `sigma = +1` for a cosine and `-1` for a sine:
 //! [`real_form`].
 
-use crate::bar::{End, EndRef};
-use crate::bc::{LinearRows, Term};
+use crate::bar::EndRef;
+use crate::bc::{LinearRows, Observable, Term};
+use crate::bem::end_indices;
 use crate::forced::waves::{squared_wavenumber, DampedMap};
 use crate::system::rows::quantity_weights;
 use crate::system::BarSystem;
@@ -19,22 +20,24 @@ use num_complex::Complex64;
 /// derivatives in the fundamental frequency `Omega`.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Block {
-    pub(super) values: Vec<Complex64>,
-    pub(super) d_omega: Vec<Complex64>,
+    width: usize,
+    values: Vec<Complex64>,
+    d_omega: Vec<Complex64>,
 }
 
 impl Block {
-    fn zeros(rows: usize, unknowns: usize) -> Self {
+    fn zeros(rows: usize, width: usize) -> Self {
         let zero = Complex64::new(0.0, 0.0);
         Self {
-            values: vec![zero; rows * unknowns],
-            d_omega: vec![zero; rows * unknowns],
+            width,
+            values: vec![zero; rows * width],
+            d_omega: vec![zero; rows * width],
         }
     }
 
-    /// Row `r` (values, derivative) of a block `unknowns` wide.
-    pub(super) fn row(&self, r: usize, unknowns: usize) -> (&[Complex64], &[Complex64]) {
-        let range = r * unknowns..(r + 1) * unknowns;
+    /// Row `r`: its values and their derivative.
+    pub(super) fn row(&self, r: usize) -> (&[Complex64], &[Complex64]) {
+        let range = r * self.width..(r + 1) * self.width;
         (&self.values[range.clone()], &self.d_omega[range])
     }
 }
@@ -72,10 +75,7 @@ fn add_term(
 ) {
     let b = term.end.bar.index();
     let (wu, wp) = quantity_weights(term.quantity, term.end.end, stiffness);
-    let (iu, ip) = match term.end.end {
-        End::Left => (0, 1),
-        End::Right => (2, 3),
-    };
+    let (iu, ip) = end_indices(term.end.end);
     let (map, d_kappa) = &maps[b];
     for j in 0..2 {
         let value = map.rows[iu][j] * wu + map.rows[ip][j] * wp;
@@ -93,10 +93,10 @@ fn block<'t>(
     maps: &[(DampedMap, Complex64)],
     system: &BarSystem,
 ) -> Block {
-    let unknowns = system.unknowns_per_harmonic();
-    let mut out = Block::zeros(terms_of.len(), unknowns);
+    let width = system.unknowns_per_harmonic();
+    let mut out = Block::zeros(terms_of.len(), width);
     for (r, terms) in terms_of.enumerate() {
-        let range = r * unknowns..(r + 1) * unknowns;
+        let range = r * width..(r + 1) * width;
         for t in terms {
             add_term(
                 t,
@@ -113,15 +113,20 @@ fn block<'t>(
 
 impl DampedRows {
     /// The rows of harmonic `n` of `system` at fundamental frequency `omega`, with damping
-    /// `damping[b]` in bar `b`.
-    pub(super) fn new(system: &BarSystem, n: usize, omega: f64, damping: &[f64]) -> Self {
+    /// `damping[b]` in bar `b`; `laws` are the observables `(gap, force)` of its laws.
+    pub(super) fn new(
+        system: &BarSystem,
+        laws: &[(Observable, Observable)],
+        n: usize,
+        omega: f64,
+        damping: &[f64],
+    ) -> Self {
         let maps = maps(system, n, omega, damping);
         let stiffness = |e: EndRef| system.stiffness_at(e);
         let mut rows = LinearRows::new();
         for condition in system.conditions() {
             condition.linear_rows(n as f64 * omega, &stiffness, &mut rows);
         }
-        let laws: Vec<_> = system.laws().map(|l| (l.gap(), l.force())).collect();
         Self {
             linear: block((0..rows.len()).map(|i| rows.row(i)), n, &maps, system),
             gap: block(

@@ -1,16 +1,16 @@
 //! The forced, damped harmonic-balance system `F(x; Omega) = 0` in the full Fourier basis.
 
-use crate::bc::LawSamples;
+use crate::bc::{LawSamples, Observable};
 use crate::continuation::ContinuationProblem;
-use crate::error::{Error, SettingsError};
+use crate::error::{Error, SettingsError, SolveError};
 use crate::forced::excitation::{Damping, Driven, Excitation};
 use crate::forced::rows::{real_form, DampedRows};
 use crate::fourier::{check_memory, Basis, SineCosineBasis};
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::{Problem, Structured};
-use crate::system::problem::law_offsets;
 use crate::system::problem::selection::{Selection, Shape};
-use crate::system::{BarSystem, HarmonicBalanceSettings, COMPLEMENTARITY_RANGE};
+use crate::system::problem::{check_complementarity, law_grams, law_offsets, unit_gram};
+use crate::system::{BarSystem, HarmonicBalanceSettings};
 use crate::ForcingError;
 
 /// What damps and drives a system: [`Damping`] and the [`Excitation`]s at its ends.
@@ -50,6 +50,10 @@ pub struct ForcedSystem {
     unknowns: usize,
     linear_count: usize,
     offsets: Vec<(f64, f64)>,
+    /// Each law's observables `(gap, force)` (fixed for a system).
+    observables: Vec<(Observable, Observable)>,
+    /// `G(1)`, for the law Gram matrices ([`law_grams`]).
+    unit_gram: Vec<f64>,
     /// Harmonic selection, if asked ([`HarmonicBalanceSettings::resonance_band`]).
     selection: Option<Selection>,
 }
@@ -83,16 +87,7 @@ impl ForcedSystem {
     ) -> Result<Self, Error> {
         let basis = SineCosineBasis::new(settings.harmonics, settings.samples_per_harmonic)?;
         let a_c = settings.complementarity;
-        let (min, max) = COMPLEMENTARITY_RANGE;
-        if !(a_c.is_finite() && (min..=max).contains(&a_c)) {
-            return Err(SettingsError::OutOfRange {
-                what: "complementarity parameter a_c",
-                value: a_c,
-                min,
-                max,
-            }
-            .into());
-        }
+        check_complementarity(a_c)?;
         if system.contact_count() == 0 {
             return Err(SettingsError::NoContact.into());
         }
@@ -115,19 +110,9 @@ impl ForcedSystem {
             .map(|&e| Driven::new(system, e))
             .collect::<Result<Vec<_>, _>>()?;
         let linear_count = unknowns - system.contact_count();
-        let (width, m) = (settings.resonance_band, settings.harmonics as f64);
-        if !(width.is_finite() && (0.0..=m).contains(&width)) {
-            return Err(SettingsError::OutOfRange {
-                what: "resonance band",
-                value: width,
-                min: 0.0,
-                max: m,
-            }
-            .into());
-        }
+        let selection = Selection::for_band(settings.resonance_band, settings.harmonics)?;
         Ok(Self {
             system: system.clone(),
-            basis,
             complementarity: a_c,
             damping,
             driven,
@@ -137,7 +122,10 @@ impl ForcedSystem {
             unknowns,
             linear_count,
             offsets,
-            selection: Selection::new(width),
+            observables: system.laws().map(|l| (l.gap(), l.force())).collect(),
+            unit_gram: unit_gram(&basis),
+            basis,
+            selection,
         })
     }
 
@@ -171,21 +159,29 @@ impl ForcedSystem {
         self.unknowns
     }
 
-    /// The unknowns of coefficient `i` of `x`, and those of its partner (the sine of a
-    /// cosine, the cosine of a sine) with the sign `sigma` of [`real_form`].
+    /// The partner of coefficient `i` (the sine of a cosine, the cosine of a sine) with the
+    /// sign `sigma` of [`real_form`]; `None` for the constant.
+    fn partner(&self, i: usize) -> Option<(usize, f64)> {
+        let m = self.basis.harmonics();
+        match i {
+            0 => None,
+            i if i <= m => Some((m + i, 1.0)),
+            i => Some((i - m, -1.0)),
+        }
+    }
+
+    /// The unknowns of coefficient `i` of `x`, and those of its partner with its sign.
     pub(super) fn blocks<'x>(
         &self,
         x: &'x [f64],
         i: usize,
     ) -> (&'x [f64], Option<(&'x [f64], f64)>) {
-        let (u, m) = (self.unknowns, self.basis.harmonics());
+        let u = self.unknowns;
         let block = |j: usize| &x[j * u..(j + 1) * u];
-        let partner = match i {
-            0 => None,
-            i if i <= m => Some((block(m + i), 1.0)),
-            i => Some((block(i - m), -1.0)),
-        };
-        (block(i), partner)
+        (
+            block(i),
+            self.partner(i).map(|(p, sigma)| (block(p), sigma)),
+        )
     }
 
     /// Coefficients of the gap (`gap`) or force of law `l` at `x` (their `Omega`-derivatives
@@ -195,7 +191,7 @@ impl ForcedSystem {
             .map(|i| {
                 let rows = &self.rows[self.basis.harmonic(i)];
                 let block = if gap { &rows.gap } else { &rows.force };
-                let (value, d) = block.row(l, self.unknowns);
+                let (value, d) = block.row(l);
                 let (own, partner) = self.blocks(x, i);
                 real_form(if derivative { d } else { value }, own, partner)
             })
@@ -240,8 +236,11 @@ impl ForcedSystem {
 
     /// The gap samples of law `l` over one period at `x` (the basis' `N` instants).
     pub fn gap_history(&self, x: &[f64], l: usize) -> Vec<f64> {
-        let n = self.basis.samples();
-        self.law_state(x).gap[l * n..(l + 1) * n].to_vec()
+        let mut gap = vec![0.0; self.basis.samples()];
+        self.basis
+            .synthesize(&self.observable(x, l, true, false), &mut gap);
+        gap.iter_mut().for_each(|v| *v += self.offsets[l].0);
+        gap
     }
 
     /// The Gram matrices `(G(w_gap), G(w_force))` of law `l` from the samples `s`.
@@ -249,8 +248,8 @@ impl ForcedSystem {
         let (n, len) = (self.basis.samples(), self.basis.len());
         let range = l * n..(l + 1) * n;
         let (mut g, mut f) = (vec![0.0; len * len], vec![0.0; len * len]);
-        self.basis.weighted_gram(&s.d_gap[range.clone()], &mut g);
-        self.basis.weighted_gram(&s.d_force[range], &mut f);
+        let weights = (&s.d_gap[range.clone()], &s.d_force[range]);
+        law_grams(&self.basis, &self.unit_gram, weights, (&mut g, &mut f));
         (g, f)
     }
 
@@ -261,7 +260,7 @@ impl ForcedSystem {
             let rows = &self.rows[self.basis.harmonic(i)];
             let (own, partner) = self.blocks(x, i);
             for r in 0..rc {
-                let (value, d) = rows.linear.row(r, self.unknowns);
+                let (value, d) = rows.linear.row(r);
                 f[i * rc + r] = real_form(if derivative { d } else { value }, own, partner);
             }
         }
@@ -279,55 +278,38 @@ impl ForcedSystem {
     /// # Errors
     /// [`SolveError::SingularJacobian`](crate::SolveError::SingularJacobian) when the open
     /// system is singular at harmonic 1 (an undamped natural frequency).
-    pub fn open_response(&mut self) -> Result<Vec<f64>, Error> {
-        let dim = self.dimension();
-        let mut jac = DenseMatrix::zeros(dim, dim);
-        self.linear_jacobian(&mut jac);
-        let (len, rc, u, m) = (
-            self.basis.len(),
-            self.linear_count,
-            self.unknowns,
-            self.basis.harmonics(),
-        );
-        let base = len * rc;
-        for l in 0..self.offsets.len() {
-            for i in [1, m + 1] {
-                let (value, _) = self.rows[1].force.row(l, u);
-                self.add_real_form(&mut jac, base + l * len + i, i, value, 1.0);
-            }
-        }
-        let mut rhs = vec![0.0; dim];
-        self.linear_block(&vec![0.0; dim], false, &mut rhs);
-        // Equations and unknowns of harmonic 1's cosine and sine.
-        let equations: Vec<usize> = [1, m + 1]
-            .iter()
-            .flat_map(|&i| {
-                (0..rc)
-                    .map(move |r| i * rc + r)
-                    .chain((0..self.offsets.len()).map(move |l| base + l * len + i))
-            })
-            .collect();
-        let unknowns: Vec<usize> = [1, m + 1]
-            .iter()
-            .flat_map(|&i| (0..u).map(move |k| i * u + k))
+    pub fn open_response(&self) -> Result<Vec<f64>, Error> {
+        let (u, m) = (self.unknowns, self.basis.harmonics());
+        let rows = &self.rows[1];
+        // Harmonic 1's equations: the linear rows, then every law's force held at zero, for
+        // the cosine (unknowns 0..u of the block) and the sine (u..2u). A complex row `a`
+        // gives `[a_r, a_i]` on the cosine's and `[-a_i, a_r]` on the sine's (`real_form`).
+        let complex_rows: Vec<_> = (0..self.linear_count)
+            .map(|r| rows.linear.row(r).0)
+            .chain((0..self.offsets.len()).map(|l| rows.force.row(l).0))
             .collect();
         let mut block = DenseMatrix::zeros(2 * u, 2 * u);
-        for (r, &e) in equations.iter().enumerate() {
-            for (c, &k) in unknowns.iter().enumerate() {
-                block[(r, c)] = jac[(e, k)];
+        for (r, a) in complex_rows.iter().enumerate() {
+            for (k, a) in a.iter().enumerate() {
+                block[(r, k)] = a.re;
+                block[(r, u + k)] = a.im;
+                block[(u + r, k)] = -a.im;
+                block[(u + r, u + k)] = a.re;
             }
         }
-        let mut b: Vec<f64> = equations.iter().map(|&e| -rhs[e]).collect();
-        let lu = Lu::factor(&block, 1e-14).map_err(|p| crate::SolveError::SingularJacobian {
+        let mut b = vec![0.0; 2 * u];
+        for &(r, value, _) in &self.rhs {
+            b[r] += value;
+        }
+        let lu = Lu::factor(&block, 1e-14).map_err(|p| SolveError::SingularJacobian {
             iteration: 0,
             pivot: p.pivot,
             ratio: p.ratio,
         })?;
         lu.solve_in_place(&mut b);
-        let mut x = vec![0.0; dim];
-        for (&k, v) in unknowns.iter().zip(b) {
-            x[k] = v;
-        }
+        let mut x = vec![0.0; self.dimension()];
+        x[u..2 * u].copy_from_slice(&b[..u]);
+        x[(m + 1) * u..(m + 2) * u].copy_from_slice(&b[u..]);
         Ok(x)
     }
 
@@ -341,16 +323,11 @@ impl ForcedSystem {
         row: &[num_complex::Complex64],
         scale: f64,
     ) {
-        let (u, m) = (self.unknowns, self.basis.harmonics());
+        let u = self.unknowns;
         for (k, a) in row.iter().enumerate() {
             jac[(target, i * u + k)] += scale * a.re;
         }
-        let partner = match i {
-            0 => None,
-            i if i <= m => Some((m + i, 1.0)),
-            i => Some((i - m, -1.0)),
-        };
-        if let Some((p, sigma)) = partner {
+        if let Some((p, sigma)) = self.partner(i) {
             for (k, a) in row.iter().enumerate() {
                 jac[(target, p * u + k)] += scale * sigma * a.im;
             }
@@ -402,7 +379,7 @@ impl ForcedSystem {
         for i in 0..self.basis.len() {
             let rows = &self.rows[self.basis.harmonic(i)];
             for r in 0..rc {
-                let (value, _) = rows.linear.row(r, self.unknowns);
+                let (value, _) = rows.linear.row(r);
                 self.add_real_form(jac, i * rc + r, i, value, 1.0);
             }
         }
@@ -456,8 +433,8 @@ impl ForcedSystem {
             let (gram_gap, gram_force) = self.grams(&s, l);
             for i in 0..len {
                 let rows = &self.rows[self.basis.harmonic(i)];
-                let (gap_row, _) = rows.gap.row(l, self.unknowns);
-                let (force_row, _) = rows.force.row(l, self.unknowns);
+                let (gap_row, _) = rows.gap.row(l);
+                let (force_row, _) = rows.force.row(l);
                 for j in 0..len {
                     let target = base + l * len + j;
                     let (wg, wf) = (gram_gap[j * len + i], gram_force[j * len + i]);
@@ -503,7 +480,7 @@ impl ContinuationProblem for ForcedSystem {
         }
         let m = self.basis.harmonics();
         self.rows = (0..=m)
-            .map(|n| DampedRows::new(&self.system, n, omega, &self.damping))
+            .map(|n| DampedRows::new(&self.system, &self.observables, n, omega, &self.damping))
             .collect();
         self.rhs = (self.driven.iter())
             .map(|d| {

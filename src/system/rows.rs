@@ -7,7 +7,7 @@
 
 use crate::bar::{End, EndRef};
 use crate::bc::{LinearRows, Observable, Quantity, Term};
-use crate::bem::HelmholtzMap;
+use crate::bem::{end_indices, HelmholtzMap};
 use crate::linalg::svd_small;
 use crate::system::BarSystem;
 
@@ -42,10 +42,7 @@ fn add_term(
 ) {
     let b = term.end.bar.index();
     let (wu, wp) = quantity_weights(term.quantity, term.end.end, stiffness);
-    let (iu, ip) = match term.end.end {
-        End::Left => (0, 1),
-        End::Right => (2, 3),
-    };
+    let (iu, ip) = end_indices(term.end.end);
     let map = &maps[b];
     for j in 0..2 {
         let value = wu * map.rows[iu][j] + wp * map.rows[ip][j];

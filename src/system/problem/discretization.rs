@@ -77,20 +77,7 @@ impl<B: Basis> Discretization<B> {
     /// [`SettingsError::NoContact`] for a linear system, [`SettingsError::TooLarge`] for a
     /// problem beyond the memory budget ([`crate::fourier::MEMORY_BUDGET_BYTES`]).
     pub(super) fn new(system: &BarSystem, basis: B, a_c: f64) -> Result<Self, Error> {
-        let what = "complementarity parameter a_c";
-        if !(a_c.is_finite() && a_c > 0.0) {
-            return Err(SettingsError::NotPositive { what, value: a_c }.into());
-        }
-        let (min, max) = COMPLEMENTARITY_RANGE;
-        if !(min..=max).contains(&a_c) {
-            return Err(SettingsError::OutOfRange {
-                what,
-                value: a_c,
-                min,
-                max,
-            }
-            .into());
-        }
+        check_complementarity(a_c)?;
         let laws = system.contact_count();
         if laws == 0 {
             return Err(SettingsError::NoContact.into());
@@ -103,9 +90,7 @@ impl<B: Basis> Discretization<B> {
             problem_doubles(len, basis.folded_samples(), unknowns, laws),
         )
         .map_err(SettingsError::TooLarge)?;
-        // Laws are evaluated on the basis' folded samples only (the others repeat them).
-        let mut unit_gram = vec![0.0; len * len];
-        basis.weighted_gram_folded(&vec![1.0; basis.folded_samples()], &mut unit_gram);
+        let unit_gram = unit_gram(&basis);
         Ok(Self {
             system: system.clone(),
             basis,
@@ -303,20 +288,16 @@ impl<B: Basis> Discretization<B> {
     /// `G(w_force)` is formed from `G(w_gap)` and `G(1)` instead of by a transform.
     pub(super) fn law_grams(
         &self,
-        (w_gap, w_force): (&[f64], &[f64]),
+        weights: (&[f64], &[f64]),
         gram_gap: &mut [f64],
         gram_force: &mut [f64],
     ) {
-        self.basis.weighted_gram_folded(w_gap, gram_gap);
-        match affine_relation(w_gap, w_force) {
-            Some((alpha, beta)) => {
-                let terms = self.unit_gram.iter().zip(gram_gap.iter());
-                for (g, (u, w)) in gram_force.iter_mut().zip(terms) {
-                    *g = alpha * u + beta * w;
-                }
-            }
-            None => self.basis.weighted_gram_folded(w_force, gram_force),
-        }
+        law_grams(
+            &self.basis,
+            &self.unit_gram,
+            weights,
+            (gram_gap, gram_force),
+        );
     }
 
     /// The linear block of `F` (its `Omega`-derivative if `derivative`) for the unknowns `x`
@@ -382,6 +363,60 @@ impl<B: Basis> Discretization<B> {
             }
         }
         w
+    }
+}
+
+/// Checks a complementarity parameter `a_c`.
+///
+/// # Errors
+/// [`SettingsError::NotPositive`] for a non-positive or non-finite `a_c`,
+/// [`SettingsError::OutOfRange`] for one outside [`COMPLEMENTARITY_RANGE`].
+pub(crate) fn check_complementarity(a_c: f64) -> Result<(), SettingsError> {
+    let what = "complementarity parameter a_c";
+    if !(a_c.is_finite() && a_c > 0.0) {
+        return Err(SettingsError::NotPositive { what, value: a_c });
+    }
+    let (min, max) = COMPLEMENTARITY_RANGE;
+    if !(min..=max).contains(&a_c) {
+        return Err(SettingsError::OutOfRange {
+            what,
+            value: a_c,
+            min,
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// `G(1)`, the Gram matrix of the unit weight on the basis' folded samples (laws are
+/// evaluated there only: the other samples repeat them), for [`law_grams`].
+pub(crate) fn unit_gram<B: Basis>(basis: &B) -> Vec<f64> {
+    let len = basis.len();
+    let mut gram = vec![0.0; len * len];
+    basis.weighted_gram_folded(&vec![1.0; basis.folded_samples()], &mut gram);
+    gram
+}
+
+/// The Gram matrices `G(w_gap)` and `G(w_force)` of one law (`len x len`, row-major) from
+/// its gradient samples on the folded grid: the two halves of the law's Jacobian block.
+///
+/// When the force weight is an affine function of the gap weight (complementarity laws),
+/// `G(w_force)` is formed from `G(w_gap)` and `unit_gram = G(1)` instead of by a transform.
+pub(crate) fn law_grams<B: Basis>(
+    basis: &B,
+    unit_gram: &[f64],
+    (w_gap, w_force): (&[f64], &[f64]),
+    (gram_gap, gram_force): (&mut [f64], &mut [f64]),
+) {
+    basis.weighted_gram_folded(w_gap, gram_gap);
+    match affine_relation(w_gap, w_force) {
+        Some((alpha, beta)) => {
+            let terms = unit_gram.iter().zip(gram_gap.iter());
+            for (g, (u, w)) in gram_force.iter_mut().zip(terms) {
+                *g = alpha * u + beta * w;
+            }
+        }
+        None => basis.weighted_gram_folded(w_force, gram_force),
     }
 }
 

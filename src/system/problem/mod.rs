@@ -33,7 +33,7 @@ mod staircase;
 mod state;
 mod step;
 
-pub(crate) use discretization::law_offsets;
+pub(crate) use discretization::{check_complementarity, law_grams, law_offsets, unit_gram};
 pub use discretization::{Discretization, COMPLEMENTARITY_RANGE, MAX_OFFSET, MAX_PHASE};
 
 use crate::continuation::ContinuationProblem;
@@ -192,15 +192,7 @@ impl<B: Basis> NonsmoothSystem<B> {
     /// [`SettingsError::OutOfRange`] for a width that is not finite, negative or above `m`.
     pub fn set_resonance_band(&mut self, width: f64) -> Result<(), SettingsError> {
         let m = self.description.basis().harmonics();
-        if !(width.is_finite() && (0.0..=m as f64).contains(&width)) {
-            return Err(SettingsError::OutOfRange {
-                what: "resonance band",
-                value: width,
-                min: 0.0,
-                max: m as f64,
-            });
-        }
-        self.selection = Selection::new(width);
+        self.selection = Selection::for_band(width, m)?;
         let omega = self.ws.frequency.omega;
         if let Some(s) = &mut self.selection {
             s.select((self.description.system(), self.description.basis()), omega);

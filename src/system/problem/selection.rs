@@ -25,6 +25,7 @@
 //! equations).
 
 use super::discretization::Discretization;
+use crate::error::SettingsError;
 use crate::fourier::Basis;
 use crate::linalg::DenseMatrix;
 use crate::modal::linear::{natural_frequency_values, Resolution};
@@ -75,8 +76,25 @@ pub(crate) struct Selection {
 }
 
 impl Selection {
+    /// The selection of band `width / m` for `m` harmonics (`None` for a zero width: no
+    /// selection).
+    ///
+    /// # Errors
+    /// [`SettingsError::OutOfRange`] for a width that is not finite, negative or above `m`.
+    pub(crate) fn for_band(width: f64, m: usize) -> Result<Option<Self>, SettingsError> {
+        if !(width.is_finite() && (0.0..=m as f64).contains(&width)) {
+            return Err(SettingsError::OutOfRange {
+                what: "resonance band",
+                value: width,
+                min: 0.0,
+                max: m as f64,
+            });
+        }
+        Ok(Self::new(width))
+    }
+
     /// The selection of band `width / m` (`None` for a zero width: no selection).
-    pub(crate) fn new(width: f64) -> Option<Self> {
+    fn new(width: f64) -> Option<Self> {
         (width > 0.0).then(|| Self {
             width,
             natural: Vec::new(),
