@@ -709,6 +709,28 @@ pub enum StabilityError {
         /// Rows of the matrix.
         dimension: usize,
     },
+    /// Hill's method needs rows that do not depend on the frequency: the exponent would
+    /// enter a condition whose rows do (an end mass).
+    #[error(
+        "condition `{condition}` has rows that depend on the frequency: Hill's method does \
+         not support it"
+    )]
+    HillUnsupported {
+        /// Name of the condition.
+        condition: String,
+    },
+    /// The Hill matrix would have more rows than the limit: each shift of its search solves
+    /// a dense eigenvalue problem of that size.
+    #[error(
+        "the Hill matrix would have {dimension} rows, over the limit of {limit}: use fewer \
+         harmonics"
+    )]
+    HillTooLarge {
+        /// `(2 m + 1)` times the unknowns per harmonic.
+        dimension: u128,
+        /// [`MAX_HILL_DIMENSION`](crate::stability::MAX_HILL_DIMENSION).
+        limit: usize,
+    },
     /// A multiplier or a matrix entry is not finite.
     #[error("the monodromy matrix has a non-finite entry ({value}) in column {column}")]
     NonFinite {

@@ -182,6 +182,7 @@ mod tests {
             character: None,
             label: None,
             stability: None,
+            hill: None,
         }
     }
 

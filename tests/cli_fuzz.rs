@@ -131,6 +131,7 @@ const FLAGS: &[(&str, Value)] = &[
     ("progress", Value::Switch),
     ("verify", Value::Switch),
     ("stability", Value::Switch),
+    ("hill", Value::Switch),
     ("basis", Value::Word(&["cosine", "full"])),
 ];
 
@@ -264,13 +265,19 @@ fn command_line(
 }
 
 /// What the `backbone` lines always end with: few points when they verify or compute
-/// multipliers, which march every point in time (later flags override earlier ones).
+/// multipliers or Hill exponents (later flags override earlier ones).
 fn backbone_tail(rng: &mut Rng, args: &mut Vec<String>) {
-    if args.iter().any(|a| a == "--verify" || a == "--stability") {
+    if (args.iter()).any(|a| a == "--verify" || a == "--stability" || a == "--hill") {
         for flag in ["--steps", "--max-steps"] {
             args.push(flag.to_string());
             args.push(rng.between(2, 8).to_string());
         }
+    }
+    if args.iter().any(|a| a == "--hill") {
+        // An arclength run may still give a thousand points, each a Hill search of 54
+        // eigenvalue problems of the matrix's size.
+        args.push("--harmonics".to_string());
+        args.push(rng.between(2, 8).to_string());
     }
 }
 

@@ -7,7 +7,8 @@ use nonsmooth_modes::branches::{
 };
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::stability::{
-    floquet, floquet_of_state, StabilityError, StabilityOptions, Verdict, MAX_DIMENSION,
+    floquet, floquet_of_state, HillOptions, StabilityError, StabilityOptions, Verdict,
+    MAX_DIMENSION,
 };
 use nonsmooth_modes::system::BarSystem;
 use nonsmooth_modes::verify::{clamped_first_mode, Grid, Model, State};
@@ -99,6 +100,15 @@ fn a_motion_without_contact_has_every_multiplier_on_the_circle() {
 /// The clamped bar at gap `gap` and its `m = 20` points at `T = 3.8, 3.7, ..., 3.4`, with
 /// the multipliers of each when `stability` is given.
 fn clamped_points(gap: f64, stability: Option<StabilityOptions>) -> (BarSystem, ModeBranches) {
+    clamped_points_with(gap, stability, None)
+}
+
+/// [`clamped_points`] with the Hill exponents of each point when `hill` is given.
+fn clamped_points_with(
+    gap: f64,
+    stability: Option<StabilityOptions>,
+    hill: Option<HillOptions>,
+) -> (BarSystem, ModeBranches) {
     let system = clamped_bar_with_obstacle(gap).unwrap();
     let grid = PeriodGrid {
         start: 3.8,
@@ -108,6 +118,7 @@ fn clamped_points(gap: f64, stability: Option<StabilityOptions>) -> (BarSystem, 
     let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
     let mut request = Request::for_method(method).harmonics(20);
     request.stability = stability;
+    request.hill = hill;
     let result = compute(&system, &request).unwrap();
     (system, result)
 }
@@ -135,6 +146,42 @@ fn verdicts_are_homogeneous_in_the_gap() {
             g.max_multiplier
         );
         assert!(f.max_multiplier.is_finite() && f.max_multiplier >= 1.0 - 1e-6);
+        compared += 1;
+    }
+    assert!(compared >= 4, "{compared} points compared");
+}
+
+/// Hill's exponents are homogeneous in the gap too: at gaps `1e-3` and `2e-3` the same
+/// verdicts, largest multipliers and exponents beyond the tolerance to `1e-8`. Each point
+/// solves the full harmonic-balance system, and its time shift is an exponent 0 of the
+/// truncated equations up to the sampling of the law.
+#[test]
+fn hill_exponents_are_homogeneous_in_the_gap() {
+    let run = |gap: f64| clamped_points_with(gap, None, Some(HillOptions::default())).1;
+    let (a, b) = (run(1e-3), run(2e-3));
+    let mut compared = 0;
+    for (p, q) in a.converged().zip(b.converged()) {
+        let (f, g) = (
+            p.hill.clone().unwrap().unwrap(),
+            q.hill.clone().unwrap().unwrap(),
+        );
+        let t = p.period;
+        assert_eq!(f.verdict, g.verdict, "T = {t}");
+        assert!(
+            (f.max_multiplier - g.max_multiplier).abs() <= 1e-8,
+            "T = {t}"
+        );
+        assert_eq!(f.exponents.len(), g.exponents.len(), "T = {t}");
+        for (x, y) in f.exponents.iter().zip(&g.exponents) {
+            assert!((x.re - y.re).abs() + (x.im - y.im).abs() <= 1e-8, "T = {t}");
+        }
+        assert!(f.residual <= 1e-9, "T = {t}: {}", f.residual);
+        assert!(
+            f.time_shift_residual <= 1e-3,
+            "T = {t}: {}",
+            f.time_shift_residual
+        );
+        assert!(f.max_multiplier.is_finite() && f.max_multiplier >= 1.0);
         compared += 1;
     }
     assert!(compared >= 4, "{compared} points compared");

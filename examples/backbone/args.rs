@@ -15,7 +15,7 @@ pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--r
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI] [--switch-at N[:SIDE]]
   [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
-  [--energy-range LO:HI] [--progress] [--verify] [--stability] [--basis cosine|full]";
+  [--energy-range LO:HI] [--progress] [--verify] [--stability] [--hill] [--basis cosine|full]";
 
 /// Largest `--steps` and `--max-steps`.
 pub const MAX_POINTS: usize = 1_000_000;
@@ -88,6 +88,8 @@ pub struct Args {
     pub verify: bool,
     /// `--stability`: the Floquet multipliers of every converged point.
     pub stability: bool,
+    /// `--hill`: the Hill exponents of every converged point.
+    pub hill: bool,
 }
 
 fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
@@ -157,6 +159,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         progress: false,
         verify: false,
         stability: false,
+        hill: false,
         full_basis: false,
     };
     let mut assembly = None;
@@ -258,6 +261,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("progress") => a.progress = true,
             Long("verify") => a.verify = true,
             Long("stability") => a.stability = true,
+            Long("hill") => a.hill = true,
             Long("basis") => {
                 a.full_basis = match parser.value()?.string()?.as_str() {
                     "cosine" => false,

@@ -2,12 +2,14 @@
 //! basis (`branches::full_basis_branch`) from the cosine run's first converged point.
 
 use crate::args::Args;
-use crate::output::{stability_cells, verification_cells};
+use crate::output::{
+    hill_cells, stability_cells, verification_cells, HILL_COLUMNS, STABILITY_COLUMNS,
+};
 use nonsmooth_modes::branches::{
     compute, full_basis_branch, to_full_basis, Method, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::linspace;
-use nonsmooth_modes::stability::StabilityOptions;
+use nonsmooth_modes::stability::{HillOptions, StabilityOptions};
 use nonsmooth_modes::system::BarSystem;
 use std::io::Write;
 
@@ -30,12 +32,9 @@ pub fn run_full_basis(
     } else {
         ""
     };
-    let stability = if a.stability {
-        ",stable,max_multiplier"
-    } else {
-        ""
-    };
-    writeln!(out, "{HEADER}{verify}{stability}")?;
+    let stability = if a.stability { STABILITY_COLUMNS } else { "" };
+    let hill = if a.hill { HILL_COLUMNS } else { "" };
+    writeln!(out, "{HEADER}{verify}{stability}{hill}")?;
     if !matches!(request.method, Method::PeriodGrid(_)) {
         return Err("--basis full continues the period grid".into());
     }
@@ -48,6 +47,7 @@ pub fn run_full_basis(
         solver: Some(request.solver_for(&request.method)?),
         check: a.verify.then(|| TimeDomainCheck::for_system(system)),
         stability: a.stability.then(StabilityOptions::default),
+        hill: a.hill.then(HillOptions::default),
         ..request.clone()
     };
     let start = to_full_basis(&first.x, a.settings.harmonics);
@@ -66,7 +66,8 @@ pub fn run_full_basis(
                 "rejected"
             };
             let omega = 2.0 * std::f64::consts::PI / period;
-            let empty = ",".repeat(6 + 3 * usize::from(a.verify) + 2 * usize::from(a.stability));
+            let verdicts = 2 * (usize::from(a.stability) + usize::from(a.hill));
+            let empty = ",".repeat(6 + 3 * usize::from(a.verify) + verdicts);
             writeln!(out, "{step},{period},{omega},,,false,{status}{empty}")?;
             continue;
         };
@@ -95,6 +96,9 @@ pub fn run_full_basis(
         }
         if a.stability {
             write!(out, "{}", stability_cells(q))?;
+        }
+        if a.hill {
+            write!(out, "{}", hill_cells(q))?;
         }
         writeln!(out)?;
     }

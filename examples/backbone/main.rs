@@ -12,7 +12,7 @@
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--switch-at N[:SIDE]] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify] [--stability]
-//!     [--basis cosine|full]
+//!     [--hill] [--basis cosine|full]
 //! ```
 //!
 //! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
@@ -66,6 +66,12 @@
 //! Changes of verdict along a branch appear in `event` as `stability-lost` and
 //! `stability-gained`. Period and energy runs only; empty cells for `--parameter` runs.
 //!
+//! `--hill` adds, after those, `hill_stable,hill_max_multiplier`: the verdict and largest
+//! multiplier of Hill's method on the truncated harmonic-balance equations (`stability::hill`,
+//! default options), a cross-check that differs from the exact map's verdict where the
+//! truncation matters (`docs/validation.md`). Unresolved where the point does not solve the
+//! full system (a harmonic selection) or its trivial exponent is not found.
+//!
 //! Last in every row, so that the columns before them keep their places:
 //! `contacts_per_period`, the number of contact intervals per period summed over the
 //! contacts (`modal::contact_intervals` on the harmonic-balance time grid: 1 for the clamped
@@ -91,8 +97,9 @@
 //! `before-start` for the periods before the cosine run's first converged one; `unfolding`
 //! is the phase-locked system's `mu`, `sine_share` and `asymmetry` say how far the motion is
 //! from even about `t = 0` and about any instant; `label` as below), then with `--verify`
-//! `periodicity_defect,displacement_defect,max_penetration` and with `--stability`
-//! `stable,max_multiplier`, as for the cosine basis. It takes `--parameter omega`,
+//! `periodicity_defect,displacement_defect,max_penetration`, with `--stability`
+//! `stable,max_multiplier` and with `--hill` `hill_stable,hill_max_multiplier`, as for the
+//! cosine basis. It takes `--parameter omega`,
 //! sequential steps and `--subharmonic 1`; other combinations are usage errors.
 
 //! `--subharmonic K > 1` (sequential runs in the period): the seed on harmonic `K` gives the

@@ -15,8 +15,9 @@ pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energ
 
 /// The whole header: [`HEADER`], the `--verify` columns if `verify`, then
 /// `contacts_per_period`, `subharmonic_share` for a subharmonic order `K > 1`, and
-/// `label,branch,dominant_harmonic`, then `stable,max_multiplier` if `stability`.
-pub fn header(verify: bool, subharmonic: usize, stability: bool) -> String {
+/// `label,branch,dominant_harmonic`, then [`STABILITY_COLUMNS`] if `stability` and
+/// [`HILL_COLUMNS`] if `hill`.
+pub fn header(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> String {
     let mut header = HEADER.to_string();
     if verify {
         header.push_str(",periodicity_defect,displacement_defect,max_penetration");
@@ -27,10 +28,19 @@ pub fn header(verify: bool, subharmonic: usize, stability: bool) -> String {
     }
     header.push_str(",label,branch,dominant_harmonic");
     if stability {
-        header.push_str(",stable,max_multiplier");
+        header.push_str(STABILITY_COLUMNS);
+    }
+    if hill {
+        header.push_str(HILL_COLUMNS);
     }
     header
 }
+
+/// The columns of `--stability`.
+pub const STABILITY_COLUMNS: &str = ",stable,max_multiplier";
+
+/// The columns of `--hill`.
+pub const HILL_COLUMNS: &str = ",hill_stable,hill_max_multiplier";
 
 fn events(events: &[Event]) -> String {
     events
@@ -54,6 +64,8 @@ pub struct Sink<'a> {
     pub subharmonic: usize,
     /// `--stability`: write `stable,max_multiplier`.
     pub stability: bool,
+    /// `--hill`: write `hill_stable,hill_max_multiplier`.
+    pub hill: bool,
 }
 
 impl Sink<'_> {
@@ -116,13 +128,16 @@ impl Sink<'_> {
         format!(",{label},{},{harmonic}", p.branch)
     }
 
-    /// [`stability_cells`], or nothing without `--stability`.
+    /// [`stability_cells`] and [`hill_cells`], or nothing without `--stability` and `--hill`.
     fn stability(&self, p: &BackbonePoint) -> String {
+        let mut cells = String::new();
         if self.stability {
-            stability_cells(p)
-        } else {
-            String::new()
+            cells.push_str(&stability_cells(p));
         }
+        if self.hill {
+            cells.push_str(&hill_cells(p));
+        }
+        cells
     }
 
     /// Writes the row of `p`, a point of `problem` (whose system is the one at the point's
@@ -205,17 +220,35 @@ pub fn verification_cells(p: &BackbonePoint) -> String {
 /// `Floquet::max_multiplier`; empty for a point without multipliers (with a message when it
 /// converged).
 pub fn stability_cells(p: &BackbonePoint) -> String {
-    match &p.stability {
-        Some(Ok(f)) => {
-            let stable = match f.verdict {
+    let outcome = (p.stability.as_ref()).map(|r| r.as_ref().map(|f| (f.verdict, f.max_multiplier)));
+    verdict_cells(p.step, "multipliers", outcome)
+}
+
+/// `,hill_stable,hill_max_multiplier` of a point, as [`stability_cells`] for
+/// `HillSpectrum`.
+pub fn hill_cells(p: &BackbonePoint) -> String {
+    let outcome = (p.hill.as_ref()).map(|r| r.as_ref().map(|h| (h.verdict, h.max_multiplier)));
+    verdict_cells(p.step, "Hill exponents", outcome)
+}
+
+/// `,verdict,max_multiplier` of step `step`'s outcome; empty cells (with a message naming
+/// `what` for an error) where there is none.
+fn verdict_cells<E: std::fmt::Display>(
+    step: usize,
+    what: &str,
+    outcome: Option<Result<(Verdict, f64), E>>,
+) -> String {
+    match outcome {
+        Some(Ok((verdict, max_multiplier))) => {
+            let stable = match verdict {
                 Verdict::Stable => "true",
                 Verdict::Unstable(_) => "false",
                 Verdict::Unresolved => "unresolved",
             };
-            format!(",{stable},{:.10e}", f.max_multiplier)
+            format!(",{stable},{max_multiplier:.10e}")
         }
         Some(Err(e)) => {
-            eprintln!("backbone: no multipliers for step {}: {e}", p.step);
+            eprintln!("backbone: no {what} for step {step}: {e}");
             ",,".to_string()
         }
         None => ",,".to_string(),

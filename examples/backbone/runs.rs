@@ -12,7 +12,7 @@ use nonsmooth_modes::branches::{
 };
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton, Solver};
-use nonsmooth_modes::stability::StabilityOptions;
+use nonsmooth_modes::stability::{HillOptions, StabilityOptions};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -27,7 +27,11 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
     if a.full_basis {
         return run_full_basis(a, &system, &request(a, &system, (t0, t1))?, (t0, t1), out);
     }
-    writeln!(out, "{}", header(a.verify, a.subharmonic, a.stability))?;
+    writeln!(
+        out,
+        "{}",
+        header(a.verify, a.subharmonic, a.stability, a.hill)
+    )?;
     let mut sink = Sink {
         out,
         verify: a.verify,
@@ -40,6 +44,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         progress: a.progress,
         subharmonic: a.subharmonic,
         stability: a.stability,
+        hill: a.hill,
     };
     if a.parameter != Parameter::Omega && a.parameter != Parameter::Energy {
         run_parameter(a, t0, &mut sink)?;
@@ -156,6 +161,9 @@ fn request(
     }
     if a.stability {
         request.stability = Some(StabilityOptions::default());
+    }
+    if a.hill {
+        request.hill = Some(HillOptions::default());
     }
     Ok(request)
 }

@@ -284,6 +284,7 @@ pub fn solved_point(
         character: None,
         label: None,
         stability: None,
+        hill: None,
     })
 }
 

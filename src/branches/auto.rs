@@ -59,6 +59,7 @@ pub(crate) fn judged_auto(
         },
         // The lifted points get the multipliers the request asks; the coarse ones need none.
         stability: None,
+        hill: None,
         ..request.clone()
     };
     let Ok(coarse_problem) = NonsmoothSystem::new(system, coarse.settings) else {

@@ -86,6 +86,7 @@ mod tests {
             character: None,
             label,
             stability: None,
+            hill: None,
         }
     }
 

@@ -161,6 +161,7 @@ pub(crate) fn lifted_points(
             character: None,
             label: None,
             stability: None,
+            hill: None,
         });
     }
     lifted

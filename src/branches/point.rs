@@ -2,11 +2,11 @@
 //! with its status, and the reason it ended. A run that stalls or is stopped keeps its points.
 
 use crate::continuation::{EndReason, Event, Point};
-use crate::error::{ContinuationError, SettingsError, SolveError};
+use crate::error::{ContinuationError, Error, SettingsError, SolveError};
 use crate::fourier::{frequency_of_period, period_of_frequency, Basis};
 use crate::modal::{Character, Label};
 use crate::solution::Solution;
-use crate::stability::{Floquet, StabilityError};
+use crate::stability::{Floquet, HillSpectrum, StabilityError};
 use crate::system::NonsmoothSystem;
 use crate::verify::PeriodicityReport;
 use std::ops::ControlFlow;
@@ -61,6 +61,14 @@ pub struct BackbonePoint {
         serde(serialize_with = "crate::stability::serialize_outcome")
     )]
     pub stability: Option<Result<Floquet, StabilityError>>,
+    /// The Hill exponents of a converged point and their verdict, where they were asked
+    /// ([`Request::hill`](crate::branches::Request::hill)): the stability of the truncated
+    /// harmonic-balance equations, a cross-check of [`BackbonePoint::stability`].
+    #[cfg_attr(
+        feature = "serde",
+        serde(serialize_with = "crate::stability::serialize_outcome")
+    )]
+    pub hill: Option<Result<HillSpectrum, Error>>,
 }
 
 impl BackbonePoint {
@@ -116,6 +124,7 @@ impl BackbonePoint {
             character: None,
             label: None,
             stability: None,
+            hill: None,
         }
     }
 }

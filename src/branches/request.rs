@@ -9,7 +9,7 @@ use crate::branches::switch::SwitchAt;
 use crate::continuation::Speculation;
 use crate::error::SolveError;
 use crate::solve::{NewtonOptions, SemismoothNewton, Solver};
-use crate::stability::StabilityOptions;
+use crate::stability::{HillOptions, StabilityOptions};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use crate::verify::PeriodicityOptions;
 
@@ -188,6 +188,9 @@ pub struct Request {
     /// Compute the Floquet multipliers of every converged point
     /// ([`stability`](crate::stability); `None`: no stability).
     pub stability: Option<StabilityOptions>,
+    /// Compute the Hill exponents of every converged point ([`hill`](fn@crate::stability::hill);
+    /// `None`: none), as a cross-check of [`Request::stability`].
+    pub hill: Option<HillOptions>,
 }
 
 impl Request {
@@ -204,6 +207,7 @@ impl Request {
             speculation: None,
             check: None,
             stability: None,
+            hill: None,
         }
     }
 
@@ -262,6 +266,13 @@ impl Request {
     /// `options` ([`StabilityOptions::default`] for the usual grid and tolerance).
     pub fn with_stability(mut self, options: StabilityOptions) -> Self {
         self.stability = Some(options);
+        self
+    }
+
+    /// The same request with the Hill exponents of every converged point, computed with
+    /// `options` ([`HillOptions::default`] for the usual search).
+    pub fn with_hill(mut self, options: HillOptions) -> Self {
+        self.hill = Some(options);
         self
     }
 

@@ -10,8 +10,8 @@ use crate::fourier::{Basis, CosineBasis};
 use crate::modal::linear::{natural_frequency_values, Resolution};
 use crate::modal::{character, label, nearest_mode, ContactState};
 use crate::solution::Solution;
-use crate::stability::{floquet, Floquet, StabilityOptions, Verdict};
-use crate::system::NonsmoothSystem;
+use crate::stability::{floquet, hill, Floquet, HillOptions, StabilityOptions, Verdict};
+use crate::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use crate::verify::periodicity_check;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -98,6 +98,8 @@ pub(crate) struct Annotator<O, B: Basis = CosineBasis> {
     problem: NonsmoothSystem<B>,
     check: Option<TimeDomainCheck>,
     stability: Option<StabilityOptions>,
+    /// Hill's method on every converged point, with the run's settings.
+    hill: Option<(HillOptions, HarmonicBalanceSettings)>,
     /// The verdict of the last converged point whose multipliers were computed, and its
     /// branch.
     last_verdict: Option<(usize, Verdict)>,
@@ -118,6 +120,7 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             problem,
             check: request.check,
             stability: request.stability,
+            hill: request.hill.map(|o| (o, request.settings)),
             last_verdict: None,
             order: request.subharmonic,
             observer,
@@ -212,6 +215,10 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
                 self.stability_event(point, f);
             }
             point.stability = Some(outcome);
+        }
+        if let Some((options, settings)) = &self.hill {
+            let system = self.problem.system();
+            point.hill = Some(hill(system, *settings, &point.x, omega, options));
         }
     }
 

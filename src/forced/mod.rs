@@ -65,7 +65,7 @@
 mod excitation;
 mod measures;
 mod response;
-mod rows;
+pub(crate) mod rows;
 mod system;
 pub mod waves;
 

@@ -17,9 +17,10 @@ use crate::system::BarSystem;
 use num_complex::Complex64;
 
 /// Dense complex rows over the `2 n_bars` Helmholtz unknowns of one harmonic, with their
-/// derivatives in the fundamental frequency `Omega`.
+/// derivatives in a parameter: the fundamental frequency `Omega` for a forced system, the
+/// Floquet exponent for a Hill matrix.
 #[derive(Debug, Clone, Default)]
-pub(super) struct Block {
+pub(crate) struct Block {
     width: usize,
     values: Vec<Complex64>,
     d_omega: Vec<Complex64>,
@@ -36,7 +37,7 @@ impl Block {
     }
 
     /// Row `r`: its values and their derivative.
-    pub(super) fn row(&self, r: usize) -> (&[Complex64], &[Complex64]) {
+    pub(crate) fn row(&self, r: usize) -> (&[Complex64], &[Complex64]) {
         let range = r * self.width..(r + 1) * self.width;
         (&self.values[range.clone()], &self.d_omega[range])
     }
@@ -44,27 +45,15 @@ impl Block {
 
 /// The rows of harmonic `n` of a damped system at one fundamental frequency.
 #[derive(Debug, Clone, Default)]
-pub(super) struct DampedRows {
-    pub(super) linear: Block,
-    pub(super) gap: Block,
-    pub(super) force: Block,
+pub(crate) struct DampedRows {
+    pub(crate) linear: Block,
+    pub(crate) gap: Block,
+    pub(crate) force: Block,
 }
 
-/// The bars' damped maps of harmonic `n` at `omega`, with `d kappa / d Omega` of each bar.
-fn maps(system: &BarSystem, n: usize, omega: f64, damping: &[f64]) -> Vec<(DampedMap, Complex64)> {
-    system
-        .bars()
-        .iter()
-        .zip(damping)
-        .map(|(bar, &eta)| {
-            let (kappa, d_kappa) = squared_wavenumber(bar, n, omega, eta);
-            (DampedMap::new(bar.length(), kappa), d_kappa)
-        })
-        .collect()
-}
-
-/// Adds `term` (at harmonic `n`) to the complex row `row`, and its `Omega`-derivative to
-/// `d_row`.
+/// Adds `term` (at harmonic `n`) to the complex row `row`, and its derivative to `d_row`
+/// (through each bar's `d kappa` in `maps`, and through the term's coefficient as a
+/// function of `n Omega`).
 fn add_term(
     term: &Term,
     n: usize,
@@ -114,14 +103,32 @@ fn block<'t>(
 impl DampedRows {
     /// The rows of harmonic `n` of `system` at fundamental frequency `omega`, with damping
     /// `damping[b]` in bar `b`; `laws` are the observables `(gap, force)` of its laws.
-    pub(super) fn new(
+    pub(crate) fn new(
         system: &BarSystem,
         laws: &[(Observable, Observable)],
         n: usize,
         omega: f64,
         damping: &[f64],
     ) -> Self {
-        let maps = maps(system, n, omega, damping);
+        let kappas: Vec<_> = (system.bars().iter().zip(damping))
+            .map(|(bar, &eta)| squared_wavenumber(bar, n, omega, eta))
+            .collect();
+        Self::at_wavenumbers(system, laws, n, omega, &kappas)
+    }
+
+    /// The rows of harmonic `n` of `system` (its conditions at fundamental frequency
+    /// `omega`) with bar `b` at the squared wave number `kappas[b].0`, whose derivative in
+    /// the rows' parameter is `kappas[b].1`.
+    pub(crate) fn at_wavenumbers(
+        system: &BarSystem,
+        laws: &[(Observable, Observable)],
+        n: usize,
+        omega: f64,
+        kappas: &[(Complex64, Complex64)],
+    ) -> Self {
+        let maps: Vec<(DampedMap, Complex64)> = (system.bars().iter().zip(kappas))
+            .map(|(bar, &(kappa, d_kappa))| (DampedMap::new(bar.length(), kappa), d_kappa))
+            .collect();
         let stiffness = |e: EndRef| system.stiffness_at(e);
         let mut rows = LinearRows::new();
         for condition in system.conditions() {

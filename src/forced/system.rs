@@ -85,6 +85,29 @@ impl ForcedSystem {
         settings: HarmonicBalanceSettings,
         forcing: &Forcing,
     ) -> Result<Self, Error> {
+        let mut free = Self::free(system, settings)?;
+        free.damping = forcing.damping.per_bar(system)?;
+        if forcing.excitations.is_empty() {
+            return Err(ForcingError::NoExcitation.into());
+        }
+        free.driven = (forcing.excitations.iter())
+            .map(|&e| Driven::new(system, e))
+            .collect::<Result<Vec<_>, _>>()?;
+        free.selection = Selection::for_band(settings.resonance_band, settings.harmonics)?;
+        Ok(free)
+    }
+
+    /// The autonomous harmonic-balance system of `system` in the full basis without a
+    /// phase condition: no damping, no excitation, no harmonic selection, at the
+    /// frequency set by [`ContinuationProblem::set_parameter`]. Its Jacobian at a point of a
+    /// backbone is the Hill matrix at exponent 0 ([`fn@crate::stability::hill`]).
+    ///
+    /// # Errors
+    /// As [`ForcedSystem::new`] for the harmonic settings and the system.
+    pub(crate) fn free(
+        system: &BarSystem,
+        settings: HarmonicBalanceSettings,
+    ) -> Result<Self, Error> {
         let basis = SineCosineBasis::new(settings.harmonics, settings.samples_per_harmonic)?;
         let a_c = settings.complementarity;
         check_complementarity(a_c)?;
@@ -102,20 +125,22 @@ impl ForcedSystem {
                 + 2.0 * laws * len * len
                 + 5.0 * laws * basis.samples() as f64,
         )?;
-        let damping = forcing.damping.per_bar(system)?;
-        if forcing.excitations.is_empty() {
-            return Err(ForcingError::NoExcitation.into());
-        }
-        let driven = (forcing.excitations.iter())
-            .map(|&e| Driven::new(system, e))
-            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self::unforced(system, basis, a_c, offsets))
+    }
+
+    fn unforced(
+        system: &BarSystem,
+        basis: SineCosineBasis,
+        a_c: f64,
+        offsets: Vec<(f64, f64)>,
+    ) -> Self {
+        let unknowns = system.unknowns_per_harmonic();
         let linear_count = unknowns - system.contact_count();
-        let selection = Selection::for_band(settings.resonance_band, settings.harmonics)?;
-        Ok(Self {
+        Self {
             system: system.clone(),
             complementarity: a_c,
-            damping,
-            driven,
+            damping: vec![0.0; system.bars().len()],
+            driven: Vec::new(),
             omega: f64::NAN,
             rows: Vec::new(),
             rhs: Vec::new(),
@@ -125,8 +150,8 @@ impl ForcedSystem {
             observables: system.laws().map(|l| (l.gap(), l.force())).collect(),
             unit_gram: unit_gram(&basis),
             basis,
-            selection,
-        })
+            selection: None,
+        }
     }
 
     /// The bar system.
@@ -155,7 +180,7 @@ impl ForcedSystem {
     }
 
     /// Unknowns per coefficient (`2 n_bars`).
-    pub(super) fn unknowns(&self) -> usize {
+    pub(crate) fn unknowns(&self) -> usize {
         self.unknowns
     }
 
@@ -251,6 +276,19 @@ impl ForcedSystem {
         let weights = (&s.d_gap[range.clone()], &s.d_force[range]);
         law_grams(&self.basis, &self.unit_gram, weights, (&mut g, &mut f));
         (g, f)
+    }
+
+    /// The Gram matrices `(G(w_gap), G(w_force))` of every law's generalised gradient at
+    /// `x` (`len x len` each, row-major): the law block of the Jacobian is
+    /// `G(w_gap) D_gap + G(w_force) D_force` with `D` the observables' rows.
+    pub(crate) fn law_gram_pairs(&self, x: &[f64]) -> Vec<(Vec<f64>, Vec<f64>)> {
+        let s = self.law_state(x);
+        (0..self.offsets.len()).map(|l| self.grams(&s, l)).collect()
+    }
+
+    /// The laws' observables `(gap, force)`.
+    pub(crate) fn observables(&self) -> &[(Observable, Observable)] {
+        &self.observables
     }
 
     /// The linear block (its `Omega`-derivative if `derivative`) minus the right-hand side.

@@ -82,11 +82,15 @@
 
 mod coordinates;
 mod floquet;
+pub mod hill;
 mod monodromy;
 mod shooting;
 
 pub use crate::error::StabilityError;
 pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
+pub use hill::{
+    hill, Exponent, HillOptions, HillSpectrum, HILL_RESIDUAL, MAX_HILL_DIMENSION, MIN_ALIGNMENT,
+};
 
 use crate::bar::shortest_travel_time;
 use crate::fourier::{period_of_frequency, Basis};
@@ -432,16 +436,17 @@ pub fn floquet<B: Basis>(
     floquet_of_state(&initial, period, options)
 }
 
-/// Serializes a point's stability outcome: the [`Floquet`] report, or `{"error": message}`.
+/// Serializes a point's stability outcome: the report ([`Floquet`], [`HillSpectrum`]), or
+/// `{"error": message}`.
 #[cfg(feature = "serde")]
-pub(crate) fn serialize_outcome<S: serde::Serializer>(
-    outcome: &Option<Result<Floquet, StabilityError>>,
+pub(crate) fn serialize_outcome<S: serde::Serializer, T: serde::Serialize, E: std::fmt::Display>(
+    outcome: &Option<Result<T, E>>,
     serializer: S,
 ) -> Result<S::Ok, S::Error> {
     use serde::ser::SerializeMap;
     match outcome {
         None => serializer.serialize_none(),
-        Some(Ok(floquet)) => serializer.serialize_some(floquet),
+        Some(Ok(report)) => serializer.serialize_some(report),
         Some(Err(error)) => {
             let mut map = serializer.serialize_map(Some(1))?;
             map.serialize_entry("error", &error.to_string())?;

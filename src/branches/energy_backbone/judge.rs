@@ -281,6 +281,7 @@ impl Judge {
                 character: None,
                 label: None,
                 stability: None,
+                hill: None,
             };
             if see(point).is_break() {
                 return Walk::Stopped;

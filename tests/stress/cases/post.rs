@@ -6,7 +6,8 @@ use crate::checks::{moderate_motion, typed, CaseResult, Checks};
 use crate::draw::Draw;
 use nonsmooth_modes::fourier::{Basis, MEMORY_BUDGET_BYTES};
 use nonsmooth_modes::modal::{branch_seed, diagnose, energy, grazing_energy, law_history};
-use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
+use nonsmooth_modes::stability::{hill, HillOptions};
+use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use nonsmooth_modes::verify::{periodicity_check, PeriodicityOptions, SpringUpdate};
 use nonsmooth_modes::{SettingsError, Solution};
 use std::f64::consts::PI;
@@ -74,6 +75,7 @@ pub(crate) fn post_processing(d: &mut Draw, c: &mut Checks) -> CaseResult {
             c.exact("law history", v);
         }
     }
+    hill_case(d, c, (&system, s), &x, omega);
     let solution = typed(c, "Solution::new", Solution::new(&problem, &x, omega))?;
     c.finite("period", [&solution.period()]);
     let end = if d.flag("foreign end", 0.1) {
@@ -230,5 +232,37 @@ fn budget_consistent<T>(
         }),
         Ok(_) => c.expect(!over, || format!("{what}: {bytes:e} bytes not refused")),
         Err(_) => {}
+    }
+}
+
+/// Hill's method at the motion `x` (any scale, any frequency, maybe the wrong length) with
+/// drawn options: finite exponents, residuals and `max_multiplier >= 1`, or a typed error.
+fn hill_case(
+    d: &mut Draw,
+    c: &mut Checks,
+    (system, settings): (&BarSystem, HarmonicBalanceSettings),
+    x: &[f64],
+    omega: f64,
+) {
+    let options = HillOptions {
+        tolerance: d.real("hill tolerance", 1e-6..=1e-1),
+        max_modulus: d.real("hill max modulus", 1.5..=1e3),
+        shifts_per_frequency: d.size("hill shifts", 1..=8),
+    };
+    match hill(system, settings, x, omega, &options) {
+        Ok(h) => {
+            c.finite(
+                "hill",
+                [&h.max_multiplier, &h.residual, &h.time_shift_residual],
+            );
+            c.finite("hill", h.trivial_distance.iter());
+            c.finite("hill", h.exponents.iter().flat_map(|e| [&e.re, &e.im]));
+            c.expect(h.max_multiplier >= 1.0, || {
+                format!("hill: max_multiplier {} below 1", h.max_multiplier)
+            });
+        }
+        Err(e) => {
+            c.error("hill", &e);
+        }
     }
 }
