@@ -46,9 +46,13 @@
 //!
 //! The exponents are those of the **truncated** equations at the point: they differ from
 //! the exact map's where truncation matters. The time shift of the motion is an exponent 0
-//! only up to the sampling of the laws ([`HillSpectrum::time_shift_residual`] measures it);
-//! spurious exponents of high harmonics may come with small positive real parts; Hill's
-//! error bounds assume smooth motions, and a motion with impacts is not one. The search is
+//! only up to the sampling of the laws ([`HillSpectrum::time_shift_residual`] measures it),
+//! and with the family direction it forms a Jordan block that this perturbation splits by
+//! its square root ([`HillSpectrum::trivial_distance`]): that pair is left out of the
+//! verdict. On the paper's systems the truncated equations have exponents with positive
+//! real parts at most points, where the exact map finds the motion stable, and more
+//! harmonics do not remove them: Hill's error bounds assume smooth motions, and a motion
+//! with impacts is not one. The crate's verdicts are the exact map's. The search is
 //! a grid of local linearisations, so an exponent may be missed where `H` varies much
 //! within a cell (many bars of very different travel times); it reports how many shifts it
 //! used and where it stopped ([`HillSpectrum::search_modulus`]). `docs/validation.md`
@@ -193,7 +197,7 @@ pub struct HillSpectrum {
     pub residual: f64,
     /// The multiplier modulus up to which the search looked (`max_modulus`).
     pub search_modulus: f64,
-    /// Shifts of the search, and candidates refined.
+    /// Shifts of the search.
     pub shifts: usize,
     /// Candidates refined by inverse iteration.
     pub refined: usize,
