@@ -184,17 +184,6 @@ impl ForcedSystem {
         self.unknowns
     }
 
-    /// The partner of coefficient `i` (the sine of a cosine, the cosine of a sine) with the
-    /// sign `sigma` of [`real_form`]; `None` for the constant.
-    fn partner(&self, i: usize) -> Option<(usize, f64)> {
-        let m = self.basis.harmonics();
-        match i {
-            0 => None,
-            i if i <= m => Some((m + i, 1.0)),
-            i => Some((i - m, -1.0)),
-        }
-    }
-
     /// The unknowns of coefficient `i` of `x`, and those of its partner with its sign.
     pub(super) fn blocks<'x>(
         &self,
@@ -205,7 +194,7 @@ impl ForcedSystem {
         let block = |j: usize| &x[j * u..(j + 1) * u];
         (
             block(i),
-            self.partner(i).map(|(p, sigma)| (block(p), sigma)),
+            self.basis.partner(i).map(|(p, sigma)| (block(p), sigma)),
         )
     }
 
@@ -365,7 +354,7 @@ impl ForcedSystem {
         for (k, a) in row.iter().enumerate() {
             jac[(target, i * u + k)] += scale * a.re;
         }
-        if let Some((p, sigma)) = self.partner(i) {
+        if let Some((p, sigma)) = self.basis.partner(i) {
             for (k, a) in row.iter().enumerate() {
                 jac[(target, p * u + k)] += scale * sigma * a.im;
             }

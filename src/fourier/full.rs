@@ -140,6 +140,20 @@ thread_local! {
     static BUFFERS: Cell<Buffers> = Cell::new(Buffers::default());
 }
 
+impl SineCosineBasis {
+    /// The partner of coefficient `i` (the sine of a cosine, the cosine of a sine) with the
+    /// sign `sigma` its term takes in a row that couples them (`+1` on a cosine's row, `-1`
+    /// on a sine's); `None` for the constant.
+    pub(crate) fn partner(&self, i: usize) -> Option<(usize, f64)> {
+        let m = self.harmonics;
+        match i {
+            0 => None,
+            i if i <= m => Some((m + i, 1.0)),
+            i => Some((i - m, -1.0)),
+        }
+    }
+}
+
 impl Basis for SineCosineBasis {
     fn len(&self) -> usize {
         2 * self.harmonics + 1

@@ -12,6 +12,7 @@ mod condense;
 pub mod family;
 mod layout;
 mod phase;
+pub(crate) use phase::shift_of;
 pub mod problem;
 pub mod rows;
 

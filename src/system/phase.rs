@@ -50,7 +50,7 @@ pub struct PhaseLocked {
 /// `D x` for a full-basis vector of `m` harmonics with `per` values per coefficient
 /// (coefficient-major, cosine `n` at `n`, sine `n` at `m + n`): each of its signals
 /// differentiated in `theta`, `(c_n, s_n) -> (n s_n, -n c_n)`.
-fn shift_of(x: &[f64], m: usize, per: usize) -> Vec<f64> {
+pub(crate) fn shift_of(x: &[f64], m: usize, per: usize) -> Vec<f64> {
     let mut out = vec![0.0; x.len()];
     for n in 1..=m {
         let (cosine, sine) = (n * per, (m + n) * per);

@@ -5,7 +5,7 @@ use crate::bc::{LinearRows, Observable};
 use crate::error::{Error, StabilityError};
 use crate::forced::rows::{Block, DampedRows};
 use crate::forced::ForcedSystem;
-use crate::fourier::Basis;
+use crate::fourier::{Basis, SineCosineBasis};
 use crate::system::BarSystem;
 use faer::{c64, Mat};
 
@@ -17,7 +17,7 @@ pub(super) struct HillMatrix {
     observables: Vec<(Observable, Observable)>,
     /// `(G(w_gap), G(w_force))` of each law at the point.
     grams: Vec<(Vec<f64>, Vec<f64>)>,
-    harmonics: usize,
+    basis: SineCosineBasis,
     /// Unknowns per coefficient (`2 n_bars`).
     unknowns: usize,
     /// Linear rows per coefficient.
@@ -38,7 +38,7 @@ impl HillMatrix {
         Ok(Self {
             observables: free.observables().to_vec(),
             grams: free.law_gram_pairs(x),
-            harmonics: free.basis().harmonics(),
+            basis: free.basis().clone(),
             unknowns,
             linear_count: unknowns - system.contact_count(),
             omega,
@@ -48,9 +48,9 @@ impl HillMatrix {
 
     /// The share of `v`'s squared norm on the coefficients of harmonics above `3 m / 4`.
     pub(super) fn high_harmonic_share(&self, v: &faer::Col<c64>) -> f64 {
-        let (u, m) = (self.unknowns, self.harmonics);
+        let (u, m) = (self.unknowns, self.basis.harmonics());
         let (mut high, mut total) = (0.0, 0.0);
-        for i in 0..2 * m + 1 {
+        for i in 0..self.basis.len() {
             let (n, _) = self.coefficient(i);
             let w: f64 = (0..u).map(|k| v[i * u + k].norm_sqr()).sum();
             total += w;
@@ -67,14 +67,14 @@ impl HillMatrix {
 
     /// Rows (and columns) of `H`.
     pub(super) fn dimension(&self) -> usize {
-        (2 * self.harmonics + 1) * self.unknowns
+        self.basis.len() * self.unknowns
     }
 
     /// `H(lambda)` and `dH/dlambda`.
     pub(super) fn at(&self, lambda: c64) -> (Mat<c64>, Mat<c64>) {
-        let (len, rc, dim) = (2 * self.harmonics + 1, self.linear_count, self.dimension());
+        let (len, rc, dim) = (self.basis.len(), self.linear_count, self.dimension());
         let mut out = (Mat::<c64>::zeros(dim, dim), Mat::<c64>::zeros(dim, dim));
-        let rows: Vec<(DampedRows, DampedRows)> = (0..=self.harmonics)
+        let rows: Vec<(DampedRows, DampedRows)> = (0..=self.basis.harmonics())
             .map(|n| (self.rows(n, lambda, 1.0), self.rows(n, lambda, -1.0)))
             .collect();
         for i in 0..len {
@@ -125,15 +125,9 @@ impl HillMatrix {
         DampedRows::at_wavenumbers(&self.system, &self.observables, n, self.omega, &kappas)
     }
 
-    /// The harmonic of coefficient `i` of the full basis, and its partner (the sine of a
-    /// cosine, the cosine of a sine) with the sign `sigma` of its term.
+    /// The harmonic of coefficient `i` and its partner ([`SineCosineBasis::partner`]).
     fn coefficient(&self, i: usize) -> (usize, Option<(usize, f64)>) {
-        let m = self.harmonics;
-        match i {
-            0 => (0, None),
-            i if i <= m => (i, Some((m + i, 1.0))),
-            i => (i - m, Some((i - m, -1.0))),
-        }
+        (self.basis.harmonic(i), self.basis.partner(i))
     }
 
     /// Adds `scale` times row `r` of the pair of blocks `(plus, minus)` (the rows at the

@@ -67,7 +67,7 @@ use crate::forced::ForcedSystem;
 use crate::fourier::{period_of_frequency, Basis};
 use crate::modal::inputs::{check_finite, check_frequency_of};
 use crate::solve::{Problem, Structured};
-use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
+use crate::system::{shift_of, BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use faer::linalg::solvers::Solve;
 use faer::{c64, Col};
 use matrix::HillMatrix;
@@ -266,7 +266,7 @@ pub fn hill(
         .iter()
         .map(|v| v / largest.max(f64::MIN_POSITIVE))
         .collect();
-    let dx = time_derivative(&unit, m, omega);
+    let dx = shift_of(&unit, m, unit.len() / (2 * m + 1));
     let trivial = (found.near_zero.iter())
         .map(|(e, v)| (e, alignment(v, &dx)))
         .filter(|(_, a)| *a >= MIN_ALIGNMENT)
@@ -367,21 +367,6 @@ fn alignment(v: &Col<c64>, dx: &[f64]) -> f64 {
     } else {
         0.0
     }
-}
-
-/// The time derivative of the full-basis state `x` of `m` harmonics at frequency `omega`.
-fn time_derivative(x: &[f64], m: usize, omega: f64) -> Vec<f64> {
-    let per = x.len() / (2 * m + 1);
-    let mut dx = vec![0.0; x.len()];
-    for n in 1..=m {
-        let (c, s) = (n * per, (m + n) * per);
-        for k in 0..per {
-            // d/dt (a cos + b sin) = n Omega (b cos - a sin)
-            dx[c + k] = n as f64 * omega * x[s + k];
-            dx[s + k] = -(n as f64) * omega * x[c + k];
-        }
-    }
-    dx
 }
 
 /// `|H(0) x'| / (|H(0)|_F |x'|)` for the time derivative `dx` of a point.
