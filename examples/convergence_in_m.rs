@@ -10,7 +10,8 @@
 //! Each way of computing the branch runs over the system's own period grid
 //! ([`BackboneOptions::for_mode`], 181 periods) at each `m`:
 //! - `grid`: the period grid ([`Method::PeriodGrid`]);
-//! - `auto`: [`Method::Auto`] (which lifts its run at `m / 2` where its own falls short);
+//! - `auto`: [`Method::Auto`] (which lifts its run at `m / 2` where its own falls short,
+//!   and keeps the paper's equations or harmonic selection, whichever covers more periods);
 //! - `auto-checked`: the same with the time-domain check ([`TimeDomainCheck::for_system`]),
 //!   by which `Auto` judges its runs;
 //! - `lifted`: the grid at the first `m`, each later `m` lifted from the one before it

@@ -6,7 +6,7 @@
 //!
 //! `--out` (default `gallery/`) receives:
 //! - `stability_clamped.svg` and `.csv`: the clamped bar's first nonsmooth mode at `m = 20`
-//!   (the default request, [`Method::Auto`] on the system's grid) with the Floquet verdict of
+//!   (the paper's equations, [`Method::PeriodGrid`] on the system's grid) with the Floquet verdict of
 //!   every converged point ([`nonsmooth_modes::stability`]): stable runs solid, unstable runs
 //!   dashed, points without a verdict hollow; the exact family, stable at every period
 //!   checked, as a black line; and the largest multiplier modulus of every point with a
@@ -38,7 +38,8 @@
 
 use nonsmooth_modes::branches::{
     compute, full_basis_branch, full_basis_system, quadrature_start, shift_origin,
-    symmetry_instant, with_harmonics, BackbonePoint, FullBasisPoint, Request, TimeDomainCheck,
+    symmetry_instant, with_harmonics, BackboneOptions, BackbonePoint, FullBasisPoint, Method,
+    Request, TimeDomainCheck,
 };
 use nonsmooth_modes::forced::{
     forced_response, Damping, Excitation, Forcing, ResponseMethod, ResponseRequest,
@@ -74,10 +75,13 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         cells_per_travel: cells,
         ..StabilityOptions::default()
     };
-    let result = compute(
-        &system,
-        &Request::new(1).harmonics(20).with_stability(options),
-    )?;
+    // The paper's equations: the points `docs/validation.md` ("Stability") discusses.
+    let grid = BackboneOptions::for_mode(&system, 1, 1)?;
+    let request = Request::new(1)
+        .harmonics(20)
+        .method(Method::PeriodGrid(grid))
+        .with_stability(options);
+    let result = compute(&system, &request)?;
     // omega_1 = pi c / (2 l) for the clamped-free unit bar.
     let omega_1 = std::f64::consts::FRAC_PI_2;
     let points: Vec<&BackbonePoint> = result.converged().collect();

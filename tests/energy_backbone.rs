@@ -329,7 +329,8 @@ fn the_chains_start_lies_above_the_grids_first_frequency() {
         .iter()
         .find(|p| (p.omega - start_omega).abs() <= 1e-12 * start_omega)
         .unwrap_or_else(|| panic!("no point at the start, Omega = {start_omega}"));
-    let mut problem = NonsmoothSystem::new(&chain, settings(20)).unwrap();
+    // The equations the run solved: Auto may have kept them under harmonic selection.
+    let mut problem = run.problem().clone();
     problem.set_parameter(start.omega);
     let mut f = vec![0.0; start.x.len()];
     problem.residual(&start.x, &mut f);

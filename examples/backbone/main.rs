@@ -52,10 +52,13 @@
 //!
 //! `--resonance-band C` holds at zero every harmonic `n >= 2` whose frequency lies within
 //! `C / m` (relative) of an open- or closed-contact natural frequency
-//! (`HarmonicBalanceSettings::resonance_band`; 0, the default, keeps every harmonic, and
-//! `system::RESONANCE_BAND` = 0.1 is the measured choice): the truncation's internal
-//! resonances go, and the skeleton converges as `--harmonics` grows (`docs/theory.md`,
-//! "Harmonic selection"). A band that is not finite, negative or above `m` is a usage error.
+//! (`HarmonicBalanceSettings::resonance_band`; `system::RESONANCE_BAND` = 0.1 is the measured
+//! choice): the truncation's internal resonances go, and the skeleton converges as
+//! `--harmonics` grows (`docs/theory.md`, "Harmonic selection"). Without it (or with 0),
+//! the library's choice (no `--method`) runs the branch both on the paper's equations and
+//! with band 0.1, and keeps the run whose skeleton covers more periods, as stderr says
+//! (`branches::SelectionJudgement`); a `--method` keeps every harmonic. A band that is not
+//! finite, negative or above `m` is a usage error.
 //!
 //! `--stability` asks the library for the Floquet multipliers of every converged point
 //! (`stability`, default options: 200 cells per shortest travel time, the state corrected to

@@ -84,6 +84,18 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             ),
             _ => {}
         }
+        if let Some(j) = run.selection {
+            let kept = if j.selected {
+                "the selected equations are kept"
+            } else {
+                "every harmonic is kept"
+            };
+            eprintln!(
+                "backbone: skeleton points cover {} of {} periods with harmonic selection (band \
+                 {}), {} without: {kept}",
+                j.covered_selected, j.steps, j.width, j.covered_full
+            );
+        }
         eprintln!(
             "backbone: {} ended: {:?}; {} rejected steps",
             run.method.name(),

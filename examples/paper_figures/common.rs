@@ -416,3 +416,40 @@ pub fn arclength_series(run: &Run, w1: f64, color: Rgb, markers: bool) -> [Serie
         .with_size(5);
     [line, jumps]
 }
+
+/// Frames a backbone panel on its branches: the horizontal range of the series drawn as
+/// lines or filled markers, widened by a twentieth of its width on each side. Points drawn
+/// as rings or crosses (internal resonances, isolated points, landings of the stall escape)
+/// beyond that range would otherwise set the axis and squeeze the branches into a corner;
+/// they are left out of the drawing, and the axis label says how many (the figure's CSV keeps
+/// every point).
+pub fn frame_on_branches(panel: &mut LinePanel) {
+    let apart = |s: &Series| matches!(s.marker, Some(Marker::Ring | Marker::Cross));
+    let (lo, hi) = (panel.series.iter())
+        .filter(|s| !apart(s))
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+    // No finite branch point, or a single abscissa: the plot's own range stays.
+    if lo >= hi || !lo.is_finite() {
+        return;
+    }
+    let margin = (hi - lo) / 20.0;
+    let (lo, hi) = (lo - margin, hi + margin);
+    panel.x_range = Some((lo, hi));
+    let mut left_out = 0;
+    for s in panel.series.iter_mut().filter(|s| apart(s)) {
+        let before = s.points.len();
+        s.points.retain(|p| (lo..=hi).contains(&p.0));
+        left_out += before - s.points.len();
+    }
+    // Said under the axis: a series left empty has no legend entry to say it.
+    if left_out > 0 {
+        panel.x_label = format!(
+            "{} ({left_out} points outside [{lo:.2}, {hi:.2}] not drawn)",
+            panel.x_label
+        );
+    }
+}

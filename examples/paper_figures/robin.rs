@@ -2,8 +2,8 @@
 //! fields, second mode, and the third subharmonic of the second mode.
 
 use crate::common::{
-    arclength_series, field, frequency_energy, labelled_series, map_panel, marked, omega_1,
-    point_map, series, settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_series, field, frame_on_branches, frequency_energy, labelled_series, map_panel,
+    marked, omega_1, point_map, series, settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
 };
 use crate::lettered::{contacts, labelled, nearest_with, Content, MIN_RESONANT_SHARE};
 use crate::runs::{arclength_run, continued_from, run, Branch, Run};
@@ -54,6 +54,7 @@ pub fn fig10_11(ctx: &Ctx) -> Res<(Stats, Stats)> {
     branches[1].size = 2;
     branches.extend(arclength_series(&arc, w1, PALETTE[4], false));
     let mut bb = backbone_panel("Robin bar (k = 0.5): NSM1", &branches, None);
+    frame_on_branches(&mut bb);
     bb.x_guides = vec![OMEGA_2 / 4.0 / w1];
     // Points a, b, c on the m = 40 branch, all on the skeleton (harmonic 1 dominant): a at low
     // energy and c at high energy, each with one contact per period; b around omega_2/4, where
@@ -152,7 +153,7 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
     // next steps); the converged points after that are isolated solutions, drawn apart.
     let (branch, beyond) = r.split_at_end(END_GAP, "NSM2 past its end (isolated)");
     stats.count([&branch, &beyond]);
-    let bb = backbone_panel(
+    let mut bb = backbone_panel(
         "Robin bar: NSM2, m = 20",
         &[
             labelled_series(&[(&branch, RED, Marker::Circle)], w1),
@@ -161,6 +162,7 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
         .concat(),
         None,
     );
+    frame_on_branches(&mut bb);
     // e: low energy, on the skeleton; d: among the internal resonances (a harmonic n >= 2 at
     // an open-contact natural frequency holds at least `MIN_RESONANT_SHARE` of the energy),
     // the largest local excess over its neighbours along the first unbroken run of converged

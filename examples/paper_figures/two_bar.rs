@@ -4,8 +4,9 @@
 //! interface, and a time-domain check of one point.
 
 use crate::common::{
-    arclength_series, field, frequency_energy, labelled_series, marked, omega_1, over_gap,
-    reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED, YELLOW,
+    arclength_series, field, frame_on_branches, frequency_energy, labelled_series, marked, omega_1,
+    over_gap, reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED,
+    YELLOW,
 };
 use crate::lettered;
 use crate::runs::{arclength_run, energy_run, run, solved_point, Branch, Run};
@@ -150,6 +151,7 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     let mut branches = labelled_series(&coloured, tb.w1);
     branches.extend(arclength_series(&arc, tb.w1, PALETTE[4], false));
     let mut bb = backbone_panel("(0.95, 1, 1): backbones, m = 20", &branches, None);
+    frame_on_branches(&mut bb);
     let w12 = OMEGA_1_BAR_2;
     bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1, 3.0];
     let conv: Vec<&BackbonePoint> = tb.runs[0].converged().collect();

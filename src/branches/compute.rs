@@ -1,11 +1,11 @@
 //! The one call: a branch of a system's nonsmooth mode from a [`Request`], whatever the method.
 
-use crate::branches::auto::judged_auto;
 use crate::branches::backbone::BackboneObserver;
 use crate::branches::plan::{asked, run_plan};
 use crate::branches::point::BackbonePoint;
 use crate::branches::request::Request;
 use crate::branches::result::{Annotator, ModeBranches};
+use crate::branches::selected::judged_with_selection;
 use crate::error::Error;
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::ops::ControlFlow;
@@ -45,6 +45,18 @@ use std::ops::ControlFlow;
 ///   corrects what it misses. The run with more good points is returned
 ///   ([`AutoChoice::Lifted`](crate::branches::AutoChoice::Lifted) when it is the lifted
 ///   one).
+///
+/// - Where the request keeps every harmonic (a band of 0, the default) and asks for the
+///   mode's own branch (order 1), all of the above runs twice: on the paper's equations and
+///   under harmonic selection of band
+///   [`RESONANCE_BAND`](crate::system::RESONANCE_BAND), on two threads when the request
+///   allows a second core ([`Request::speculation`]). The run whose converged skeleton
+///   points (verified, where the request asks for the check) cover more periods of the grid
+///   is returned, a tie keeping the paper's equations ([`ModeBranches::selection`]): the
+///   selection removes the truncation's internal resonances, so that the skeleton converges
+///   in `m` (`docs/theory.md`, "Harmonic selection"), but on assemblies with dense natural
+///   frequencies it can drop harmonics the motion needs. [`ModeBranches::problem`] gives
+///   the equations the points solve.
 ///
 /// The choice is [`ModeBranches::auto`]. `Auto`'s points reach an observer
 /// ([`compute_observed`]) once its runs are judged.
@@ -91,10 +103,13 @@ pub fn compute_observed(
         Ok(planned) => planned,
         Err(given) => {
             // Auto's runs are judged before they are shown.
-            let (run, method, auto, problem) = judged_auto(system, request, given, problem)?;
+            let ((run, method, auto, problem), selection) =
+                judged_with_selection(system, request, given, problem)?;
             let mut annotator = Annotator::new(problem, request, observer);
             let end = annotator.replay(run.points, run.end);
-            return Ok(annotator.finish((method, auto), run.e_g, end, run.rejected));
+            let mut result = annotator.finish((method, auto), run.e_g, end, run.rejected);
+            result.selection = selection;
+            return Ok(result);
         }
     };
     let mut annotator = Annotator::new(problem, request, observer);

@@ -61,33 +61,9 @@ pub fn group_by_label(points: &[BackbonePoint]) -> Vec<PointGroup<'_>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::branches::point::PointStatus;
 
     fn point(step: usize, label: Option<Label>, converged: bool) -> BackbonePoint {
-        BackbonePoint {
-            step,
-            period: 4.0 - 0.01 * step as f64,
-            omega: 1.0,
-            x: vec![0.0],
-            energy: 1.0,
-            energy_normalized: 1.0,
-            converged,
-            status: if converged {
-                PointStatus::Converged
-            } else {
-                PointStatus::CollapsedToRest
-            },
-            residual_norm: 0.0,
-            iterations: 1,
-            step_size: 0.01,
-            events: Vec::new(),
-            branch: 0,
-            time_domain: None,
-            character: None,
-            label,
-            stability: None,
-            hill: None,
-        }
+        BackbonePoint::for_test(step, 4.0 - 0.01 * step as f64, label, converged)
     }
 
     #[test]

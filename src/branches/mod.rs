@@ -20,6 +20,7 @@ mod plan;
 mod point;
 mod request;
 mod result;
+mod selected;
 mod start;
 mod subharmonic;
 mod switch;
@@ -46,7 +47,7 @@ pub use level::EnergyLevel;
 pub use lift::lift;
 pub use parameter::{parameter_branch, ParameterSteps};
 pub use point::{Backbone, BackbonePoint, PointStatus};
-pub use request::{AutoChoice, Method, Request, TimeDomainCheck};
+pub use request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 pub use result::ModeBranches;
 pub use start::{
     BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, MIN_COARSE_HARMONICS, RIGID_AMPLITUDES,

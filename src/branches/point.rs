@@ -129,6 +129,43 @@ impl BackbonePoint {
     }
 }
 
+#[cfg(test)]
+impl BackbonePoint {
+    /// A point of unit energy at step `step` and period `period`, with `label`, converged
+    /// or collapsed to rest (for tests of what reads labels and periods).
+    pub(crate) fn for_test(
+        step: usize,
+        period: f64,
+        label: Option<crate::modal::Label>,
+        converged: bool,
+    ) -> Self {
+        Self {
+            step,
+            period,
+            omega: 1.0,
+            x: vec![0.0],
+            energy: 1.0,
+            energy_normalized: 1.0,
+            converged,
+            status: if converged {
+                PointStatus::Converged
+            } else {
+                PointStatus::CollapsedToRest
+            },
+            residual_norm: 0.0,
+            iterations: 1,
+            step_size: 0.01,
+            events: Vec::new(),
+            branch: 0,
+            time_domain: None,
+            character: None,
+            label,
+            stability: None,
+            hill: None,
+        }
+    }
+}
+
 /// The period `T` and fundamental frequency `Omega` of a point: the one its driver holds as
 /// its parameter, kept as it is, and the other derived from it once
 /// ([`frequency_of_period`], [`period_of_frequency`]): a point's period and frequency never

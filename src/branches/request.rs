@@ -25,7 +25,9 @@ pub enum Method {
     /// genuine subharmonic for an order `K >= 2`, otherwise the period grid where the branch
     /// can be entered at the grid's first period, and pseudo-arclength over the grid's range
     /// (walking the branch back to its first period) where it can be entered only at a higher
-    /// frequency. The result records the choice ([`AutoChoice`]).
+    /// frequency; for a request that keeps every harmonic, both on the paper's equations and
+    /// under harmonic selection, the run whose skeleton covers more of the grid returned. The
+    /// result records the choices ([`AutoChoice`], [`SelectionJudgement`]).
     Auto(Option<BackboneOptions>),
     /// Sequential continuation over a grid of periods ([`BackboneOptions::for_mode`]).
     PeriodGrid(BackboneOptions),
@@ -121,6 +123,29 @@ pub enum AutoChoice {
         /// Good points of the best run at the request's harmonics.
         direct_good: usize,
     },
+}
+
+/// How [`Method::Auto`](crate::branches::Method::Auto) chose between the paper's equations
+/// and harmonic selection ([`ModeBranches::selection`](crate::branches::ModeBranches::selection)):
+/// the grid periods each run covers with a good point of the mode's own branch (converged,
+/// labelled [`Label::Skeleton`](crate::modal::Label::Skeleton), so neither an internal resonance nor unverified where a
+/// check was asked; a period counts once, from the point nearest it within half a grid
+/// step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct SelectionJudgement {
+    /// The selection's band width `c` ([`HarmonicBalanceSettings::resonance_band`](crate::system::HarmonicBalanceSettings::resonance_band)).
+    pub width: f64,
+    /// Grid periods covered by the run under selection (0 where it found no point).
+    pub covered_selected: usize,
+    /// Grid periods covered by the run on the paper's equations (0 where it found no
+    /// point).
+    pub covered_full: usize,
+    /// Steps of the period grid.
+    pub steps: usize,
+    /// Whether the run under selection was returned: it covers more periods (a tie keeps the
+    /// paper's equations).
+    pub selected: bool,
 }
 
 /// The time-domain check of every converged point ([`crate::verify::periodicity_check`]).
@@ -225,7 +250,7 @@ impl Request {
     }
 
     /// The same request with harmonic selection of width `width`
-    /// ([`HarmonicBalanceSettings::resonance_band`]; `RESONANCE_BAND` is the measured
+    /// ([`HarmonicBalanceSettings::resonance_band`](crate::system::HarmonicBalanceSettings::resonance_band); `RESONANCE_BAND` is the measured
     /// choice, 0 keeps every harmonic).
     pub fn resonance_band(mut self, width: f64) -> Self {
         self.settings.resonance_band = width;

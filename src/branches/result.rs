@@ -3,7 +3,7 @@
 
 use crate::branches::backbone::BackboneObserver;
 use crate::branches::point::BackbonePoint;
-use crate::branches::request::{AutoChoice, Method, Request, TimeDomainCheck};
+use crate::branches::request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
@@ -36,6 +36,11 @@ pub struct ModeBranches {
     pub rejected_steps: usize,
     /// Why the run ended.
     pub end: EndReason,
+    /// How [`Method::Auto`] chose between the paper's equations and harmonic selection
+    /// (`None` where it did not compare them: a method asked, a request with a band of its
+    /// own, or a subharmonic order). The equations the points solve are
+    /// [`ModeBranches::problem`]'s ([`NonsmoothSystem::resonance_band`](crate::system::NonsmoothSystem::resonance_band)).
+    pub selection: Option<SelectionJudgement>,
 }
 
 impl ModeBranches {
@@ -157,10 +162,14 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
 
     /// Shows points annotated by another annotator of the same request to the observer and
     /// keeps them, up to the one at which it stops the run; returns `end`, or
-    /// [`EndReason::StoppedByObserver`] if it stopped.
+    /// [`EndReason::StoppedByObserver`] if it stopped. The multipliers and Hill exponents this
+    /// request asks are added to converged points that the other run left without them.
     pub(crate) fn replay(&mut self, points: Vec<BackbonePoint>, end: EndReason) -> EndReason {
-        for point in points {
+        for mut point in points {
             self.converged += usize::from(point.converged);
+            if point.converged && point.character.is_some() {
+                self.assess(&mut point);
+            }
             let flow = self.observer.point(&point);
             self.points.push(point);
             if flow.is_break() {
@@ -208,7 +217,14 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         let natural = &self.natural;
         point.label = label(&described, self.order, omega, natural, verified).ok();
         point.character = Some(described);
-        if let Some(options) = &self.stability {
+        self.assess(point);
+    }
+
+    /// The Floquet multipliers and Hill exponents the request asks of a converged point, where
+    /// it has none yet (a point replayed from a run that did not ask them).
+    fn assess(&mut self, point: &mut BackbonePoint) {
+        let omega = point.omega;
+        if let (Some(options), None) = (&self.stability, &point.stability) {
             let (system, basis) = (self.problem.system(), self.problem.basis());
             let outcome = floquet(system, basis, &point.x, omega, options);
             if let Ok(f) = &outcome {
@@ -216,7 +232,7 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             }
             point.stability = Some(outcome);
         }
-        if let Some((options, settings)) = &self.hill {
+        if let (Some((options, settings)), None) = (&self.hill, &point.hill) {
             let system = self.problem.system();
             point.hill = Some(hill(system, *settings, &point.x, omega, options));
         }
@@ -304,6 +320,7 @@ impl<O: BackboneObserver> Annotator<O> {
             points: self.points,
             rejected_steps,
             end,
+            selection: None,
         }
     }
 }

@@ -102,6 +102,7 @@ impl Checks {
             self.backbone_point(what, p);
         }
         self.groups(what, run);
+        self.selection(what, run);
         let by_observer = run.end == EndReason::StoppedByObserver;
         if by_observer != stopped {
             self.no_end.push(format!(
@@ -135,6 +136,23 @@ impl Checks {
                 },
             );
         }
+    }
+
+    /// `Method::Auto`'s comparison with harmonic selection is consistent: its counts fit in
+    /// the grid, it kept the selection exactly when that covered more periods, and the
+    /// points solve the equations it says (the band of the run's problem).
+    fn selection(&mut self, what: &str, run: &ModeBranches) {
+        let Some(j) = run.selection else {
+            return;
+        };
+        let band = run.problem().resonance_band();
+        let consistent = j.covered_selected <= j.steps
+            && j.covered_full <= j.steps
+            && j.selected == (j.covered_selected > j.covered_full)
+            && band == if j.selected { j.width } else { 0.0 };
+        self.expect(consistent, || {
+            format!("{what}: selection {j:?} with a problem of band {band}")
+        });
     }
 
     /// Records a result that contradicts its input when `ok` is false.

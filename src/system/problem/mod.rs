@@ -71,15 +71,20 @@ pub struct HarmonicBalanceSettings {
     /// `n >= 2` is held at zero (0, the default: every harmonic kept, the paper's equations;
     /// [`RESONANCE_BAND`] is the measured choice; at most `m`). It removes the internal
     /// resonances of the truncation, so that the skeleton converges as `m` grows
-    /// (`docs/theory.md`, "Harmonic selection").
+    /// (`docs/theory.md`, "Harmonic selection"). With 0,
+    /// [`Method::Auto`](crate::branches::Method::Auto) also runs the branch with
+    /// [`RESONANCE_BAND`] and keeps the run whose skeleton covers more of its grid
+    /// ([`SelectionJudgement`](crate::branches::SelectionJudgement)).
     pub resonance_band: f64,
 }
 
 /// The width `c` of [`HarmonicBalanceSettings::resonance_band`] measured on both exact
 /// families (`docs/validation.md`, "Convergence in the number of harmonics"): narrower bands
 /// let resonances through at large `m`, wider ones drop harmonics the motion needs. On chains
-/// of several bars, whose natural frequencies are dense, it drops too many
-/// (`docs/assemblies.md`, the census).
+/// of several bars, whose natural frequencies are dense, it can drop too many
+/// (`docs/assemblies.md`, the census), which is why
+/// [`Method::Auto`](crate::branches::Method::Auto) compares it with the paper's equations
+/// instead of always applying it.
 pub const RESONANCE_BAND: f64 = 0.1;
 
 impl Default for HarmonicBalanceSettings {
