@@ -269,3 +269,57 @@ fn bad_input_is_a_typed_error() {
     let e = floquet(&system, basis, &rest, -1.0, &options(50.0)).unwrap_err();
     assert!(matches!(e, StabilityError::Verify(_)), "{e}");
 }
+
+/// `Method::Auto` judges its two runs (the paper's equations, harmonic selection) without
+/// the multipliers and Hill exponents, and adds them to the run it keeps: every converged
+/// point of the default request carries both, and its multipliers are those of the same
+/// point asked of the kept equations directly.
+#[test]
+fn auto_keeps_the_multipliers_of_the_run_it_keeps() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let grid = PeriodGrid {
+        start: 3.8,
+        end: 3.4,
+        steps: 5,
+    };
+    let options = BackboneOptions::on_grid(grid, 1, 1);
+    let mut request = Request::for_method(Method::Auto(Some(options))).harmonics(20);
+    request.stability = Some(self::options(100.0));
+    request.hill = Some(HillOptions::default());
+    let auto = compute(&system, &request).unwrap();
+    let judgement = auto.selection.expect("a comparison");
+    let band = auto.problem().resonance_band();
+    assert_eq!(
+        band,
+        if judgement.selected {
+            judgement.width
+        } else {
+            0.0
+        }
+    );
+    assert!(auto.converged().count() >= 4);
+    for p in auto.converged() {
+        assert!(
+            p.stability.is_some() && p.hill.is_some(),
+            "T = {}",
+            p.period
+        );
+    }
+    let direct = compute(
+        &system,
+        &Request {
+            method: Method::PeriodGrid(options),
+            ..request.clone().resonance_band(band)
+        },
+    )
+    .unwrap();
+    for (p, q) in auto.converged().zip(direct.converged()) {
+        assert_eq!(p.period, q.period);
+        let verdicts = |p: &nonsmooth_modes::branches::BackbonePoint| {
+            p.stability
+                .as_ref()
+                .map(|s| s.as_ref().map(|f| f.verdict).ok())
+        };
+        assert_eq!(verdicts(p), verdicts(q), "T = {}", p.period);
+    }
+}
