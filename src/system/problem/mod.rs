@@ -466,9 +466,21 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         rhs: &mut [f64],
         columns: usize,
     ) -> Option<Result<(), SingularStep>> {
-        // The condensed and banded steps solve every harmonic's equations.
         if self.active_selection().is_some() {
-            return None;
+            // The condensed step with the dropped coefficients held (the staircase solves
+            // every harmonic's equations), at the masked point as the Jacobian is.
+            return self.at_selected(x, |p, y| {
+                p.sample_laws(y);
+                let Workspace {
+                    frequency,
+                    samples,
+                    reduced,
+                    ..
+                } = &mut p.ws;
+                let dropped = p.selection.as_ref().map_or(&[][..], Selection::dropped);
+                let d = &p.description;
+                reduced.solve((d, frequency), samples, (rhs, columns), dropped)
+            });
         }
         self.sample_laws(x);
         let Workspace {
@@ -480,7 +492,7 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         let d = &self.description;
         banded
             .solve((d, frequency), samples, rhs, columns)
-            .or_else(|| reduced.solve((d, frequency), samples, rhs, columns))
+            .or_else(|| reduced.solve((d, frequency), samples, (rhs, columns), &[]))
     }
 
     /// Along a line search the observables are affine in `t`: the samples of `x` (kept from

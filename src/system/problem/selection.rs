@@ -21,8 +21,9 @@
 //! replaced by the rows `x_i = 0`, and the other equations see it as zero. The constant and
 //! the fundamental are never dropped. The set changes with `Omega`; the problem keeps its
 //! dimension, so continuation drivers follow it unchanged. While a harmonic is dropped, the
-//! Newton step factorises the masked dense Jacobian (the condensed step solves the full
-//! equations).
+//! condensed Newton step (`step.rs`) leaves its null directions out of the reduced matrix and
+//! sets its unknowns from its own rows; the staircase step of chains, which solves every
+//! harmonic's equations, gives way to it.
 
 use super::discretization::Discretization;
 use crate::error::SettingsError;
@@ -107,6 +108,11 @@ impl Selection {
     /// Whether a harmonic is dropped at the current frequency.
     pub(crate) fn active(&self) -> bool {
         !self.dropped.is_empty()
+    }
+
+    /// The basis coefficients dropped at the current frequency, ascending.
+    pub(crate) fn dropped(&self) -> &[usize] {
+        &self.dropped
     }
 
     /// The harmonics dropped at the current frequency, ascending.
@@ -225,9 +231,11 @@ impl Selection {
 #[cfg(test)]
 mod tests {
     use crate::continuation::ContinuationProblem;
-    use crate::linalg::DenseMatrix;
+    use crate::linalg::{DenseMatrix, Lu};
     use crate::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
-    use crate::solve::{residual_scale, NonlinearSolver, Problem, Solver};
+    use crate::solve::{
+        residual_scale, NonlinearSolver, Problem, Solver, Structured, PIVOT_TOLERANCE,
+    };
     use crate::system::{HarmonicBalanceSettings, NonsmoothSystem};
     use std::f64::consts::PI;
 
@@ -324,6 +332,59 @@ mod tests {
         for r in 0..n {
             let fd = (f1[r] - f0[r]) / dw;
             assert!((fd - df[r]).abs() < 1e-4 * (1.0 + fd.abs()), "row {r}");
+        }
+    }
+
+    /// The condensed step with harmonics dropped solves the masked Jacobian's system: two
+    /// right-hand sides (the residual and a fixed pattern) against a dense LU, at a point in
+    /// contact (the exact motion) and at one in the open contact, on the clamped bar and on
+    /// two bars in contact.
+    #[test]
+    fn the_condensed_step_solves_the_selected_equations() {
+        let bars = [
+            clamped_bar_with_obstacle(1e-3).unwrap(),
+            crate::reference::contact_chain(2, 1e-3, 0.5).unwrap(),
+        ];
+        for (b, system) in bars.iter().enumerate() {
+            for scale in [1.0, 0.3] {
+                let settings = HarmonicBalanceSettings {
+                    harmonics: 12,
+                    resonance_band: 0.5,
+                    ..HarmonicBalanceSettings::default()
+                };
+                let mut p = NonsmoothSystem::new(system, settings).unwrap();
+                p.set_parameter(2.0 * PI / 3.5);
+                assert!(!p.dropped_harmonics().is_empty());
+                let n = p.dimension();
+                let x: Vec<f64> = if b == 0 {
+                    ClampedFirstMode::new(1e-3, 3.5).unknowns(12)
+                } else {
+                    (0..n)
+                        .map(|k| 1e-4 * (((k * 7) % 5) as f64 - 2.0))
+                        .collect()
+                };
+                let x: Vec<f64> = x.iter().map(|v| scale * v).collect();
+                let mut rhs = vec![0.0; 2 * n];
+                p.residual(&x, &mut rhs[..n]);
+                for (k, v) in rhs[n..].iter_mut().enumerate() {
+                    *v = ((k * 37) % 11) as f64 - 5.0;
+                }
+                let mut dense = rhs.clone();
+                let mut jac = DenseMatrix::zeros(n, n);
+                p.jacobian(&x, &mut jac);
+                let lu = Lu::factor(&jac, PIVOT_TOLERANCE).unwrap();
+                dense.chunks_exact_mut(n).for_each(|c| lu.solve_in_place(c));
+                let solved = Structured::solve_jacobian(&mut p, &x, &mut rhs, 2);
+                assert!(matches!(solved, Some(Ok(()))), "system {b}: {solved:?}");
+                for (a, d) in rhs.chunks_exact(n).zip(dense.chunks_exact(n)) {
+                    let size = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+                    let error = (a.iter().zip(d)).fold(0.0_f64, |m, (u, v)| m.max((u - v).abs()));
+                    assert!(
+                        error <= 1e-9 * size,
+                        "system {b}, scale {scale}: {error:e} of {size:e}"
+                    );
+                }
+            }
         }
     }
 

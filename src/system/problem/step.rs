@@ -41,23 +41,26 @@ pub(super) struct Reduced {
 impl Reduced {
     /// Solves `J(x) z = r` in place for the `columns` right-hand sides stored one after the
     /// other in `rhs`, at the frequency of `at` and with the law samples of `samples`, which
-    /// the caller has made those of `x`. `None` where a harmonic's rows are rank-deficient
-    /// (the caller falls back to the dense Jacobian).
+    /// the caller has made those of `x`. `dropped` lists the coefficients the harmonic
+    /// selection holds at zero, ascending: their equations are `z_i = r_i` and no other
+    /// equation sees them (`selection.rs`), so their null directions leave the reduced
+    /// matrix and their law rows there become rows of the identity. `None` where a
+    /// harmonic's rows are rank-deficient (the caller falls back to the dense Jacobian).
     pub(super) fn solve<B: Basis>(
         &mut self,
         (d, at): (&Discretization<B>, &mut Frequency),
         samples: &mut Samples,
-        rhs: &mut [f64],
-        columns: usize,
+        (rhs, columns): (&mut [f64], usize),
+        dropped: &[usize],
     ) -> Option<Result<(), SingularStep>> {
         if !at.condense() {
             return None;
         }
         let at = &*at;
-        let factored = self.factor((d, at), samples);
+        let factored = self.factor((d, at), samples, dropped);
         if factored.is_ok() {
             for column in rhs.chunks_exact_mut(d.dimension()).take(columns) {
-                self.solve_one((d, at), samples, column);
+                self.solve_one((d, at), samples, column, dropped);
             }
         }
         Some(factored)
@@ -69,6 +72,7 @@ impl Reduced {
         &mut self,
         (d, at): (&Discretization<B>, &Frequency),
         samples: &mut Samples,
+        dropped: &[usize],
     ) -> Result<(), SingularStep> {
         let (len, un, rpc) = (d.basis().len(), d.unknowns, d.linear_count);
         let c = un - rpc;
@@ -93,6 +97,11 @@ impl Reduced {
                     force_z[i * c + k] = dot(frow, z);
                 }
             }
+            // A dropped coefficient's null directions are seen by no law row.
+            for &i in dropped {
+                gap_z[i * c..(i + 1) * c].fill(0.0);
+                force_z[i * c..(i + 1) * c].fill(0.0);
+            }
             // The transpose is stored (column `l len + j` of the column-major storage is
             // row `j` of the law's block): reads of the row-major Gram matrices and writes
             // are both contiguous.
@@ -104,7 +113,12 @@ impl Reduced {
                 let column = (l * len + j) * size;
                 let out = &mut matrix[column..column + size];
                 let zs = gap_z.iter().zip(force_z.iter());
-                if c == 1 {
+                if dropped.binary_search(&j).is_ok() {
+                    // The law row of a dropped coefficient: `b_(j, l) = 0` (one null
+                    // direction per law, `c` of them).
+                    out.fill(0.0);
+                    out[j * c + l] = 1.0;
+                } else if c == 1 {
                     // One contact (the common case): a plain vectorisable loop.
                     for ((m, (gz, fz)), (g, f)) in out.iter_mut().zip(zs).zip(gg.iter().zip(gf)) {
                         *m = g * gz + f * fz;
@@ -132,6 +146,7 @@ impl Reduced {
         (d, at): (&Discretization<B>, &Frequency),
         samples: &Samples,
         r: &mut [f64],
+        dropped: &[usize],
     ) {
         let (len, un, rpc) = (d.basis().len(), d.unknowns, d.linear_count);
         let c = un - rpc;
@@ -162,6 +177,10 @@ impl Reduced {
                 self.gap_p[i] = dot(rows.gap_row(l), zi);
                 self.force_p[i] = dot(rows.force_row(l), zi);
             }
+            for &i in dropped {
+                self.gap_p[i] = 0.0;
+                self.force_p[i] = 0.0;
+            }
             let (gram_gap, gram_force) = samples.grams(l, len);
             for j in 0..len {
                 let row = l * len + j;
@@ -173,6 +192,9 @@ impl Reduced {
                     - dot_lanes(gg, &self.gap_p)
                     - dot_lanes(gf, &self.force_p);
             }
+            for &j in dropped {
+                self.rhs[l * len + j] = 0.0;
+            }
         }
         self.lu.solve_transpose_in_place(&mut self.rhs);
         for i in 0..len {
@@ -183,6 +205,15 @@ impl Reduced {
                 for (d, n) in zi.iter_mut().zip(&cd.null[k * un..(k + 1) * un]) {
                     *d += b * n;
                 }
+            }
+        }
+        // A dropped coefficient solves `z_i = r_i`: its linear rows give its first `rpc`
+        // unknowns, its law rows the others.
+        for &i in dropped {
+            let zi = &mut z[i * un..(i + 1) * un];
+            zi[..rpc].copy_from_slice(&self.column[i * rpc..(i + 1) * rpc]);
+            for (l, v) in zi[rpc..].iter_mut().enumerate() {
+                *v = self.column[base + l * len + i];
             }
         }
     }
