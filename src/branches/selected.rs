@@ -10,9 +10,10 @@
 //! `m` on a bar with an obstacle; on assemblies whose natural frequencies are dense it can
 //! drop harmonics the motion needs (`docs/assemblies.md`). Neither run is better on every
 //! system, so `Auto` runs both and keeps the one with more grid periods covered by good
-//! points of the mode's own branch: a count that internal resonances, unverified points and
-//! failed steps do not raise, and that an arclength run cannot inflate by visiting one
-//! period many times.
+//! points of the mode's own branch: points labelled as internal resonances, unverified points
+//! and failed steps do not count, and an arclength run that visits one period many times
+//! counts it once. It is a proxy (a spike of the truncation whose harmonic 1 dominates counts
+//! as skeleton), which on both exact families keeps the more accurate run at every `m`.
 
 use crate::branches::auto::{judged_auto, AutoRun};
 use crate::branches::backbone::{BackboneOptions, PeriodGrid};
