@@ -73,7 +73,7 @@ fn converges_in_m(clamped: bool, bar: (f64, f64, f64, f64), floor: f64) {
         request.settings.complementarity *= bar.2 / bar.0;
         let run = compute(&system, &request).expect("a run");
         let judgement = run.selection.expect("Auto compares the two equations");
-        assert!(judgement.selected, "m = {m}: {judgement:?} for {bar:?}");
+        assert!(judgement.selected(), "m = {m}: {judgement:?} for {bar:?}");
         assert!(judgement.covered_selected > judgement.covered_full);
         assert_eq!(run.problem().resonance_band(), RESONANCE_BAND);
         let (median, within) = skeleton_errors(&run, clamped, tau);

@@ -97,6 +97,16 @@ fn a_motion_without_contact_has_every_multiplier_on_the_circle() {
     assert_eq!(f.verdict, Verdict::Stable);
 }
 
+/// The period grid `T = 3.8, 3.7, ..., 3.4` of the clamped bar's first mode.
+fn clamped_grid() -> BackboneOptions {
+    let grid = PeriodGrid {
+        start: 3.8,
+        end: 3.4,
+        steps: 5,
+    };
+    BackboneOptions::on_grid(grid, 1, 1)
+}
+
 /// The clamped bar at gap `gap` and its `m = 20` points at `T = 3.8, 3.7, ..., 3.4`, with
 /// the multipliers of each when `stability` is given.
 fn clamped_points(gap: f64, stability: Option<StabilityOptions>) -> (BarSystem, ModeBranches) {
@@ -110,12 +120,7 @@ fn clamped_points_with(
     hill: Option<HillOptions>,
 ) -> (BarSystem, ModeBranches) {
     let system = clamped_bar_with_obstacle(gap).unwrap();
-    let grid = PeriodGrid {
-        start: 3.8,
-        end: 3.4,
-        steps: 5,
-    };
-    let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
+    let method = Method::PeriodGrid(clamped_grid());
     let mut request = Request::for_method(method).harmonics(20);
     request.stability = stability;
     request.hill = hill;
@@ -277,12 +282,7 @@ fn bad_input_is_a_typed_error() {
 #[test]
 fn auto_keeps_the_multipliers_of_the_run_it_keeps() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
-    let grid = PeriodGrid {
-        start: 3.8,
-        end: 3.4,
-        steps: 5,
-    };
-    let options = BackboneOptions::on_grid(grid, 1, 1);
+    let options = clamped_grid();
     let mut request = Request::for_method(Method::Auto(Some(options))).harmonics(20);
     request.stability = Some(self::options(100.0));
     request.hill = Some(HillOptions::default());
@@ -291,7 +291,7 @@ fn auto_keeps_the_multipliers_of_the_run_it_keeps() {
     let band = auto.problem().resonance_band();
     assert_eq!(
         band,
-        if judgement.selected {
+        if judgement.selected() {
             judgement.width
         } else {
             0.0

@@ -85,7 +85,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
             _ => {}
         }
         if let Some(j) = run.selection {
-            let kept = if j.selected {
+            let kept = if j.selected() {
                 "the selected equations are kept"
             } else {
                 "every harmonic is kept"

@@ -143,9 +143,14 @@ pub struct SelectionJudgement {
     pub covered_full: usize,
     /// Steps of the period grid.
     pub steps: usize,
+}
+
+impl SelectionJudgement {
     /// Whether the run under selection was returned: it covers more periods (a tie keeps the
-    /// paper's equations).
-    pub selected: bool,
+    /// paper's equations; a run that failed covers none).
+    pub fn selected(&self) -> bool {
+        self.covered_selected > self.covered_full
+    }
 }
 
 /// The time-domain check of every converged point ([`crate::verify::periodicity_check`]).

@@ -49,7 +49,6 @@ pub(crate) fn judged_with_selection(
         hill: None,
         ..request.clone()
     };
-    let full = |problem| judged_auto(system, &judged, given, problem);
     let selected = Request {
         settings: HarmonicBalanceSettings {
             resonance_band: RESONANCE_BAND,
@@ -57,14 +56,17 @@ pub(crate) fn judged_with_selection(
         },
         ..judged.clone()
     };
-    let grid = match given {
-        Some(options) => options.grid,
-        None => BackboneOptions::for_mode(system, request.mode, request.subharmonic)?.grid,
+    // The system's grid is derived once, for both runs and the judgement.
+    let given = match given {
+        Some(options) => options,
+        None => BackboneOptions::for_mode(system, request.mode, request.subharmonic)?,
     };
+    let grid = given.grid;
+    let full = |problem| judged_auto(system, &judged, Some(given), problem);
     let Ok(selected_problem) = NonsmoothSystem::new(system, selected.settings) else {
         return Ok((full(problem)?, None));
     };
-    let held = |problem| judged_auto(system, &selected, given, problem);
+    let held = |problem| judged_auto(system, &selected, Some(given), problem);
     let (full, held) = if request.speculation.is_some() {
         std::thread::scope(|scope| {
             let worker = scope.spawn(|| held(selected_problem));
@@ -87,22 +89,10 @@ pub(crate) fn judged_with_selection(
         covered_selected: covered(&held),
         covered_full: covered(&full),
         steps: grid.steps,
-        selected: false,
     };
-    let selected = judgement.covered_selected > judgement.covered_full;
-    let kept = match (full, held) {
-        (Ok(run), Ok(other)) => Ok(if selected { other } else { run }),
-        (Ok(run), Err(_)) => Ok(run),
-        (Err(_), Ok(other)) if selected => Ok(other),
-        (Err(e), _) => Err(e),
-    }?;
-    Ok((
-        kept,
-        Some(SelectionJudgement {
-            selected,
-            ..judgement
-        }),
-    ))
+    // A failed run covers no period, so the run kept failed only if both did.
+    let kept = if judgement.selected() { held } else { full }?;
+    Ok((kept, Some(judgement)))
 }
 
 /// The periods of `grid` that a converged point labelled [`Label::Skeleton`] lies within

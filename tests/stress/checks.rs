@@ -148,8 +148,7 @@ impl Checks {
         let band = run.problem().resonance_band();
         let consistent = j.covered_selected <= j.steps
             && j.covered_full <= j.steps
-            && j.selected == (j.covered_selected > j.covered_full)
-            && band == if j.selected { j.width } else { 0.0 };
+            && band == if j.selected() { j.width } else { 0.0 };
         self.expect(consistent, || {
             format!("{what}: selection {j:?} with a problem of band {band}")
         });
