@@ -156,6 +156,22 @@ pub enum SettingsError {
         /// The rejected value.
         value: usize,
     },
+    /// A request names one mode and order, its method's options another
+    /// ([`Request::for_method`](crate::branches::Request::for_method) builds one that agrees).
+    #[error(
+        "the request asks NSM {request_mode} sub {request_order}, its method's options NSM \
+         {method_mode} sub {method_order}"
+    )]
+    MethodDisagrees {
+        /// The request's mode.
+        request_mode: usize,
+        /// The request's order.
+        request_order: usize,
+        /// The mode the method's options name.
+        method_mode: usize,
+        /// The order the method's options name.
+        method_order: usize,
+    },
     /// The system has no unilateral condition, so it has no nonsmooth mode to compute.
     #[error("the system has no unilateral contact condition")]
     NoContact,

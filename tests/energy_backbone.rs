@@ -6,7 +6,7 @@ use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{
     compute, compute_observed, ArclengthBackboneOptions, AutoChoice, BackboneOptions,
     BackbonePoint, EnergyBackboneOptions, EnergyGrid, EnergyLevel, Method, ModeBranches,
-    PeriodGrid, PointStatus, Request, FLOATING_RETRY_DEPTH,
+    PeriodGrid, PointStatus, Request, CLOSE_START_RATIOS, FLOATING_RETRY_DEPTH, START_RATIOS,
 };
 use nonsmooth_modes::continuation::{augmented, geomspace, ContinuationProblem};
 use nonsmooth_modes::linalg::DenseMatrix;
@@ -17,6 +17,7 @@ use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
 use nonsmooth_modes::{ContinuationError, Error};
+use proptest::prelude::*;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -401,4 +402,71 @@ fn the_chains_arclength_backbone_starts_where_its_guesses_converge() {
     assert!(points.windows(2).all(|w| w[1].step > w[0].step));
     assert_eq!(run.points, points);
     assert_every_contact_touches(&system, &points);
+}
+
+/// NSM `mode` of the unit clamped bar facing a clamped bar 2 of length `l2`, wave speed `c2`
+/// and stiffness `ea2` across `GAP`, in the energy from the mode's grazing level, `m = 20`.
+fn against_partner(l2: f64, c2: f64, ea2: f64, mode: usize) -> ModeBranches {
+    let second = Bar::new(l2, c2, ea2).unwrap();
+    let system = nonsmooth_modes::reference::two_bars_in_contact(second, GAP).unwrap();
+    let options = EnergyBackboneOptions::for_mode(&system, mode, 1).unwrap();
+    let request = Request {
+        mode,
+        ..request(20, Method::Energy(options))
+    };
+    compute(&system, &request).unwrap()
+}
+
+/// Against a soft partner (the paper's configuration 2, bar 2 four times softer), the first
+/// mode of bar 1 (system mode 1) and its second (system mode 3) harden so little that at the
+/// usual start frequencies their motions lie far above the grazing seed: the start's closer
+/// frequencies ([`CLOSE_START_RATIOS`]) enter both, and every level converges just above the
+/// linear frequency.
+#[test]
+fn a_bar_against_a_soft_partner_starts_near_its_linear_frequency() {
+    for (mode, linear) in [(1, PI / 2.0), (3, 1.5 * PI)] {
+        let run = against_partner(3.8, 4.0, 0.25, mode);
+        let start = run.points.first().expect("a start");
+        let ratio = start.omega / linear;
+        assert!(
+            ratio < START_RATIOS[0]
+                && CLOSE_START_RATIOS
+                    .iter()
+                    .any(|r| (ratio / r - 1.0).abs() < 1e-12),
+            "mode {mode}: start at {ratio} times the linear frequency"
+        );
+        let converged = run.converged().count();
+        assert!(
+            converged >= 20,
+            "mode {mode}: {converged} converged, {:?}",
+            run.end
+        );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The first mode of the unit clamped bar against a partner of any length whose first
+    /// frequency lies above bar 1's (so that system mode 1 is bar 1's), and softer than it
+    /// (`EA_2` from 1/50 to 1/4): the energy backbone starts, and its points harden.
+    #[test]
+    fn bar_1_against_any_soft_partner_starts(
+        l2 in 0.5f64..4.0,
+        ratio in 1.3f64..3.0,
+        ea2 in 0.02f64..0.25,
+    ) {
+        let c2 = ratio * l2;
+        let run = against_partner(l2, c2, ea2, 1);
+        prop_assert!(
+            !matches!(run.error(), Some(e) if e.to_string().contains("no start")),
+            "{:?}",
+            run.end
+        );
+        let converged: Vec<&BackbonePoint> = run.converged().collect();
+        prop_assert!(!converged.is_empty(), "{:?}", run.end);
+        for p in converged {
+            prop_assert!(p.omega > PI / 2.0, "Omega {} below the linear frequency", p.omega);
+        }
+    }
 }

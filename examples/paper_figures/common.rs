@@ -208,6 +208,20 @@ pub fn series(run: &Run, omega_1: f64, color: Rgb, marker: Marker) -> Series {
         .with_marker(marker)
 }
 
+/// The line of a branch continued through a lettered point (`runs::continued_from`), in one
+/// colour for every figure, named by the run.
+pub fn through_series(run: &Run, omega_1: f64) -> Series {
+    Series::line(
+        &run.label,
+        run.converged()
+            .map(|q| (q.omega / omega_1, q.energy_normalized))
+            .collect(),
+    )
+    .with_color(PALETTE[4])
+    .with_marker(Marker::Circle)
+    .with_size(1)
+}
+
 /// The runs' converged points split by label: each run's own branch (skeleton or subharmonic,
 /// and any point without a label) as markers in its colour and marker, named by the run; then
 /// each run's internal resonances as small rings in the same colour, one legend entry for them

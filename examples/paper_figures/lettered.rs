@@ -246,15 +246,25 @@ pub fn fig18_family1<'a>(
     for (letter, lo, hi, bar2) in [("a", 1.0, half, 2), ("b", half, 1.13, 1)] {
         let target = 2.0 * std::f64::consts::PI / (0.5 * (lo + hi) * w1);
         let p = nearest_with(run, target, |p| {
-            if !(lo..hi).contains(&(p.omega / w1)) {
-                return Ok(false);
-            }
-            let c = Content::of(system, basis, p)?;
-            Ok(in_mode(system, basis, p, &c, 0, 1) && c.dominant(1) == bar2)
+            Ok((lo..hi).contains(&(p.omega / w1))
+                && fig18_family1_character(system, basis, p, bar2)?)
         })?;
         out.push((letter, p));
     }
     Ok(out)
+}
+
+/// Whether `p` has the character of Fig. 18's family 1 with bar 2 carried by its harmonic
+/// `bar2`: bar 1 in its NSM1 (harmonic 1 the largest of its energy, no node), and `bar2` the
+/// oscillating harmonic holding most of bar 2's energy.
+pub fn fig18_family1_character(
+    system: &BarSystem,
+    basis: &CosineBasis,
+    p: &BackbonePoint,
+    bar2: usize,
+) -> Res<bool> {
+    let c = Content::of(system, basis, p)?;
+    Ok(in_mode(system, basis, p, &c, 0, 1) && c.dominant(1) == bar2)
 }
 
 /// Whether `p` is within `tolerance` of its run's exact energy (always, for a run without an

@@ -24,10 +24,12 @@
 
 mod clamped;
 mod common;
+mod designs;
 mod lettered;
 mod residual;
 mod robin;
 mod runs;
+mod seeded;
 mod summary;
 mod two_bar;
 
@@ -196,8 +198,8 @@ fn main() -> ExitCode {
     if wanted(14) || wanted(15) || wanted(16) {
         config1(&ctx, &mut rows);
     }
-    figure(&mut rows, 17, two_bar::fig17);
-    figure(&mut rows, 18, two_bar::fig18);
+    figure(&mut rows, 17, designs::fig17);
+    figure(&mut rows, 18, designs::fig18);
     println!();
     println!(
         "{:<7} {:>7} {:>10} {:>8}  files",

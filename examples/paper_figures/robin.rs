@@ -3,17 +3,18 @@
 
 use crate::common::{
     arclength_series, field, frame_on_branches, frequency_energy, labelled_series, map_panel,
-    marked, omega_1, point_map, series, settings, Ctx, Res, Stats, BLUE, GAP, GREEN, RED, YELLOW,
+    marked, omega_1, point_map, series, settings, through_series, Ctx, Res, Stats, BLUE, GAP,
+    GREEN, RED, YELLOW,
 };
 use crate::lettered::{contacts, labelled, nearest_with, Content, MIN_RESONANT_SHARE};
-use crate::runs::{arclength_run, continued_from, run, Branch, Run};
+use crate::runs::{arclength_run, continued_from, kept_around, run, Branch, Run};
 use nonsmooth_modes::branches::{symmetry_breaking_direction, BackbonePoint, GENUINE_SHARE};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{
     energy, grazing_energy, law_history, natural_frequencies, subharmonic_share, ContactState,
     Label,
 };
-use nonsmooth_modes::plot::{backbone_panel, Figure, Marker, Series, PALETTE};
+use nonsmooth_modes::plot::{backbone_panel, Figure, Marker, PALETTE};
 use nonsmooth_modes::reference::{robin_bar_with_obstacle, ROBIN_FREE_FREQUENCIES};
 use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
@@ -365,36 +366,15 @@ pub fn fig13(ctx: &Ctx) -> Res<Stats> {
     let through_g = match g {
         Some((p, _, _)) => {
             let all = continued_from(&system, m, p, (0.001, 60), "branch through g")?;
-            let mut same = Vec::with_capacity(all.points.len());
-            for q in &all.points {
-                same.push(subharmonic_share(&system, &basis, &q.x, q.omega, 3)? >= GENUINE_SHARE);
-            }
-            let at = all.points.iter().position(|q| q.period == p.period);
-            let (lo, hi) = at.map_or((0, 0), |i| {
-                let lo = (0..=i).rev().take_while(|&k| same[k]).last().unwrap_or(i);
-                let hi = (i..same.len()).take_while(|&k| same[k]).last().unwrap_or(i);
-                (lo, hi + 1)
-            });
-            Some(Run {
-                points: all.points[lo..hi].to_vec(),
-                ..all
-            })
+            Some(kept_around(all, p, |q| {
+                Ok(subharmonic_share(&system, &basis, &q.x, q.omega, 3)? >= GENUINE_SHARE)
+            })?)
         }
         None => None,
     };
     if let Some(b) = &through_g {
         stats.count([b]);
-        bb.series.push(
-            Series::line(
-                "branch through g",
-                b.converged()
-                    .map(|q| (q.omega / w1, q.energy_normalized))
-                    .collect(),
-            )
-            .with_color(PALETTE[4])
-            .with_marker(Marker::Circle)
-            .with_size(1),
-        );
+        bb.series.push(through_series(b, w1));
     }
     let mut panels = Vec::new();
     let mut marks = Vec::new();

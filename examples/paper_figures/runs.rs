@@ -342,3 +342,27 @@ pub fn continued_from(
         exact: None,
     })
 }
+
+/// The stretch of `all` (a run from [`continued_from`] through `p`) around `p` whose points
+/// all satisfy `keep`: the branch of `p`'s own motion, without the other motions the
+/// continuation falls onto where that branch ends.
+pub fn kept_around(
+    all: Run,
+    p: &BackbonePoint,
+    mut keep: impl FnMut(&BackbonePoint) -> Res<bool>,
+) -> Res<Run> {
+    let mut same = Vec::with_capacity(all.points.len());
+    for q in &all.points {
+        same.push(keep(q)?);
+    }
+    let at = all.points.iter().position(|q| q.period == p.period);
+    let (lo, hi) = at.map_or((0, 0), |i| {
+        let lo = (0..=i).rev().take_while(|&k| same[k]).last().unwrap_or(i);
+        let hi = (i..same.len()).take_while(|&k| same[k]).last().unwrap_or(i);
+        (lo, hi + 1)
+    });
+    Ok(Run {
+        points: all.points[lo..hi].to_vec(),
+        ..all
+    })
+}

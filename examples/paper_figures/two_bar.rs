@@ -1,7 +1,7 @@
-//! Figs. 14-18: two bars in contact, in the configurations `(l, c, alpha)` = (0.95, 1, 1),
-//! (3.8, 4, 4) and (0.95, 2, 1), with the paper's definition `α = E₁A₁/(E₂A₂)`
-//! (`reference::paper_second_bar`): backbones with snapshots of both bars, the contact
-//! interface, and a time-domain check of one point.
+//! Figs. 14-16: two bars in contact in configuration 1, `(l, c, alpha)` = (0.95, 1, 1), with
+//! the paper's definition `α = E₁A₁/(E₂A₂)` (`reference::paper_second_bar`): backbones with
+//! snapshots of both bars, the contact interface, and a time-domain check of one point; and
+//! the two-bar system and snapshots that Figs. 17 and 18 (`designs`) share.
 
 use crate::common::{
     arclength_series, field, frame_on_branches, frequency_energy, labelled_series, marked, omega_1,
@@ -9,42 +9,42 @@ use crate::common::{
     YELLOW,
 };
 use crate::lettered;
-use crate::runs::{arclength_run, energy_run, run, solved_point, Branch, Run};
+use crate::runs::{arclength_run, energy_run, run, Branch, Run};
 use nonsmooth_modes::branches::BackbonePoint;
-use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::fourier::CosineBasis;
-use nonsmooth_modes::modal::{branch_seed, harmonic_energies_by_bar, law_history};
+use nonsmooth_modes::modal::{
+    harmonic_energies_by_bar, law_history, natural_frequencies, ContactState,
+};
 use nonsmooth_modes::plot::{
     backbone_panel, snapshots_panel, Figure, LegendPosition, LinePanel, Marker, Panel, PlacedBar,
     Placement, Rgb, Series, SpaceTimeField, PALETTE,
 };
 use nonsmooth_modes::reference::{paper_second_bar, two_bars_in_contact};
-use nonsmooth_modes::solve::{NonlinearSolver, SemismoothNewton};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
 use nonsmooth_modes::verify::{march, periodicity_check, MarchOptions, PeriodicityOptions, State};
 use std::f64::consts::PI;
 
 /// Harmonics of every two-bar run.
-const M: usize = 20;
+pub const M: usize = 20;
 
 /// Samples of the interface histories of Figs. 15 and 16.
 const SAMPLES: usize = 600;
 
 /// First natural frequency `pi c / (2 l)` of bar 2 in configurations 1 and 2, where
 /// `l / c = 0.95`.
-const OMEGA_1_BAR_2: f64 = PI / (2.0 * 0.95);
+pub const OMEGA_1_BAR_2: f64 = PI / (2.0 * 0.95);
 
 /// A two-bar system, its backbones and the first natural frequency `w1` of bar 1.
 pub struct TwoBar {
-    system: BarSystem,
-    runs: Vec<Run>,
-    w1: f64,
+    pub system: BarSystem,
+    pub runs: Vec<Run>,
+    pub w1: f64,
 }
 
 impl TwoBar {
     /// Bar 2 `(l, c, alpha)` (the paper's triplet, `α = E₁A₁/(E₂A₂)`) facing the unit
     /// bar, and its backbones along `branches`.
-    fn new((l, c, alpha): (f64, f64, f64), branches: &[Branch<'_>]) -> Res<Self> {
+    pub fn new((l, c, alpha): (f64, f64, f64), branches: &[Branch<'_>]) -> Res<Self> {
         let system = two_bars_in_contact(paper_second_bar(l, c, alpha)?, GAP)?;
         let w1 = omega_1(&system)?;
         let runs = branches
@@ -67,14 +67,58 @@ impl TwoBar {
 
     /// The system with NSM2 of bar 2 (system mode 4) added, continued in the energy: a period
     /// grid started at its linear period slides to rest at every step.
-    fn with_nsm2_of_bar_2(mut self) -> Res<Self> {
-        let run = energy_run(&self.system, M, "NSM2 (bar 2)", 4)?;
+    pub fn with_nsm2_of_bar_2(self) -> Res<Self> {
+        self.with_energy_run("NSM2 (bar 2)", 4)
+    }
+
+    /// The system with system mode `mode`'s branch added, continued in the energy
+    /// ([`energy_run`]) under `label`.
+    pub fn with_energy_run(mut self, label: &str, mode: usize) -> Res<Self> {
+        let run = energy_run(&self.system, M, label, mode)?;
         self.runs.push(run);
         Ok(self)
     }
 
-    fn runs(&self) -> Vec<&Run> {
+    pub fn runs(&self) -> Vec<&Run> {
         self.runs.iter().collect()
+    }
+
+    /// The median, over the converged points of run `i`, of the share of the system's energy
+    /// that internal resonances carry: the harmonics `n >= 2` whose frequency `n Omega` lies
+    /// within [`lettered::RESONANCE_BAND`] of an open-contact natural frequency (`None` for a
+    /// run without converged points). The paper compares configurations by it in words ("much
+    /// less dominant"); configurations 1 and 2 share their natural frequencies, so the band
+    /// covers the same harmonics in both.
+    pub fn resonant_energy_median(&self, i: usize) -> Res<Option<f64>> {
+        let basis = settings(M).cosine_basis()?;
+        let points: Vec<&BackbonePoint> = self.runs[i].converged().collect();
+        let highest = (M + 1) as f64 * points.iter().fold(0.0f64, |a, p| a.max(p.omega));
+        let natural: Vec<f64> = natural_frequencies(&self.system, ContactState::Open, highest)?
+            .iter()
+            .map(|mode| mode.omega)
+            .collect();
+        let near = |f: f64| {
+            natural
+                .iter()
+                .any(|w| (f / w - 1.0).abs() < lettered::RESONANCE_BAND)
+        };
+        let mut shares = Vec::with_capacity(points.len());
+        for p in points {
+            let by_bar = harmonic_energies_by_bar(&self.system, &basis, &p.x, p.omega)?;
+            let total: f64 = by_bar.iter().flatten().sum();
+            let resonant: f64 = (by_bar.iter())
+                .flat_map(|e| {
+                    (2..e.len())
+                        .filter(|&n| near(n as f64 * p.omega))
+                        .map(|n| e[n])
+                })
+                .sum();
+            if total > 0.0 {
+                shares.push(resonant / total);
+            }
+        }
+        shares.sort_by(f64::total_cmp);
+        Ok(shares.get(shares.len() / 2).copied())
     }
 }
 
@@ -108,7 +152,7 @@ fn snapshots(
 }
 
 /// Snapshots of the harmonic-balance point `p` at 8 instants.
-fn snapshots_of(
+pub fn snapshots_of(
     system: &BarSystem,
     basis: &CosineBasis,
     p: &BackbonePoint,
@@ -123,7 +167,7 @@ fn snapshots_of(
 }
 
 /// Snapshot panels of `points` (name, point), titled `point {name}: ...`.
-fn named_snapshots(tb: &TwoBar, points: &[(&str, &BackbonePoint)]) -> Res<Vec<Panel>> {
+pub fn named_snapshots(tb: &TwoBar, points: &[(&str, &BackbonePoint)]) -> Res<Vec<Panel>> {
     let basis = settings(M).cosine_basis()?;
     points
         .iter()
@@ -142,6 +186,7 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
     let nsm2_arc = Branch::new("NSM2 (bar 1) arclength", 3, (1.33, 1.05), 0);
     let arc = arclength_run(ctx, &tb.system, M, &nsm2_arc, tb.w1)?;
     stats.count(tb.runs.iter().chain([&arc]));
+    stats.note = resonance_note(tb)?;
     let coloured: Vec<(&Run, Rgb, Marker)> = tb
         .runs
         .iter()
@@ -188,6 +233,18 @@ pub fn fig14(ctx: &Ctx, tb: &TwoBar) -> Res<(Stats, Vec<BackbonePoint>)> {
         tb.w1,
     )?;
     Ok((stats, picks.iter().map(|(_, p)| (*p).clone()).collect()))
+}
+
+/// The progress note of a configuration's NSM1 (run 0): the median share of its energy in
+/// internal resonances ([`TwoBar::resonant_energy_median`]).
+pub fn resonance_note(tb: &TwoBar) -> Res<String> {
+    Ok(match tb.resonant_energy_median(0)? {
+        Some(share) => format!(
+            "NSM1: internal resonances carry a median {:.0} % of the energy",
+            100.0 * share
+        ),
+        None => "NSM1: no converged point".into(),
+    })
 }
 
 /// Interface positions from `x = 1` in units of `g0`: bar 1 at `u(1)`, bar 2 at `g0 - w(l)`.
@@ -346,223 +403,6 @@ pub fn fig16(ctx: &Ctx, tb: &TwoBar, p: &BackbonePoint) -> Res<Stats> {
             "pos2_over_g0",
         ],
         &[&tm, &force, &u1[1..=n], &u2[1..=n]],
-    )?;
-    Ok(stats)
-}
-
-/// Fig. 17: configuration 2 (3.8, 4, 4), NSM1 and one field.
-pub fn fig17(ctx: &Ctx) -> Res<Stats> {
-    let mut stats = Stats::default();
-    // From T = 3.95 the grazing seed of this system slides to rest (bar 2, four times softer,
-    // takes the motion); from 3.9 it starts on the branch.
-    let nsm1 = Branch::new("NSM1", 1, (3.9, 2.85), ctx.steps(221));
-    let tb = TwoBar::new((3.8, 4.0, 4.0), &[nsm1])?.with_nsm2_of_bar_2()?;
-    stats.count(&tb.runs);
-    let mut bb = backbone_panel(
-        "(3.8, 4, 4), α = E₁A₁/(E₂A₂): NSM1 and NSM2, m = 20",
-        &labelled_series(
-            &[
-                (&tb.runs[0], GREEN, Marker::Circle),
-                (&tb.runs[1], RED, Marker::Circle),
-            ],
-            tb.w1,
-        ),
-        None,
-    );
-    let w12 = OMEGA_1_BAR_2;
-    bb.x_guides = vec![w12 / tb.w1, 4.0 / 3.0 * w12 / tb.w1];
-    let basis = settings(M).cosine_basis()?;
-    let lowest = tb.runs[0]
-        .converged()
-        .min_by(|x, y| x.energy_normalized.total_cmp(&y.energy_normalized));
-    let mut panels = Vec::new();
-    let mut marks = Vec::new();
-    if let Some(p) = lowest {
-        marks.push(("b", p));
-        panels.push(snapshots_of(
-            &tb.system,
-            &basis,
-            p,
-            format!("point b: {}", frequency_energy(p, tb.w1)),
-        )?);
-    }
-    // Without a converged point the legend entry "point" is left out altogether.
-    let all = if marks.is_empty() {
-        vec![Panel::Lines(bb)]
-    } else {
-        marked(bb, "", &marks, tb.w1, panels)
-    };
-    ctx.backbone_figure(
-        &mut stats,
-        "fig17_two_bar_config2",
-        &Figure::new("Fig. 17: two bars (3.8, 4, 4)", 2, all),
-        &tb.runs(),
-        tb.w1,
-    )?;
-    Ok(stats)
-}
-
-/// Bar 1's subharmonic motion in a family-2 point of configuration 3, where bar 2 moves in its
-/// NSM1: `(n, j)` for bar 1 in NSM`j` sub`n`, i.e. its harmonic `n > 1` carrying the most of
-/// its energy (at least half of the most any of its harmonics carries) near its clamped-free
-/// mode `j` (`n Omega` within 5 % of `(2j - 1) pi / 2`); `None` when bar 2 is not in NSM1 (its
-/// harmonic 1 not its largest) or bar 1 has no such harmonic.
-fn subharmonic_of_bar_1(
-    system: &BarSystem,
-    basis: &CosineBasis,
-    p: &BackbonePoint,
-) -> Res<Option<(usize, usize)>> {
-    let by_bar = harmonic_energies_by_bar(system, basis, &p.x, p.omega)?;
-    let largest = |e: &[f64], from: usize| {
-        (from..e.len())
-            .max_by(|&a, &b| e[a].total_cmp(&e[b]))
-            .unwrap_or(from)
-    };
-    let (bar1, bar2) = (&by_bar[0], &by_bar[1]);
-    if largest(bar2, 1) != 1 {
-        return Ok(None);
-    }
-    let n = largest(bar1, 2);
-    let most = bar1.iter().copied().fold(0.0, f64::max);
-    let j = ((n as f64 * p.omega / (PI / 2.0) + 1.0) / 2.0)
-        .round()
-        .max(1.0) as usize;
-    let mode = (2 * j - 1) as f64 * PI / 2.0;
-    let near = (n as f64 * p.omega / mode - 1.0).abs() < 0.05;
-    Ok((bar1[n] >= 0.5 * most && near).then_some((n, j)))
-}
-
-/// Frequencies `Omega / omega_1` above `omega_3^(1)/2 = 2.5` where the paper's point e of
-/// Fig. 18 (bar 1 in NSM3 sub2, hardening) is sought from seeds.
-const ABOVE_HALF_OMEGA_3: [f64; 4] = [2.51, 2.53, 2.56, 2.6];
-
-/// Bar 1 in NSM3 sub2 with bar 2 in NSM1 (the paper's point e of Fig. 18) at the lowest of
-/// [`ABOVE_HALF_OMEGA_3`] where a seed combining bar 2's first mode on harmonic 1 (system mode
-/// 2) and bar 1's third mode on harmonic 2 (system mode 4), in the ratios 1:1, 2:1 and 1:0.5,
-/// converges to a motion in contact with that content.
-fn hardening_nsm3_sub2(
-    system: &BarSystem,
-    basis: &CosineBasis,
-    w1: f64,
-) -> Res<Option<BackbonePoint>> {
-    let mut problem = NonsmoothSystem::new(system, settings(M))?;
-    let solver = SemismoothNewton::default();
-    for ratio in ABOVE_HALF_OMEGA_3 {
-        let omega = ratio * w1;
-        let bar_2 = branch_seed(&mut problem, 2, 1, omega)?;
-        let bar_1 = branch_seed(&mut problem, 4, 2, omega)?;
-        for (a, b) in [(1.0, 1.0), (2.0, 1.0), (1.0, 0.5)] {
-            let mut x: Vec<f64> = (bar_2.iter().zip(&bar_1))
-                .map(|(u, v)| a * u + b * v)
-                .collect();
-            problem.set_parameter(omega);
-            let Ok(info) = solver.solve(&mut problem, &mut x) else {
-                continue;
-            };
-            let point = solved_point(system, basis, (x, omega), &info)?;
-            // Above rest (a seed can slide to it), with the content of e.
-            if point.energy_normalized > 1e-3
-                && subharmonic_of_bar_1(system, basis, &point)? == Some((2, 3))
-            {
-                return Ok(Some(point));
-            }
-        }
-    }
-    Ok(None)
-}
-
-/// Fig. 18: configuration 3 (0.95, 2, 1): the two families and a few fields.
-pub fn fig18(ctx: &Ctx) -> Res<Stats> {
-    let mut stats = Stats::default();
-    let w12 = 2.0 * PI / (2.0 * 0.95);
-    let tb = TwoBar::new(
-        (0.95, 2.0, 1.0),
-        &[
-            Branch::new("NSM1 (family 1)", 1, (3.95, 3.45), ctx.steps(101)),
-            Branch::new(
-                "NSM2 (family 2)",
-                2,
-                (2.0 * PI / w12 - 0.01, 1.45),
-                ctx.steps(91),
-            ),
-        ],
-    )?;
-    let (runs, w1) = (&tb.runs, tb.w1);
-    stats.count(runs);
-    let mut bb = backbone_panel(
-        "(0.95, 2, 1): backbones, m = 20",
-        &{
-            let mut s = labelled_series(
-                &[
-                    (&runs[0], Rgb::BLACK, Marker::Circle),
-                    (&runs[1], PALETTE[7], Marker::Square),
-                ],
-                w1,
-            );
-            s[1].size = 2;
-            s
-        },
-        None,
-    );
-    bb.x_guides = vec![1.0, 1.13, 0.5 * w12 / w1, w12 / w1, 1.25 * w12 / w1];
-    // The paper's a and b (family 1) by the bars' harmonic content; its c, d and e are
-    // family-2 points with bar 2 in NSM1 and bar 1 in NSM6 sub5, NSM3 sub2 below (softening)
-    // and above (hardening) omega_3^(1)/2 (`subharmonic_of_bar_1`).
-    let half = 0.5 * w12 / w1;
-    let basis = settings(M).cosine_basis()?;
-    let family1 = lettered::fig18_family1(&tb.system, &basis, w1, &runs[0], half)?;
-    for (letter, p) in &family1 {
-        stats.lettered(letter, p.is_some());
-    }
-    let mut classified = Vec::new();
-    for p in runs[1].converged() {
-        if let Some(nj) = subharmonic_of_bar_1(&tb.system, &basis, p)? {
-            classified.push((p, nj));
-        }
-    }
-    // The point of NSM`j` sub`n` in bar 1 nearest `omega_j / n`, on the side `side` of it.
-    let nearest = |(n, j): (usize, usize), side: f64| {
-        let centre = (2 * j - 1) as f64 * PI / 2.0 / n as f64;
-        classified
-            .iter()
-            .filter(|(p, nj)| *nj == (n, j) && (p.omega - centre) * side >= 0.0)
-            .min_by(|a, b| {
-                (a.0.omega - centre)
-                    .abs()
-                    .total_cmp(&(b.0.omega - centre).abs())
-            })
-            .map(|(p, _)| *p)
-    };
-    // Family 2's grid does not reach NSM3 sub2 above omega_3^(1)/2: e is sought from seeds of
-    // the combined motion itself when the run has none.
-    let seeded = match nearest((2, 3), 1.0) {
-        Some(_) => None,
-        None => hardening_nsm3_sub2(&tb.system, &basis, w1)?,
-    };
-    let family2 = [
-        ("c", nearest((5, 6), 1.0).or(nearest((5, 6), -1.0))),
-        ("d", nearest((2, 3), -1.0)),
-        ("e", nearest((2, 3), 1.0).or(seeded.as_ref())),
-    ];
-    for (letter, p) in &family2 {
-        stats.lettered(letter, p.is_some());
-    }
-    let named: Vec<(&str, &BackbonePoint)> = family1
-        .into_iter()
-        .chain(family2)
-        .filter_map(|(name, p)| p.map(|p| (name, p)))
-        .collect();
-    let panels = named_snapshots(&tb, &named)?;
-    ctx.backbone_figure(
-        &mut stats,
-        "fig18_two_bar_config3",
-        &Figure::new(
-            "Fig. 18: two bars (0.95, 2, 1) (dashed: ω₁⁽¹⁾, 1.13 ω₁⁽¹⁾, ω₁⁽²⁾/2, ω₁⁽²⁾, 1.25 ω₁⁽²⁾)",
-            3,
-            marked(bb, "", &named, w1, panels),
-        ),
-        &tb.runs(),
-        w1,
     )?;
     Ok(stats)
 }

@@ -6,7 +6,7 @@ use crate::branches::point::BackbonePoint;
 use crate::branches::request::Request;
 use crate::branches::result::{Annotator, ModeBranches};
 use crate::branches::selected::judged_with_selection;
-use crate::error::Error;
+use crate::error::{Error, SettingsError};
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::ops::ControlFlow;
 
@@ -64,7 +64,9 @@ use std::ops::ControlFlow;
 /// # Errors
 /// Only when no point was computed: invalid settings or options, no linear mode `i`, an
 /// assembly with a bar nothing holds
-/// ([`SettingsError::Unconfined`](crate::SettingsError::Unconfined)), or no start and no
+/// ([`SettingsError::Unconfined`](crate::SettingsError::Unconfined)), a method whose options
+/// name another mode or order than the request
+/// ([`SettingsError::MethodDisagrees`](crate::SettingsError::MethodDisagrees)), or no start and no
 /// converged step ([`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound),
 /// which says what was tried). A run that stalls or fails part-way returns its points with
 /// its end reason ([`ModeBranches::end`]).
@@ -98,6 +100,17 @@ pub fn compute_observed(
     request: &Request,
     observer: impl BackboneObserver,
 ) -> Result<ModeBranches, Error> {
+    if let Some((mode, order)) = request.method.mode_and_order() {
+        if (mode, order) != (request.mode, request.subharmonic) {
+            return Err(SettingsError::MethodDisagrees {
+                request_mode: request.mode,
+                request_order: request.subharmonic,
+                method_mode: mode,
+                method_order: order,
+            }
+            .into());
+        }
+    }
     let problem = NonsmoothSystem::new(system, request.settings)?;
     let (plan, method) = match asked(request) {
         Ok(planned) => planned,
@@ -116,4 +129,32 @@ pub fn compute_observed(
     let solver = request.solver_for(&method)?;
     let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
     Ok(annotator.finish((method, None), e_g, end, rejected))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::branches::{EnergyBackboneOptions, Method};
+    use crate::reference::clamped_bar_with_obstacle;
+
+    /// A method whose options name another mode than the request is refused with both
+    /// modes, before anything is computed; the request built from the method runs.
+    #[test]
+    fn a_method_for_another_mode_is_refused() {
+        let system = clamped_bar_with_obstacle(1e-3).unwrap();
+        let options = EnergyBackboneOptions::for_mode(&system, 2, 1).unwrap();
+        let method = Method::Energy(options);
+        let mixed = Request::new(1).harmonics(5).method(method);
+        match compute(&system, &mixed) {
+            Err(Error::Settings(SettingsError::MethodDisagrees {
+                request_mode: 1,
+                request_order: 1,
+                method_mode: 2,
+                method_order: 1,
+            })) => {}
+            other => panic!("{other:?}"),
+        }
+        let agreed = Request::for_method(method).harmonics(5);
+        assert!(compute(&system, &agreed).is_ok());
+    }
 }

@@ -14,6 +14,24 @@ use crate::system::{BarSystem, NonsmoothSystem};
 /// grid's first, [`crate::branches::PeriodGrid::for_mode`]).
 pub const START_RATIOS: [f64; 3] = [80.0 / 79.0, 40.0 / 39.0, 20.0 / 19.0];
 
+/// Frequencies of the energy backbone's start nearer the linear mode's than
+/// [`START_RATIOS`], tried after them: `1 + 1 / (79 * 2^k)`, `k = 1..=12` (the first offset
+/// halved twelve times, down to `3.1e-6`). A branch whose hardening is weak (a soft partner
+/// in contact) rises so steeply that at `80/79` its motion is far above the grazing seed: its
+/// frequency shift shrinks with the partner's stiffness.
+pub const CLOSE_START_RATIOS: [f64; 12] = close_start_ratios();
+
+/// `1 + 1 / (79 * 2^k)` for `k = 1..=12`.
+const fn close_start_ratios() -> [f64; 12] {
+    let mut ratios = [0.0; 12];
+    let mut k = 0;
+    while k < 12 {
+        ratios[k] = 1.0 + 1.0 / (79.0 * (1u32 << (k + 1)) as f64);
+        k += 1;
+    }
+    ratios
+}
+
 /// Amplitudes of the start, relative to the grazing seed's: a seed that only grazes can
 /// slide to a rigid-body motion resting against an obstacle (a floating bar), one that
 /// slightly penetrates cannot.

@@ -50,8 +50,8 @@ pub use point::{Backbone, BackbonePoint, PointStatus};
 pub use request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 pub use result::ModeBranches;
 pub use start::{
-    BackboneStart, FLOATING_AMPLITUDES, FLOATING_RATIOS, MIN_COARSE_HARMONICS, RIGID_AMPLITUDES,
-    START_AMPLITUDES, START_RATIOS,
+    BackboneStart, CLOSE_START_RATIOS, FLOATING_AMPLITUDES, FLOATING_RATIOS, MIN_COARSE_HARMONICS,
+    RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
 };
 pub use subharmonic::{leave_subspace, symmetry_breaking_direction, GENUINE_SHARE, NUDGES};
 pub use switch::SwitchAt;

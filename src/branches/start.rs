@@ -18,7 +18,8 @@ use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
 pub(crate) use crate::branches::guesses::StartGuesses;
 pub use crate::branches::guesses::{
-    FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES, START_RATIOS,
+    CLOSE_START_RATIOS, FLOATING_AMPLITUDES, FLOATING_RATIOS, RIGID_AMPLITUDES, START_AMPLITUDES,
+    START_RATIOS,
 };
 use std::ops::ControlFlow;
 

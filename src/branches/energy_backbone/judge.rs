@@ -2,7 +2,9 @@
 //! that start a branch and jump its internal resonances.
 
 use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
-use crate::branches::start::{first_solution, StartGuesses, Tally, RIGID_AMPLITUDES};
+use crate::branches::start::{
+    first_solution, StartGuesses, Tally, CLOSE_START_RATIOS, RIGID_AMPLITUDES,
+};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError};
 use crate::fourier::period_of_frequency;
@@ -180,7 +182,7 @@ impl Judge {
         let homotopy = SmoothingHomotopy::new(solver);
         let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
         let guesses = StartGuesses::new(self.problem.system());
-        for ratio in guesses.ratios() {
+        for ratio in guesses.ratios().into_iter().chain(CLOSE_START_RATIOS) {
             let omega = ratio * linear.omega / self.subharmonic as f64;
             let seed = seed_from_mode(&mut self.problem, linear, self.subharmonic, omega)?;
             let tries = guesses.around(
@@ -193,9 +195,10 @@ impl Judge {
                 return Ok((x, omega));
             }
         }
+        let ratios = guesses.ratios().len() + CLOSE_START_RATIOS.len();
         Err(SettingsError::NoStart {
             omega: linear.omega,
-            attempts: guesses.count() * solvers.len(),
+            attempts: guesses.count() / guesses.ratios().len() * ratios * solvers.len(),
         }
         .into())
     }

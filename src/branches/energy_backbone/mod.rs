@@ -106,7 +106,10 @@ impl EnergyBackboneOptions {
 /// # The run
 /// - **Start.** A nonsmooth mode at a fixed frequency just above linear mode `mode`'s,
 ///   solved from its grazing seed (placed on harmonic `subharmonic`; see
-///   [`START_RATIOS`](crate::branches::START_RATIOS)). Its level is the branch's first; the grid's levels above it follow.
+///   [`START_RATIOS`](crate::branches::START_RATIOS), then the nearer
+///   [`CLOSE_START_RATIOS`](crate::branches::CLOSE_START_RATIOS) where a branch hardens so
+///   little that it has left the seed's reach at the first). Its level is the branch's first;
+///   the grid's levels above it follow.
 /// - **Levels.** Each level is solved in `(x, Omega)` from the predictor. The state of
 ///   rest is no solution at any level, so no point collapses to it.
 /// - **Acceptance.** A converged point joins the branch if its frequency is positive (and

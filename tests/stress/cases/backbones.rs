@@ -18,7 +18,7 @@ use nonsmooth_modes::branches::{
 use nonsmooth_modes::continuation::{Rejection, SequentialOptions, Speculation};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, contact_chain, ClampedFirstMode};
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
-use nonsmooth_modes::ModelError;
+use nonsmooth_modes::{Error, ModelError, SettingsError};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -285,11 +285,31 @@ pub(crate) fn request_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
         watcher: Watcher::new(stop_policy(d, false)),
         points: Vec::new(),
     };
-    let run = typed(
-        c,
-        "compute",
-        compute_observed(&system, &request, &mut observer),
-    )?;
+    // A request that names another mode than its method's options is refused, naming both.
+    let disagrees = d.flag("request names another mode", 0.1) && name != "auto";
+    if disagrees {
+        request.mode = 3 - mode;
+    }
+    let outcome = compute_observed(&system, &request, &mut observer);
+    if disagrees {
+        c.expect(
+            matches!(
+                &outcome,
+                Err(Error::Settings(SettingsError::MethodDisagrees {
+                    request_mode,
+                    method_mode,
+                    ..
+                })) if *request_mode == 3 - mode && *method_mode == mode
+            ),
+            || {
+                format!(
+                    "compute ({name}): mode {} against options of mode {mode}: {outcome:?}",
+                    3 - mode
+                )
+            },
+        );
+    }
+    let run = typed(c, "compute", outcome)?;
     let BackboneWatcher { watcher, points } = observer;
     c.mode_branches(&format!("compute ({name})"), &run, watcher.stopped);
     c.expect(points == run.points, || {
