@@ -7,6 +7,7 @@ use nonsmooth_modes::reference::{
 };
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
 use nonsmooth_modes::{Error, SettingsError};
+use proptest::prelude::*;
 use std::f64::consts::PI;
 
 /// Roots of `f` on `(0, hi)` by sign changes on a fine grid and bisection to rounding.
@@ -196,4 +197,42 @@ fn rigid_body_modes_with_their_multiplicity() {
     assert_eq!(count(&floating, ContactState::Open), 2);
     // Closed, the two bars move together: one translation.
     assert_eq!(count(&floating, ContactState::Closed), 1);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Two bars in contact, open: the spectrum is both bars' clamped-free spectra, whatever
+    /// their stiffness ratio, from a partner 10^4 times softer to 10^4 times stiffer. A much
+    /// softer partner enters the open-contact matrix only through the force balance, where it
+    /// weighs little: the roots of the stiffer bar then dip below that floor over less than a
+    /// scan step, and are found by the determinant's change of sign.
+    #[test]
+    fn open_two_bar_spectrum_at_any_stiffness_ratio(
+        l in 0.3f64..4.0,
+        c in 0.3f64..4.0,
+        decades in -4.0f64..4.0,
+    ) {
+        let ea = 10f64.powf(decades);
+        let system = two_bars_in_contact(Bar::new(l, c, ea).unwrap(), 1e-3).unwrap();
+        let hi = 12.0;
+        let count = (hi * l / (PI * c)).ceil() as usize + 8;
+        let mut want: Vec<f64> = (1..=count)
+            .flat_map(|i| {
+                let n = (2 * i - 1) as f64;
+                [n * PI / 2.0, n * PI * c / (2.0 * l)]
+            })
+            .filter(|w| *w < hi)
+            .collect();
+        want.sort_by(f64::total_cmp);
+        // Distinct frequencies closer than about two scan steps (`pi min(c/l) / 200` each)
+        // merge, as `natural_frequencies` documents.
+        let step = PI * (c / l).min(1.0) / 200.0;
+        prop_assume!(want.windows(2).all(|w| w[1] - w[0] > 3.0 * step));
+        let got = computed(&system, ContactState::Open, hi);
+        prop_assert_eq!(got.len(), want.len(), "EA_2 = {}: got {:?}, want {:?}", ea, got, want);
+        for (g, w) in got.iter().zip(&want) {
+            prop_assert!((g - w).abs() <= 1e-8 * w, "EA_2 = {}: got {}, want {}", ea, g, w);
+        }
+    }
 }
