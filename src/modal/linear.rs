@@ -9,7 +9,7 @@
 
 use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
-use crate::linalg::{singular_values_small, svd_small, DenseMatrix, Lu};
+use crate::linalg::{determinant_sign_small, singular_values_small, svd_small, DenseMatrix, Lu};
 use crate::modal::energy::{energy_of, Conditions};
 use crate::modal::inputs::check_frequency_of;
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
@@ -44,7 +44,9 @@ struct StateMatrix<'a> {
     /// Row-major, `n x n`.
     matrix: Vec<f64>,
     singular: Vec<f64>,
-    lu: Lu,
+    /// Scratch copies of the matrix for the singular values and the elimination.
+    work: Vec<f64>,
+    elimination: Vec<f64>,
 }
 
 impl<'a> StateMatrix<'a> {
@@ -56,7 +58,8 @@ impl<'a> StateMatrix<'a> {
             scratch: RowsScratch::default(),
             matrix: Vec::new(),
             singular: Vec::new(),
-            lu: Lu::default(),
+            work: Vec::new(),
+            elimination: Vec::new(),
         }
     }
 
@@ -89,9 +92,7 @@ impl<'a> StateMatrix<'a> {
     /// `sigma_min / sigma_max` of the matrix at `omega`: zero where it is singular.
     fn singularity(&mut self, omega: f64) -> f64 {
         let n = self.at(omega).1;
-        self.singular.resize(n, 0.0);
-        singular_values_small(&self.matrix, n, n, &mut self.singular);
-        self.singular[n - 1] / self.singular[0]
+        self.ratio(n)
     }
 
     /// The sign of the determinant of the (row-scaled) matrix at `omega`, `0` where a pivot
@@ -101,12 +102,22 @@ impl<'a> StateMatrix<'a> {
     /// that floor over less than a scan step.
     fn determinant_sign(&mut self, omega: f64) -> f64 {
         let n = self.at(omega).1;
-        // The storage is column-major: it holds the transpose, of the same determinant.
-        self.lu.storage(n).copy_from_slice(&self.matrix);
-        match self.lu.factor_stored(0.0) {
-            Ok(()) => self.lu.determinant_sign(),
-            Err(_) => 0.0,
-        }
+        determinant_sign_small(&self.matrix, n, &mut self.elimination)
+    }
+
+    /// Both [`StateMatrix::singularity`] and [`StateMatrix::determinant_sign`] at `omega`,
+    /// from one assembly of the matrix: a scan sample.
+    fn sample(&mut self, omega: f64) -> (f64, f64) {
+        let n = self.at(omega).1;
+        let sign = determinant_sign_small(&self.matrix, n, &mut self.elimination);
+        (self.ratio(n), sign)
+    }
+
+    /// `sigma_min / sigma_max` of the `n x n` matrix assembled last.
+    fn ratio(&mut self, n: usize) -> f64 {
+        self.singular.resize(n, 0.0);
+        singular_values_small(&self.matrix, (n, n), &mut self.singular, &mut self.work);
+        self.singular[n - 1] / self.singular[0]
     }
 }
 
@@ -205,10 +216,7 @@ pub(crate) fn natural_frequency_values(
     let steps = samples.ceil() as usize + 1;
     let mut matrix = StateMatrix::new(system, state);
     let at = |i: usize| (i as f64 + 0.5) * h;
-    let values: Vec<f64> = (0..=steps).map(|i| matrix.singularity(at(i))).collect();
-    let signs: Vec<f64> = (0..=steps)
-        .map(|i| matrix.determinant_sign(at(i)))
-        .collect();
+    let (values, signs): (Vec<f64>, Vec<f64>) = (0..=steps).map(|i| matrix.sample(at(i))).unzip();
     let mut modes = Vec::new();
     for i in 1..values.len() - 1 {
         if values[i] <= values[i - 1] && values[i] < values[i + 1] {
@@ -221,13 +229,18 @@ pub(crate) fn natural_frequency_values(
         }
     }
     // Roots whose dip the samples stepped over: a change of the determinant's sign between
-    // two samples that no root above accounts for (none within two steps: closer ones merge
-    // anyway), located by bisection on the sign.
+    // two samples that no minimum above accounts for (none within two steps: closer ones
+    // merge anyway), located by bisection on the sign.
+    let from_minima = modes.len();
     for i in 0..values.len() - 1 {
-        if signs[i] * signs[i + 1] < 0.0 {
+        // The minima come in ascending order: the first at or above `at(i) - 2h`.
+        let k = modes[..from_minima].partition_point(|&m| m < at(i) - 2.0 * h);
+        let known = modes[..from_minima]
+            .get(k)
+            .is_some_and(|&m| m <= at(i + 1) + 2.0 * h);
+        if signs[i] * signs[i + 1] < 0.0 && !known {
             let omega = sign_change(|w| matrix.determinant_sign(w), (at(i), at(i + 1)), signs[i]);
-            let known = modes.iter().any(|m| (m - omega).abs() < 2.0 * h);
-            if !known && omega <= omega_max && matrix.singularity(omega) <= 1e-8 {
+            if omega <= omega_max && matrix.singularity(omega) <= 1e-8 {
                 modes.push(omega);
             }
         }
