@@ -209,8 +209,12 @@ impl StartGuesses {
     /// Guesses tried at all frequencies together, the closing guesses (which depend on the
     /// seed) aside.
     pub(crate) fn count(&self) -> usize {
-        let per_seed = self.amplitudes().len() * (1 + self.rigid.len() * RIGID_AMPLITUDES.len());
-        self.ratios().len() * per_seed
+        self.ratios().len() * self.per_frequency()
+    }
+
+    /// Guesses tried at one frequency, the closing guesses aside.
+    pub(crate) fn per_frequency(&self) -> usize {
+        self.amplitudes().len() * (1 + self.rigid.len() * RIGID_AMPLITUDES.len())
     }
 
     /// The seed at each of the amplitudes, without rigid-body motions.

@@ -182,7 +182,12 @@ impl Judge {
         let homotopy = SmoothingHomotopy::new(solver);
         let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
         let guesses = StartGuesses::new(self.problem.system());
-        for ratio in guesses.ratios().into_iter().chain(CLOSE_START_RATIOS) {
+        let ratios: Vec<f64> = guesses
+            .ratios()
+            .into_iter()
+            .chain(CLOSE_START_RATIOS)
+            .collect();
+        for &ratio in &ratios {
             let omega = ratio * linear.omega / self.subharmonic as f64;
             let seed = seed_from_mode(&mut self.problem, linear, self.subharmonic, omega)?;
             let tries = guesses.around(
@@ -195,10 +200,9 @@ impl Judge {
                 return Ok((x, omega));
             }
         }
-        let ratios = guesses.ratios().len() + CLOSE_START_RATIOS.len();
         Err(SettingsError::NoStart {
             omega: linear.omega,
-            attempts: guesses.count() / guesses.ratios().len() * ratios * solvers.len(),
+            attempts: guesses.per_frequency() * ratios.len() * solvers.len(),
         }
         .into())
     }
