@@ -13,8 +13,15 @@
 //! that decays like `1/n^2`, so leaving out a few harmonics costs little, while keeping them
 //! costs the branch.
 //!
+//! Leaving a harmonic out costs its genuine content, of relative amplitude about `1/n^2`,
+//! while what it removes is an error of the truncation's order `1/m`: the trade pays only for
+//! `n^2 >= m`. Below that, a harmonic is part of the motion the truncation resolves (harmonic
+//! 4 holds about 5 % of the clamped bar's energy), and dropping it moves the whole point: on
+//! the clamped bar, every harmonic `4 j` meets a natural frequency at once near `T = 3.2`, and
+//! holding them at zero put seven grid points 20 to 23 % below the exact family at `m = 20`.
+//!
 //! # What
-//! At the fundamental frequency `Omega`, harmonic `n >= 2` is *dropped* when
+//! At the fundamental frequency `Omega`, harmonic `n >= 2` with `n^2 >= m` is *dropped* when
 //! `|n Omega / omega_k - 1| < c / m` for a natural frequency `omega_k > 0` of the system with
 //! every contact open or every contact closed ([`crate::modal::ContactState`]). A dropped
 //! harmonic's unknowns are held at zero: its equations (linear rows and law projections) are
@@ -74,6 +81,13 @@ pub(crate) struct Selection {
     dropped: Vec<usize>,
     /// Scratch for `x` with the dropped unknowns zeroed.
     masked: Vec<f64>,
+}
+
+/// Whether harmonic `n` of a basis of `m` harmonics may be dropped: never the constant or
+/// the fundamental, and only where its genuine content (`~ 1/n^2`) is below the truncation's
+/// error (`~ 1/m`), `n^2 >= m` (module docs).
+fn droppable(n: usize, m: usize) -> bool {
+    n >= 2 && n.saturating_mul(n) >= m
 }
 
 impl Selection {
@@ -147,7 +161,7 @@ impl Selection {
         self.dropped = (0..basis.len())
             .filter(|&i| {
                 let n = basis.harmonic(i);
-                n >= 2
+                droppable(n, basis.harmonics())
                     && natural
                         .iter()
                         .any(|w| (n as f64 * omega / w - 1.0).abs() < band)
