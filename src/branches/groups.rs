@@ -16,8 +16,9 @@ use crate::modal::Label;
 pub struct PointGroup<'a> {
     /// What the points are: [`Label::Skeleton`] or [`Label::Subharmonic`] for the mode's
     /// own branch, [`Label::InternalResonance`] (naming the harmonic and the linear mode it
-    /// meets) for a resonance, [`Label::Unverified`] for points that failed the time-domain
-    /// check.
+    /// meets) for a resonance, [`Label::OffBranch`] for points off the branch the run
+    /// followed (the group carries the first one's ratio), [`Label::Unverified`] for points
+    /// that failed the time-domain check.
     pub label: Label,
     /// The points.
     pub points: Vec<&'a BackbonePoint>,
@@ -41,7 +42,12 @@ pub fn group_by_label(points: &[BackbonePoint]) -> Vec<PointGroup<'_>> {
         let Some(label) = &p.label else {
             continue;
         };
-        match groups.iter_mut().find(|g| &g.label == label) {
+        // Off-branch points form one group, whatever their ratios.
+        let same = |g: &PointGroup<'_>| match (&g.label, label) {
+            (Label::OffBranch { .. }, Label::OffBranch { .. }) => true,
+            (a, b) => a == b,
+        };
+        match groups.iter_mut().find(|g| same(g)) {
             Some(g) => g.points.push(p),
             None => groups.push(PointGroup {
                 label: label.clone(),
@@ -53,7 +59,8 @@ pub fn group_by_label(points: &[BackbonePoint]) -> Vec<PointGroup<'_>> {
     groups.sort_by_key(|g| match g.label {
         Label::Skeleton | Label::Subharmonic { .. } => 0,
         Label::InternalResonance { .. } => 1,
-        Label::Unverified => 2,
+        Label::OffBranch { .. } => 2,
+        Label::Unverified => 3,
     });
     groups
 }

@@ -6,6 +6,7 @@
 mod auto;
 mod backbone;
 mod compute;
+mod continuity;
 mod convergence;
 mod defaults;
 mod energy_backbone;
@@ -31,6 +32,7 @@ pub use backbone::{
     MAX_CONSECUTIVE_FAILURES, TRIVIAL_ENERGY,
 };
 pub use compute::{compute, compute_observed};
+pub use continuity::JUMP_RATIO;
 pub use convergence::{convergence_study, ConvergenceEntry};
 pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use energy_backbone::{

@@ -51,7 +51,7 @@ pub struct BackbonePoint {
     /// shares by bar and harmonic, dominant harmonic and linear modes.
     pub character: Option<Character>,
     /// Which branch of the mode a converged point lies on: skeleton, internal resonance,
-    /// subharmonic, or unverified ([`Label`]).
+    /// subharmonic, off the branch its run followed, or unverified ([`Label`]).
     pub label: Option<Label>,
     /// The Floquet multipliers of a converged point and its verdict, where they were asked
     /// ([`Request::stability`](crate::branches::Request::stability)), or why they could not

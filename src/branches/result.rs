@@ -2,13 +2,14 @@
 //! index, its time-domain defect and its label on the way.
 
 use crate::branches::backbone::BackboneObserver;
+use crate::branches::continuity::{BranchTail, Sample};
 use crate::branches::point::BackbonePoint;
 use crate::branches::request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::modal::linear::{natural_frequency_values, Resolution};
-use crate::modal::{character, label, nearest_mode, ContactState};
+use crate::modal::{character, label, nearest_mode, ContactState, Label};
 use crate::solution::Solution;
 use crate::stability::{floquet, hill, Floquet, HillOptions, StabilityOptions, Verdict};
 use crate::system::{HarmonicBalanceSettings, NonsmoothSystem};
@@ -116,6 +117,9 @@ pub(crate) struct Annotator<O, B: Basis = CosineBasis> {
     /// Open-contact natural frequencies up to `natural_up_to` (computed as points need).
     natural: Vec<f64>,
     natural_up_to: f64,
+    /// The last points of the mode's own branch, which the next one must continue
+    /// ([`crate::branches::continuity`]).
+    tail: BranchTail,
 }
 
 impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
@@ -134,6 +138,7 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             converged: 0,
             natural: Vec::new(),
             natural_up_to: 0.0,
+            tail: BranchTail::default(),
         }
     }
 
@@ -215,9 +220,30 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
                 .is_some_and(|r| r.displacement_defect <= check.max_displacement_defect)
         });
         let natural = &self.natural;
-        point.label = label(&described, self.order, omega, natural, verified).ok();
+        let content = label(&described, self.order, omega, natural, verified).ok();
         point.character = Some(described);
+        point.label = content.map(|l| self.on_branch(l, point));
         self.assess(point);
+    }
+
+    /// `label` where the point continues the mode's own branch, [`Label::OffBranch`] where
+    /// its content reads as the branch's (skeleton, subharmonic) but it lies off the branch
+    /// followed so far ([`crate::branches::continuity`]).
+    fn on_branch(&mut self, label: Label, point: &BackbonePoint) -> Label {
+        if !matches!(label, Label::Skeleton | Label::Subharmonic { .. }) {
+            return label;
+        }
+        let weights = self.problem.description().state_weights(point.omega);
+        let per = self.problem.description().unknowns;
+        let sample = Sample {
+            period: point.period,
+            x: point.x.clone(),
+            held: self.problem.held_at(point.omega),
+        };
+        match self.tail.continues(sample, &weights, per) {
+            Ok(()) => label,
+            Err(ratio) => Label::OffBranch { ratio },
+        }
     }
 
     /// The Floquet multipliers and Hill exponents the request asks of a converged point, where

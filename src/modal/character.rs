@@ -197,23 +197,34 @@ pub enum Label {
     /// The time-domain check was asked for and the point failed it: it is not a motion of the
     /// bars to tolerance, whatever its harmonic content says.
     Unverified,
+    /// The point's harmonic content reads as the branch's own (skeleton or subharmonic), but
+    /// the point does not continue the branch its run followed: it lies `ratio` times the
+    /// predicted step away from the branch's secant prediction, more than
+    /// [`JUMP_RATIO`](crate::branches::JUMP_RATIO) (a spike of a truncation resonance, or a
+    /// neighbouring solution the corrector jumped to). Given by the runs of
+    /// [`compute`](crate::branches::compute), never by [`label`].
+    OffBranch {
+        /// Distance to the branch's prediction over the predicted step.
+        ratio: f64,
+    },
 }
 
 impl Label {
     /// The kind of label without its numbers: `skeleton`, `subharmonic`,
-    /// `internal-resonance` or `unverified` (for grouping points in reports).
+    /// `internal-resonance`, `unverified` or `off-branch` (for grouping points in reports).
     pub fn kind(&self) -> &'static str {
         match self {
             Label::Skeleton => "skeleton",
             Label::Subharmonic { .. } => "subharmonic",
             Label::InternalResonance { .. } => "internal-resonance",
             Label::Unverified => "unverified",
+            Label::OffBranch { .. } => "off-branch",
         }
     }
 }
 
 /// CSV-safe (no comma, no space): `skeleton`, `subharmonic-3`,
-/// `internal-resonance-h3-mode2`, `unverified`.
+/// `internal-resonance-h3-mode2`, `unverified`, `off-branch`.
 impl fmt::Display for Label {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -236,6 +247,11 @@ impl fmt::Display for Label {
 ///    [`Label::Subharmonic`] for `k > 1`.
 /// 3. Otherwise [`Label::InternalResonance`] with the mode whose natural frequency is nearest
 ///    `j Omega` ([`nearest_mode`]).
+///
+/// This is the label of one point's content. The runs of
+/// [`compute`](crate::branches::compute) also ask whether the point continues the branch
+/// they followed, and label a skeleton or subharmonic point that does not
+/// [`Label::OffBranch`].
 ///
 /// Why the dominant harmonic: near its skeleton, NSM `i` sub `k` is the linear mode `i`
 /// (frequency `omega_i`) slightly deformed by the contacts and repeated over `k` of its

@@ -27,7 +27,7 @@ pub struct Discretization<B: Basis = CosineBasis> {
     kink_blend: f64,
     layout: Layout,
     /// Unknowns per basis coefficient (`2 n_bars`).
-    pub(super) unknowns: usize,
+    pub(crate) unknowns: usize,
     /// Linear rows per basis coefficient (`2 n_bars - n_contacts`).
     pub(super) linear_count: usize,
     /// Number of unilateral laws.
@@ -350,7 +350,7 @@ impl<B: Basis> Discretization<B> {
     /// `A cos(kx) + B sin(kx)/k` of bar `b` stores about `EA l (A^2 k^2 + B^2) / 4` of
     /// strain energy, so `w_A = EA l (k^2 + 1/l^2)` (the `1/l^2` keeps rigid displacements
     /// weighted) and `w_B = EA l`.
-    pub(super) fn state_weights(&self, omega: f64) -> Vec<f64> {
+    pub(crate) fn state_weights(&self, omega: f64) -> Vec<f64> {
         let bars = self.system.bars();
         let mut w = Vec::with_capacity(self.dimension());
         for i in 0..self.basis.len() {

@@ -220,6 +220,13 @@ impl<B: Basis> NonsmoothSystem<B> {
             .map_or_else(Vec::new, |s| s.dropped_harmonics(self.description.basis()))
     }
 
+    /// The basis coefficients the harmonic selection holds at zero at `omega`, ascending
+    /// (empty without selection); the problem stays at its own frequency.
+    pub(crate) fn held_at(&mut self, omega: f64) -> Vec<usize> {
+        let (system, basis) = (self.description.system(), self.description.basis());
+        (self.selection.as_mut()).map_or_else(Vec::new, |s| s.dropped_at((system, basis), omega))
+    }
+
     /// The selection when it drops a harmonic at the current frequency.
     fn active_selection(&self) -> Option<&Selection> {
         self.selection.as_ref().filter(|s| s.active())

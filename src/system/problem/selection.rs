@@ -137,9 +137,18 @@ impl Selection {
     /// Recomputes the dropped coefficients at `omega`, extending the natural frequencies when
     /// `omega` needs higher ones.
     pub(crate) fn select<B: Basis>(&mut self, (system, basis): (&BarSystem, &B), omega: f64) {
-        self.dropped.clear();
+        self.dropped = self.dropped_at((system, basis), omega);
+    }
+
+    /// The coefficients the selection drops at `omega` (the current ones are left as they
+    /// are), extending the natural frequencies when `omega` needs higher ones.
+    pub(crate) fn dropped_at<B: Basis>(
+        &mut self,
+        (system, basis): (&BarSystem, &B),
+        omega: f64,
+    ) -> Vec<usize> {
         if !(omega.is_finite() && omega > 0.0) {
-            return;
+            return Vec::new();
         }
         let band = self.width / basis.harmonics().max(1) as f64;
         let needed = (basis.harmonics() as f64 + 1.0) * omega * (1.0 + band);
@@ -158,7 +167,7 @@ impl Selection {
             self.covered = bound;
         }
         let natural = &self.natural;
-        self.dropped = (0..basis.len())
+        (0..basis.len())
             .filter(|&i| {
                 let n = basis.harmonic(i);
                 droppable(n, basis.harmonics())
@@ -166,7 +175,7 @@ impl Selection {
                         .iter()
                         .any(|w| (n as f64 * omega / w - 1.0).abs() < band)
             })
-            .collect();
+            .collect()
     }
 
     /// `x` with the dropped unknowns set to zero (the scratch is handed out; give it back with
