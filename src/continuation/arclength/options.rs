@@ -1,9 +1,9 @@
 //! Options of the pseudo-arclength driver: steps, range, predictor, norm scales, step control,
 //! and their validation.
 
+use crate::continuation::range::{Direction, Ends, Range};
 #[cfg(doc)]
 use crate::continuation::EndReason;
-use crate::continuation::{Direction, Ends, Range};
 use crate::error::ContinuationError;
 
 /// How the predictor direction is formed.
@@ -41,8 +41,8 @@ pub struct ArclengthOptions {
     pub ds_max: f64,
     /// Accepted points before [`EndReason::MaxSteps`] (default 2000).
     pub max_steps: usize,
-    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves `[lo, hi]`
-    /// (default unbounded).
+    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves `[lo, hi]`,
+    /// `lo < hi` (default unbounded; infinite bounds are allowed, NaN is not).
     pub parameter_range: (f64, f64),
     /// Initial direction of `lambda`: `+1` or `-1` (default `+1`).
     pub direction: f64,
