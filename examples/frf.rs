@@ -40,8 +40,9 @@
 //! contact law between the samples (`forced::ForcedSystem::contact_defect`) and
 //! `dropped_harmonics` the harmonics the band held at zero there (separated by `;`). Every point
 //! computed is written; a run that ends early, or whose start does not converge, says why on
-//! stderr and exits with code 1. Usage errors, including a system or forcing the library
-//! refuses, exit with code 2.
+//! stderr and exits with code 1. Usage errors, including a system, forcing or frequency range
+//! the library refuses (`--omega-range 2:1` is reversed: the sweep climbs from `LO`), exit
+//! with code 2.
 
 use lexopt::prelude::*;
 use nonsmooth_modes::bar::{Bar, EndRef};
@@ -312,6 +313,8 @@ fn run(a: Args) -> Result<ExitCode, Box<dyn std::error::Error>> {
     };
     let response = match forced_response(&a.system, &request) {
         Ok(r) => r,
+        // A range refused as given is a usage error (exit 2, with the usage).
+        Err(e) if e.bad_range().is_some() => return Err(format!("{e}\n{USAGE}").into()),
         // A solver that fails at the start is a failed run (exit 1), not a usage error.
         Err(e @ (Error::Solve(_) | Error::Continuation(_))) => {
             eprintln!("frf: {e}");

@@ -339,6 +339,11 @@ pub enum SettingsError {
         /// How many items there are (valid indices are `0..count`).
         count: usize,
     },
+    /// A range given by its ends (a period or energy grid, a range of forcing frequencies)
+    /// that cannot be used: empty, reversed, a single value, or ends that are not finite or
+    /// not positive.
+    #[error(transparent)]
+    Range(#[from] BadRange),
     /// A request within the memory budget that the allocator refused all the same (the
     /// process has less memory than the budget left): returned instead of aborting.
     #[error("{what} needs {bytes:.3e} bytes, which the allocator refused")]
@@ -530,6 +535,10 @@ pub enum ContinuationError {
     /// ([`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES)).
     #[error(transparent)]
     TooLarge(#[from] OverBudget),
+    /// A parameter range or list of values that cannot be used: empty (all its values equal),
+    /// reversed or with a NaN end.
+    #[error(transparent)]
+    Range(#[from] BadRange),
 }
 
 /// Errors of the time-domain integrator and of the periodicity check ([`crate::verify`]).
@@ -880,5 +889,99 @@ fn binary_size(bytes: f64) -> String {
 impl From<OverBudget> for Error {
     fn from(e: OverBudget) -> Self {
         Error::Settings(e.into())
+    }
+}
+
+/// What makes a range unusable ([`BadRange`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum RangeDefect {
+    /// Its ends are equal (for a list of values: all its values are): a grid of several
+    /// steps would compute the same point again and again, a range would hold nothing to
+    /// continue in.
+    Empty,
+    /// Its start lies above its end where the range must rise (a range of forcing
+    /// frequencies, a continuation's `(lo, hi)`): the computation would have nowhere to go.
+    Reversed,
+    /// A grid of fewer than two steps, which has no step to take.
+    SinglePoint,
+    /// An end is NaN or infinite.
+    NotFinite,
+    /// An end is zero or negative where the range holds periods, frequencies or energy
+    /// levels, which are positive.
+    NotPositive,
+}
+
+/// A range given by its two ends (and, for a grid, its number of values) that cannot be used,
+/// quoted as it was given: carried by the `Range` variants of [`SettingsError`] (period and
+/// energy grids, forcing frequencies) and [`ContinuationError`] (a continuation's parameter
+/// range or values).
+///
+/// Its message names the range, its ends and steps as given, and what is wrong with them,
+/// so that a user who typed `3.5` twice or `2:1` sees those numbers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BadRange {
+    /// Which range (e.g. "period grid", "forcing frequency range").
+    pub what: &'static str,
+    /// Its start as given.
+    pub start: f64,
+    /// Its end as given.
+    pub end: f64,
+    /// Its number of values, for a grid (`None` for a range `(lo, hi)`).
+    pub steps: Option<usize>,
+    /// What is wrong with it.
+    pub defect: RangeDefect,
+}
+
+impl std::fmt::Display for BadRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Self {
+            what, start, end, ..
+        } = self;
+        write!(f, "the {what} from {start} to {end}")?;
+        if let Some(steps) = self.steps {
+            let plural = if steps == 1 { "" } else { "s" };
+            write!(f, " in {steps} step{plural}")?;
+        }
+        match self.defect {
+            RangeDefect::Empty if self.steps.is_some() => write!(
+                f,
+                " is empty: its ends are equal, so every step would compute the same point"
+            ),
+            RangeDefect::Empty => write!(f, " is empty: its ends are equal"),
+            RangeDefect::Reversed => write!(
+                f,
+                " is reversed: it must rise, from its lower end to its higher ({start} > {end})"
+            ),
+            RangeDefect::SinglePoint => {
+                write!(f, " has fewer than 2 values: give at least 2 steps")
+            }
+            RangeDefect::NotFinite => write!(f, " has an end that is not finite"),
+            RangeDefect::NotPositive => {
+                write!(f, " has an end that is not positive: both must be above 0")
+            }
+        }
+    }
+}
+
+impl std::error::Error for BadRange {}
+
+/// A grid or a range of frequencies is a setting.
+impl From<BadRange> for Error {
+    fn from(e: BadRange) -> Self {
+        Error::Settings(e.into())
+    }
+}
+
+impl Error {
+    /// The range this error refuses, if it is one ([`SettingsError::Range`] or
+    /// [`ContinuationError::Range`]): input to correct, not a computation that failed, so a
+    /// front end can report it as a usage error.
+    pub fn bad_range(&self) -> Option<&BadRange> {
+        match self {
+            Error::Settings(SettingsError::Range(r))
+            | Error::Continuation(ContinuationError::Range(r)) => Some(r),
+            _ => None,
+        }
     }
 }

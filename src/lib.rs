@@ -100,6 +100,7 @@ pub mod system;
 pub mod verify;
 
 pub use error::{
-    ContinuationError, Error, ForcingError, ModelError, SettingsError, SolveError, StabilityError,
+    BadRange, ContinuationError, Error, ForcingError, ModelError, RangeDefect, SettingsError,
+    SolveError, StabilityError,
 };
 pub use solution::Solution;

@@ -5,10 +5,15 @@ use nonsmooth_modes::bc::{
     BoundaryCondition, Contact, LinearRows, Quantity, Robin, Signorini, Term,
 };
 use nonsmooth_modes::branches::{
-    compute, lift, ArclengthBackboneOptions, BackboneOptions, Method, ModeBranches, PeriodGrid,
-    Request,
+    compute, lift, parameter_branch, ArclengthBackboneOptions, BackboneOptions,
+    EnergyBackboneOptions, EnergyGrid, Method, ModeBranches, ParameterSteps, PeriodGrid, Request,
 };
-use nonsmooth_modes::continuation::{linspace, ContinuationProblem, Sequential, SequentialOptions};
+use nonsmooth_modes::continuation::{
+    linspace, ArclengthOptions, ContinuationProblem, Sequential, SequentialOptions,
+};
+use nonsmooth_modes::forced::{
+    forced_response, Damping, Excitation, Forcing, ResponseMethod, ResponseRequest,
+};
 use nonsmooth_modes::linalg::DenseMatrix;
 use nonsmooth_modes::modal::{branch_seed, grazing_energy, natural_frequencies, ContactState};
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
@@ -18,7 +23,9 @@ use nonsmooth_modes::solve::{
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
-use nonsmooth_modes::{ContinuationError, Error, ModelError, SettingsError, SolveError};
+use nonsmooth_modes::{
+    BadRange, ContinuationError, Error, ModelError, RangeDefect, SettingsError, SolveError,
+};
 use std::f64::consts::PI;
 
 const BAD: [f64; 6] = [0.0, -1.0, -0.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY];
@@ -778,6 +785,44 @@ fn solver_options_validate_and_read_back() {
 
 type Driver = Sequential<'static, NonsmoothSystem, SemismoothNewton>;
 
+/// `range` is the range `what` from `start` to `end` (`steps` values for a grid) refused for
+/// `defect`, its numbers as given (a NaN end as NaN) and quoted in its message.
+fn assert_range(
+    range: &BadRange,
+    what: &str,
+    (start, end, steps): (f64, f64, Option<usize>),
+    defect: RangeDefect,
+) {
+    assert_eq!(range.what, what);
+    assert_eq!(range.defect, defect, "{range:?}");
+    assert!(
+        same(range.start, start) && same(range.end, end),
+        "{range:?}"
+    );
+    assert_eq!(range.steps, steps);
+    let message = range.to_string();
+    let mut quoted = format!("the {what} from {start} to {end}");
+    if let Some(steps) = steps {
+        quoted += &format!(" in {steps} step");
+    }
+    assert!(message.contains(&quoted), "{message}");
+}
+
+/// `result` refuses `grid` as a period grid with `defect`, quoting it as given.
+fn assert_bad_grid(result: Result<ModeBranches, Error>, grid: PeriodGrid, defect: RangeDefect) {
+    match result {
+        Err(e) => {
+            let Error::Settings(SettingsError::Range(r)) = &e else {
+                panic!("grid {grid:?}: expected a bad range, got {e:?}");
+            };
+            assert!(e.bad_range().is_some_and(|b| std::ptr::eq(b, r)));
+            let ends = (grid.start, grid.end, Some(grid.steps));
+            assert_range(r, "period grid", ends, defect);
+        }
+        Ok(run) => panic!("grid {grid:?} ran, {} points", run.points.len()),
+    }
+}
+
 #[test]
 fn bad_continuation_ranges() {
     let invalid = |r: Result<Vec<f64>, ContinuationError>, what: &str, value: f64| match r {
@@ -869,30 +914,20 @@ fn bad_period_grids() {
                 steps: 5,
             },
         ] {
-            match run(grid, 1e-6).unwrap_err() {
-                Error::Continuation(ContinuationError::InvalidOption { what, value }) => {
-                    assert_eq!(what, "period");
-                    assert!(same(value, v));
-                }
-                other => panic!("grid {grid:?}: {other:?}"),
-            }
+            let defect = if v.is_finite() {
+                RangeDefect::NotPositive
+            } else {
+                RangeDefect::NotFinite
+            };
+            assert_bad_grid(run(grid, 1e-6), grid, defect);
         }
     }
-    assert_eq!(
-        run(
-            PeriodGrid {
-                start: 3.9,
-                end: 3.5,
-                steps: 1
-            },
-            1e-6
-        )
-        .unwrap_err(),
-        Error::Continuation(ContinuationError::InvalidOption {
-            what: "steps (at least 2)",
-            value: 1.0
-        })
-    );
+    let single = PeriodGrid {
+        start: 3.9,
+        end: 3.5,
+        steps: 1,
+    };
+    assert_bad_grid(run(single, 1e-6), single, RangeDefect::SinglePoint);
     for v in [-1.0, f64::NAN, f64::INFINITY] {
         match run(
             PeriodGrid {
@@ -949,6 +984,182 @@ fn bad_period_grids() {
         assert!(p.energy.is_finite() && p.energy_normalized.is_finite());
         assert!(p.residual_norm.is_finite());
         assert!(p.x.iter().all(|v| v.is_finite()));
+    }
+}
+
+/// A period grid whose ends are equal would compute its one point at every step: refused,
+/// quoting the grid, by a named method and by `Method::Auto`, which also quotes a negative
+/// period as typed (not the frequency it would derive). Either direction of a grid is fine.
+#[test]
+fn degenerate_period_grids_are_refused_as_given() {
+    let system = clamped();
+    let settings = HarmonicBalanceSettings {
+        harmonics: 4,
+        ..Default::default()
+    };
+    let empty = PeriodGrid {
+        start: 3.5,
+        end: 3.5,
+        steps: 181,
+    };
+    let negative = PeriodGrid {
+        start: -3.5,
+        ..PAPER_GRID
+    };
+    for (grid, defect) in [
+        (empty, RangeDefect::Empty),
+        (negative, RangeDefect::NotPositive),
+    ] {
+        let options = BackboneOptions::on_grid(grid, 1, 1);
+        for method in [
+            Method::PeriodGrid(options),
+            Method::Auto(Some(options)),
+            Method::GenuineSubharmonic(BackboneOptions::on_grid(grid, 1, 2)),
+        ] {
+            let request = Request::for_method(method).settings(settings);
+            let result = compute(&system, &request);
+            if let Err(e) = &result {
+                assert!(!e.to_string().contains("frequency"), "{e}");
+            }
+            assert_bad_grid(result, grid, defect);
+        }
+    }
+    let message = empty.validate().unwrap_err().to_string();
+    assert!(
+        message.contains("from 3.5 to 3.5 in 181 steps is empty"),
+        "{message}"
+    );
+    let rising = PeriodGrid {
+        start: PAPER_GRID.end,
+        end: PAPER_GRID.start,
+        ..PAPER_GRID
+    };
+    assert!(rising.validate().is_ok() && PAPER_GRID.validate().is_ok());
+}
+
+/// Energy levels climb from the grazing point: equal ends and a falling grid are refused,
+/// quoting the levels.
+#[test]
+fn degenerate_energy_grids_are_refused_as_given() {
+    let system = clamped();
+    for (start, end, defect) in [
+        (2.0, 2.0, RangeDefect::Empty),
+        (300.0, 1.0, RangeDefect::Reversed),
+        (0.0, 2.0, RangeDefect::NotPositive),
+    ] {
+        let levels = EnergyGrid {
+            start,
+            end,
+            steps: 5,
+        };
+        let options = EnergyBackboneOptions {
+            levels,
+            ..EnergyBackboneOptions::for_mode(&system, 1, 1).unwrap()
+        };
+        let request = Request::for_method(Method::Energy(options)).harmonics(4);
+        match compute(&system, &request) {
+            Err(Error::Settings(SettingsError::Range(r))) => {
+                assert_range(&r, "energy grid", (start, end, Some(5)), defect);
+            }
+            other => panic!("{levels:?}: {:?}", other.map(|r| r.points.len())),
+        }
+    }
+}
+
+/// A forced response climbs its frequency range from its lower end: `2:1` is refused as
+/// reversed, `1:1` as empty, and ends that are not positive and finite as such, each
+/// quoting the range.
+#[test]
+fn degenerate_forcing_ranges_are_refused_as_given() {
+    let system = clamped();
+    let base = system.bar_id(0).unwrap().left();
+    let request = |omega_range| ResponseRequest {
+        settings: HarmonicBalanceSettings {
+            harmonics: 4,
+            ..Default::default()
+        },
+        forcing: Forcing {
+            damping: Damping::Uniform(1e-3),
+            excitations: vec![Excitation::base_motion(base, 1e-6)],
+        },
+        omega_range,
+        steps: 10,
+        method: ResponseMethod::Sequential,
+        solver: Solver::default(),
+    };
+    for ((lo, hi), defect) in [
+        ((2.0, 1.0), RangeDefect::Reversed),
+        ((1.5, 1.5), RangeDefect::Empty),
+        ((-1.0, 2.0), RangeDefect::NotPositive),
+        ((f64::NAN, 2.0), RangeDefect::NotFinite),
+    ] {
+        match forced_response(&system, &request((lo, hi))) {
+            Err(Error::Settings(SettingsError::Range(r))) => {
+                assert_range(&r, "forcing frequency range", (lo, hi, None), defect);
+            }
+            other => panic!("{lo}:{hi}: {:?}", other.map(|r| r.points.len())),
+        }
+    }
+    let message = forced_response(&system, &request((2.0, 1.0)))
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("from 2 to 1 is reversed"), "{message}");
+}
+
+/// A continuation's parameter range that is empty or reversed, and natural-parameter values
+/// that are all the same, are refused before the run starts, quoting them: the arclength
+/// backbone's frequency range, the driver's options and the values of `parameter_branch`.
+#[test]
+fn degenerate_parameter_ranges_are_refused_as_given() {
+    let system = clamped();
+    for ((lo, hi), defect) in [
+        ((2.0, 1.0), RangeDefect::Reversed),
+        ((1.6, 1.6), RangeDefect::Empty),
+    ] {
+        let options = ArclengthBackboneOptions {
+            omega_range: (lo, hi),
+            ..ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap()
+        };
+        let request = Request::for_method(Method::Arclength(options)).harmonics(4);
+        match compute(&system, &request) {
+            Err(Error::Settings(SettingsError::Range(r))) => {
+                assert_range(&r, "frequency range", (lo, hi, None), defect);
+            }
+            other => panic!("{lo}:{hi}: {:?}", other.map(|r| r.points.len())),
+        }
+        let driver = ArclengthOptions {
+            parameter_range: (lo, hi),
+            ..Default::default()
+        };
+        match driver.validate() {
+            Err(ContinuationError::Range(r)) => {
+                assert_range(&r, "parameter range", (lo, hi, None), defect);
+            }
+            other => panic!("{lo}:{hi}: {other:?}"),
+        }
+    }
+    let settings = HarmonicBalanceSettings {
+        harmonics: 4,
+        ..Default::default()
+    };
+    let n = NonsmoothSystem::new(&system, settings).unwrap().dimension();
+    let gap = 1e-3;
+    let steps = ParameterSteps::Values(vec![gap; 4], SequentialOptions::default());
+    let result = parameter_branch(
+        clamped_bar_with_obstacle,
+        settings,
+        (vec![0.0; n], 2.0 * PI / 3.6),
+        gap,
+        steps,
+        SemismoothNewton::default(),
+        |_, _| std::ops::ControlFlow::Continue(()),
+    );
+    match result {
+        Err(Error::Continuation(ContinuationError::Range(r))) => {
+            let ends = (gap, gap, Some(4));
+            assert_range(&r, "parameter values", ends, RangeDefect::Empty);
+        }
+        other => panic!("{:?}", other.map(|b| b.points.len())),
     }
 }
 

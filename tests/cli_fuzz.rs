@@ -264,9 +264,17 @@ fn command_line(
     args
 }
 
-/// What the `backbone` lines always end with: few points when they verify or compute
-/// multipliers or Hill exponents (later flags override earlier ones).
+/// What the `backbone` lines always end with: sometimes a period grid whose ends are equal
+/// (which the library refuses), and few points when they verify or compute multipliers or
+/// Hill exponents (later flags override earlier ones).
 fn backbone_tail(rng: &mut Rng, args: &mut Vec<String>) {
+    if rng.chance(0.05) {
+        let period = format!("{:.4e}", rng.log_uniform(0.5, 12.0));
+        for flag in ["--period-start", "--period-end"] {
+            args.push(flag.to_string());
+            args.push(period.clone());
+        }
+    }
     if (args.iter()).any(|a| a == "--verify" || a == "--stability" || a == "--hill") {
         for flag in ["--steps", "--max-steps"] {
             args.push(flag.to_string());
@@ -343,7 +351,12 @@ fn valid(rng: &mut Rng, value: Value, dir: &Path, index: usize) -> String {
         Value::Real(lo, hi) => format!("{:.4e}", rng.log_uniform(lo, hi)),
         Value::Range(lo, hi) => {
             let (a, b) = (rng.log_uniform(lo, hi), rng.log_uniform(lo, hi));
-            format!("{:.4e}:{:.4e}", a.min(b), a.max(b))
+            // Mostly rising; sometimes reversed or empty, which the library refuses.
+            match rng.below(10) {
+                0 => format!("{:.4e}:{:.4e}", a.max(b), a.min(b)),
+                1 => format!("{a:.4e}:{a:.4e}"),
+                _ => format!("{:.4e}:{:.4e}", a.min(b), a.max(b)),
+            }
         }
         Value::File => match rng.below(4) {
             // A directory that does not exist.
@@ -649,6 +662,57 @@ fn fuzz_frf_long() {
         from_env("CLI_FUZZ_LINES", LONG_LINES),
         from_env("CLI_FUZZ_SEED", 0x1000_5eed),
     );
+}
+
+/// A range the library refuses as given is a usage error: exit code 2, the range quoted on
+/// stderr as typed (a period grid from 3.5 to 3.5 once computed 181 identical points; a
+/// reversed forcing range was reported as an empty continuation option, with neither end).
+#[test]
+fn degenerate_ranges_are_usage_errors() {
+    let forcing = [
+        "--system",
+        "ds",
+        "--forcing",
+        "base:1.start:1e-6",
+        "--damping",
+        "1e-3",
+    ];
+    let reversed: Vec<&str> = forcing
+        .iter()
+        .copied()
+        .chain(["--omega-range", "2:1"])
+        .collect();
+    let cases: [(&Cli, &[&str], &[&str]); 3] = [
+        (
+            &BACKBONE,
+            &["--period-start", "3.5", "--period-end", "3.5"],
+            &["period grid from 3.5 to 3.5 in 181 steps is empty"],
+        ),
+        (
+            &BACKBONE,
+            &["--period-start", "-3.5"],
+            &["period grid from -3.5 to 3.05", "not positive"],
+        ),
+        (
+            &FRF,
+            &reversed,
+            &["forcing frequency range from 2 to 1 is reversed"],
+        ),
+    ];
+    for (cli, args, quoted) in cases {
+        let binary = example_binary(cli.example, cli.source);
+        let output = Command::new(&binary)
+            .args(args)
+            .stdin(Stdio::null())
+            .output()
+            .expect("spawn the example");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        for text in quoted {
+            assert!(stderr.contains(text), "{args:?}: {stderr}");
+        }
+        assert!(stderr.contains("usage:"), "{args:?}: {stderr}");
+    }
 }
 
 /// The `gallery` example refuses what it does not know before any computation: an unknown

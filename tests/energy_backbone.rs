@@ -16,7 +16,7 @@ use nonsmooth_modes::solve::{Problem, Solver, Structured};
 use nonsmooth_modes::system::{
     AssemblyBuilder, BarSystem, HarmonicBalanceSettings, NonsmoothSystem,
 };
-use nonsmooth_modes::{ContinuationError, Error};
+use nonsmooth_modes::{ContinuationError, Error, SettingsError};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
@@ -175,8 +175,8 @@ fn energy_levels_must_be_positive() {
         let run = compute(&system, &request(8, Method::Energy(options)));
         assert!(
             matches!(
-                run,
-                Err(Error::Continuation(ContinuationError::InvalidOption { .. }))
+                &run,
+                Err(Error::Settings(SettingsError::Range(r))) if r.what == "energy grid"
             ),
             "{start}..{end}: {run:?}"
         );

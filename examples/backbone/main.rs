@@ -157,11 +157,15 @@
 //! most [`MAX_SAMPLES_PER_HARMONIC`].
 //!
 //! Exit codes: 0 when the run completed (steps that did not converge are reported, not
-//! errors); 1 when the run failed, including values the library rejects (`--steps 0`,
-//! `--gap nan`, sizes over its memory budget, an unwritable `--out`); 2 on a usage error (an
-//! unknown flag, a missing or unparsable value, a value over the example's limits, `--system`
-//! with `--assembly`, an assembly file that cannot be read or built). Every
-//! failure is explained on stderr. `--help` prints the usage on stdout and exits with 0.
+//! errors); 1 when the run failed, including values the library rejects (`--gap nan`, sizes
+//! over its memory budget, an unwritable `--out`); 2 on a usage error (an unknown flag, a
+//! missing or unparsable value, a value over the example's limits, `--system` with
+//! `--assembly`, an assembly file that cannot be read or built, and a range the library
+//! refuses as given, `nonsmooth_modes::BadRange`: a period grid whose ends are equal
+//! (`--period-start 3.5 --period-end 3.5`), with fewer than 2 steps or a period that is not
+//! positive and finite, a falling `--energy-range`, an empty or reversed `--omega-range` or
+//! `--parameter-range`). Every failure is explained on stderr. `--help` prints the usage on
+//! stdout and exits with 0.
 //!
 //! [`MAX_POINTS`]: args::MAX_POINTS
 //! [`MAX_HARMONICS`]: args::MAX_HARMONICS
@@ -176,6 +180,14 @@ mod systems;
 use args::{parse, USAGE};
 use runs::run;
 use std::process::ExitCode;
+
+/// Whether `e` is the library refusing a range of the command line as given: input to
+/// correct, a usage error like an unparsable value, not a run that failed.
+fn is_bad_range(e: &(dyn std::error::Error + 'static)) -> bool {
+    e.downcast_ref::<nonsmooth_modes::Error>()
+        .and_then(nonsmooth_modes::Error::bad_range)
+        .is_some()
+}
 
 fn main() -> ExitCode {
     let args = match parse() {
@@ -200,6 +212,10 @@ fn main() -> ExitCode {
         Ok((total, converged)) => {
             eprintln!("backbone: {converged} of {total} steps converged");
             ExitCode::SUCCESS
+        }
+        Err(e) if is_bad_range(e.as_ref()) => {
+            eprintln!("backbone: {e}\n{USAGE}");
+            ExitCode::from(2)
         }
         Err(e) => {
             eprintln!("backbone: error: {e}");

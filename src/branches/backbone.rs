@@ -8,10 +8,11 @@ use crate::branches::start::{
 };
 use crate::branches::switch::{Runner, SwitchAt};
 use crate::continuation::{
-    linspace, Arclength, ArclengthOptions, Branch, EndReason, Observer, PeriodParametrised, Point,
-    Predictor, Rejection, Selection, Sequential, SequentialOptions, Speculation, Speculative, Step,
+    linspace, Arclength, ArclengthOptions, Branch, Direction, EndReason, Ends, Observer,
+    PeriodParametrised, Point, Predictor, Range, Rejection, Selection, Sequential,
+    SequentialOptions, Speculation, Speculative, Step,
 };
-use crate::error::{ContinuationError, Error};
+use crate::error::{BadRange, ContinuationError, Error};
 use crate::fourier::frequency_of_period;
 use crate::modal::energy::energy;
 use crate::modal::inputs::check_frequency_of;
@@ -21,6 +22,10 @@ use std::cell::RefCell;
 use std::ops::ControlFlow;
 
 /// `steps` equispaced periods from `start` to `end` (both included).
+///
+/// The grid may run either way: from long periods to short ones (the derived grids, from just
+/// below the linear period into the hardening range) or back (from inside the nonlinear
+/// range towards the linear mode). [`PeriodGrid::validate`] says which grids are refused.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PeriodGrid {
@@ -30,6 +35,22 @@ pub struct PeriodGrid {
     pub end: f64,
     /// Number of periods (at least 2).
     pub steps: usize,
+}
+
+impl PeriodGrid {
+    /// Checks the grid as given, before anything is computed.
+    ///
+    /// # Errors
+    /// [`BadRange`] quoting the grid: a period that is not finite
+    /// ([`RangeDefect::NotFinite`](crate::RangeDefect::NotFinite)) or not positive
+    /// ([`NotPositive`](crate::RangeDefect::NotPositive)), fewer than 2 steps
+    /// ([`SinglePoint`](crate::RangeDefect::SinglePoint)), or equal ends
+    /// ([`Empty`](crate::RangeDefect::Empty)): every step would compute the same point. Its
+    /// direction is free.
+    pub fn validate(&self) -> Result<(), BadRange> {
+        Range::grid("period grid", self.start, self.end, self.steps)
+            .check(Ends::Positive, Direction::Either)
+    }
 }
 
 /// Options of a period-grid backbone ([`Method::PeriodGrid`](crate::branches::Method::PeriodGrid)).
@@ -197,17 +218,9 @@ fn drive_backbone<S: NonlinearSolver>(
     ) -> Branch,
     mut observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
-    let mut problem = NonsmoothSystem::new(system, settings)?;
     let grid = options.grid;
-    for v in [grid.start, grid.end] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(ContinuationError::InvalidOption {
-                what: "period",
-                value: v,
-            }
-            .into());
-        }
-    }
+    grid.validate()?;
+    let mut problem = NonsmoothSystem::new(system, settings)?;
     check_trivial_energy(options.trivial_energy)?;
     for v in [grid.start, grid.end] {
         check_frequency_of(&problem, frequency_of_period(v))?;
@@ -455,6 +468,14 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         }
         .into());
     }
+    let arclength = ArclengthOptions {
+        parameter_range: options.omega_range,
+        ..options.arclength
+    };
+    // The range (empty, reversed: named as the frequencies it bounds) and the driver's steps
+    // are refused before the start search.
+    Range::bounds("frequency range", options.omega_range).check(Ends::NotNan, Direction::Rising)?;
+    arclength.validate()?;
     // The driver's parameter is the frequency: the asked start period is converted once.
     let asked = frequency_of_period(options.start_period);
     let omega0 = asked;
@@ -464,10 +485,6 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
     }
     let (e_g, start) = grazing_and_seed(&mut problem, options.mode, options.subharmonic, omega0)?;
     let basis = problem.basis().clone();
-    let arclength = ArclengthOptions {
-        parameter_range: options.omega_range,
-        ..options.arclength
-    };
     if let Some(escape) = options.escape {
         escape.validate()?;
     }

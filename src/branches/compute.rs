@@ -66,7 +66,11 @@ use std::ops::ControlFlow;
 /// assembly with a bar nothing holds
 /// ([`SettingsError::Unconfined`](crate::SettingsError::Unconfined)), a method whose options
 /// name another mode or order than the request
-/// ([`SettingsError::MethodDisagrees`](crate::SettingsError::MethodDisagrees)), or no start and no
+/// ([`SettingsError::MethodDisagrees`](crate::SettingsError::MethodDisagrees)), a period or
+/// energy grid that is empty, a single point, with a period or level that is not positive
+/// and finite, or a falling energy grid ([`SettingsError::Range`](crate::SettingsError::Range),
+/// quoting the grid as given, whatever the method, [`Method::Auto`](crate::branches::Method::Auto)
+/// included), or no start and no
 /// converged step ([`SettingsError::StartNotFound`](crate::SettingsError::StartNotFound),
 /// which says what was tried). A run that stalls or fails part-way returns its points with
 /// its end reason ([`ModeBranches::end`]).
@@ -111,6 +115,7 @@ pub fn compute_observed(
             .into());
         }
     }
+    request.method.validate_grid()?;
     let problem = NonsmoothSystem::new(system, request.settings)?;
     let (plan, method) = match asked(request) {
         Ok(planned) => planned,

@@ -11,7 +11,7 @@ use crate::branches::point::{BackbonePoint, PointStatus};
 use crate::continuation::{
     Arclength, ArclengthOptions, Branch, Point, Sequential, SequentialOptions, Step,
 };
-use crate::error::{ContinuationError, Error};
+use crate::error::{BadRange, ContinuationError, Error, RangeDefect};
 use crate::modal::energy::energy;
 use crate::modal::linear::grazing_energy;
 use crate::solve::NonlinearSolver;
@@ -51,7 +51,10 @@ pub enum ParameterSteps {
 /// # Errors
 /// A family that rejects `value`, a system at `value` without grazing energy, invalid
 /// settings or options, or a start where the solver fails ([`ContinuationError::Start`],
-/// arclength only).
+/// arclength only). Values that do not begin at `value` are refused
+/// ([`ContinuationError::InvalidOption`]), and so are several values all the same or an
+/// arclength range that is empty, reversed or has a NaN end ([`ContinuationError::Range`],
+/// quoting them): the run would have nowhere to go.
 pub fn parameter_branch<F, S>(
     family: F,
     settings: HarmonicBalanceSettings,
@@ -65,6 +68,9 @@ where
     F: SystemFamily + Clone,
     S: NonlinearSolver,
 {
+    if let ParameterSteps::Values(values, _) = &steps {
+        check_values(values, value)?;
+    }
     let basis = settings.cosine_basis()?;
     let floor = TRIVIAL_ENERGY;
     let problem = ParameterFamily::at(family.clone(), settings, omega, value)?;
@@ -88,13 +94,6 @@ where
     let mut see = |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report);
     let branch = match steps {
         ParameterSteps::Values(values, options) => {
-            if values.first() != Some(&value) {
-                return Err(ContinuationError::InvalidOption {
-                    what: "first parameter value (must be the start's)",
-                    value: values.first().copied().unwrap_or(f64::NAN),
-                }
-                .into());
-            }
             Sequential::new(problem, solver, x, values, options)?.run(&mut see)
         }
         ParameterSteps::Arclength(options) => {
@@ -102,4 +101,28 @@ where
         }
     };
     Ok(branch)
+}
+
+/// Checks the values of a natural-parameter run from the start's `value` before anything is
+/// computed: they begin at `value` ([`ContinuationError::InvalidOption`]), and several values
+/// that are all the same are an empty range, each step the same point
+/// ([`ContinuationError::Range`]).
+fn check_values(values: &[f64], value: f64) -> Result<(), ContinuationError> {
+    if values.first() != Some(&value) {
+        return Err(ContinuationError::InvalidOption {
+            what: "first parameter value (must be the start's)",
+            value: values.first().copied().unwrap_or(f64::NAN),
+        });
+    }
+    if values.len() >= 2 && values.iter().all(|v| *v == value) {
+        return Err(BadRange {
+            what: "parameter values",
+            start: value,
+            end: value,
+            steps: Some(values.len()),
+            defect: RangeDefect::Empty,
+        }
+        .into());
+    }
+    Ok(())
 }

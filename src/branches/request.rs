@@ -7,7 +7,7 @@ use crate::branches::backbone::{ArclengthBackboneOptions, BackboneOptions};
 use crate::branches::energy_backbone::EnergyBackboneOptions;
 use crate::branches::switch::SwitchAt;
 use crate::continuation::Speculation;
-use crate::error::SolveError;
+use crate::error::{BadRange, SolveError};
 use crate::solve::{NewtonOptions, SemismoothNewton, Solver};
 use crate::stability::{HillOptions, StabilityOptions};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
@@ -54,6 +54,23 @@ impl Method {
             Self::PeriodGrid(o) | Self::GenuineSubharmonic(o) => Some((o.mode, o.subharmonic)),
             Self::Arclength(o) | Self::Switch(o, _) => Some((o.mode, o.subharmonic)),
             Self::Energy(o) => Some((o.mode, o.subharmonic)),
+        }
+    }
+
+    /// Checks the grid the method carries (a period grid, energy levels), as given, before
+    /// anything is computed: [`Method::Auto`] would otherwise meet a bad period only as the
+    /// frequency it derives from it. Arclength ranges are checked with the driver's options.
+    ///
+    /// # Errors
+    /// [`BadRange`] as [`PeriodGrid::validate`](crate::branches::PeriodGrid::validate) and
+    /// [`EnergyGrid::validate`](crate::branches::EnergyGrid::validate).
+    pub(crate) fn validate_grid(&self) -> Result<(), BadRange> {
+        match self {
+            Self::Auto(Some(o)) | Self::PeriodGrid(o) | Self::GenuineSubharmonic(o) => {
+                o.grid.validate()
+            }
+            Self::Energy(o) => o.levels.validate(),
+            Self::Auto(None) | Self::Arclength(_) | Self::Switch(..) => Ok(()),
         }
     }
 

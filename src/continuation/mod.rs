@@ -24,6 +24,7 @@ pub mod augmented;
 mod bordering;
 mod driver;
 mod progress;
+mod range;
 mod sequential;
 mod speculative;
 
@@ -32,6 +33,7 @@ pub(crate) use bordering::{fill_bordered, solve_bordered};
 pub(crate) use driver::{next_point, run_with};
 pub use driver::{Branch, EndReason, Observer, RejectReason, Rejection, Step};
 pub use progress::{quiet, Progress};
+pub(crate) use range::{Direction, Ends, Range};
 pub use sequential::{geomspace, linspace, Predictor, Selection, Sequential, SequentialOptions};
 pub use speculative::{Speculation, SpeculationStats, Speculative};
 

@@ -4,8 +4,8 @@
 
 use crate::branches::{PointStatus, MAX_CONSECUTIVE_FAILURES};
 use crate::continuation::{
-    linspace, Arclength, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem, EndReason,
-    Point, Predictor, Sequential, SequentialOptions, Step,
+    linspace, Arclength, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem, Direction,
+    EndReason, Ends, Point, Predictor, Range, Sequential, SequentialOptions, Step,
 };
 use crate::error::{ContinuationError, Error, SettingsError};
 use crate::forced::{ForcedSystem, Forcing};
@@ -120,7 +120,8 @@ impl ForcedResponse {
 ///
 /// # Errors
 /// [`SettingsError`] and [`ForcingError`](crate::ForcingError) as [`ForcedSystem::new`];
-/// [`SettingsError::NotPositive`] / [`SettingsError::OutOfRange`] for a bad range;
+/// [`SettingsError::Range`] for a frequency range that is not positive and finite, empty
+/// or reversed (`lo > hi`), quoting it;
 /// [`ContinuationError`] for zero steps or a start that does not converge. A run that stops
 /// part-way returns its points and its [`EndReason`].
 pub fn forced_response(
@@ -128,22 +129,9 @@ pub fn forced_response(
     request: &ResponseRequest,
 ) -> Result<ForcedResponse, Error> {
     let (lo, hi) = request.omega_range;
-    if !(lo.is_finite() && lo > 0.0) {
-        return Err(SettingsError::NotPositive {
-            what: "lowest forcing frequency",
-            value: lo,
-        }
-        .into());
-    }
-    if !(hi.is_finite() && hi > lo) {
-        return Err(SettingsError::OutOfRange {
-            what: "highest forcing frequency",
-            value: hi,
-            min: lo,
-            max: f64::MAX,
-        }
-        .into());
-    }
+    // A sweep climbs from `lo`, as an experiment's does: a range given downwards is refused,
+    // not swept down.
+    Range::bounds("forcing frequency range", (lo, hi)).check(Ends::Positive, Direction::Rising)?;
     if request.steps == 0 {
         return Err(ContinuationError::InvalidOption {
             what: "steps",

@@ -9,9 +9,10 @@ pub use judge::{CALM_STEPS, ESCAPE_PERIODS, MARGINAL_SHARE, SLOPE_COLLAPSE, SLOP
 use crate::branches::level::EnergyLevel;
 use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
 use crate::continuation::{
-    augmented, geomspace, EndReason, Predictor, Sequential, SequentialOptions, Step,
+    augmented, geomspace, Direction, EndReason, Ends, Predictor, Range, Sequential,
+    SequentialOptions, Step,
 };
-use crate::error::Error;
+use crate::error::{BadRange, Error};
 use crate::modal::drift::check_held;
 use crate::modal::energy::energy;
 use crate::modal::linear::{grazing_energy, grazing_energy_of, open_mode};
@@ -20,7 +21,8 @@ use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::ops::ControlFlow;
 
 /// `steps` energy levels `E / E_g` from `start` to `end` (both included) in geometric
-/// progression.
+/// progression, rising: the run starts at the mode's grazing point and climbs the levels
+/// above it ([`EnergyGrid::validate`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct EnergyGrid {
@@ -33,6 +35,18 @@ pub struct EnergyGrid {
 }
 
 impl EnergyGrid {
+    /// Checks the levels as given, before anything is computed.
+    ///
+    /// # Errors
+    /// [`BadRange`] quoting the grid: a level that is not finite or not positive, fewer than
+    /// 2 steps, equal ends (every step the same level) or a grid that falls: the run climbs
+    /// from the grazing point through the levels above the one it has reached, so a falling
+    /// grid would jump to its first level and walk down against the run.
+    pub fn validate(&self) -> Result<(), BadRange> {
+        Range::grid("energy grid", self.start, self.end, self.steps)
+            .check(Ends::Positive, Direction::Rising)
+    }
+
     /// The first mode's grid: `E / E_g` from 1, its grazing point, to 300, in 181 levels.
     /// For the clamped bar this spans the paper's periods, `T = 3.90` to `3.02`.
     const FIRST_MODE: Self = Self {
@@ -145,11 +159,12 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
     solver: S,
     mut observer: impl FnMut(BackbonePoint) -> ControlFlow<()>,
 ) -> Result<(f64, EndReason), Error> {
+    let grid = options.levels;
+    grid.validate()?;
     let problem = NonsmoothSystem::new(system, settings)?;
     // A bar that can drift away has no periodic motion that touches it: refused as by the
     // period and arclength backbones.
     check_held(system)?;
-    let grid = options.levels;
     let levels = geomspace(grid.start, grid.end, grid.steps)?;
     let (e_g, first) = grazing_energy(system)?;
     let linear = if options.mode == 1 {

@@ -1,6 +1,7 @@
 //! Options of the pseudo-arclength driver: steps, range, predictor, norm scales, step control,
 //! and their validation.
 
+use crate::continuation::range::{Direction, Ends, Range};
 #[cfg(doc)]
 use crate::continuation::EndReason;
 use crate::error::ContinuationError;
@@ -40,8 +41,8 @@ pub struct ArclengthOptions {
     pub ds_max: f64,
     /// Accepted points before [`EndReason::MaxSteps`] (default 2000).
     pub max_steps: usize,
-    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves `[lo, hi]`
-    /// (default unbounded).
+    /// The run ends with [`EndReason::ParameterOutOfRange`] when `lambda` leaves `[lo, hi]`,
+    /// `lo < hi` (default unbounded; infinite bounds are allowed, NaN is not).
     pub parameter_range: (f64, f64),
     /// Initial direction of `lambda`: `+1` or `-1` (default `+1`).
     pub direction: f64,
@@ -100,9 +101,10 @@ impl ArclengthOptions {
     /// Checks the options.
     ///
     /// # Errors
-    /// [`ContinuationError::InvalidOption`] for non-finite or non-positive steps,
-    /// `ds_min > ds_max`, `ds` outside `[ds_min, ds_max]`, an empty or NaN range, a zero
-    /// direction, factors out of range or non-positive fixed scales.
+    /// [`ContinuationError::Range`] for a `parameter_range` that is empty, reversed or has a
+    /// NaN end (its bounds may be infinite); [`ContinuationError::InvalidOption`] for
+    /// non-finite or non-positive steps, `ds_min > ds_max`, `ds` outside `[ds_min, ds_max]`,
+    /// a zero direction, factors out of range or non-positive fixed scales.
     pub fn validate(&self) -> Result<(), ContinuationError> {
         let bad = |what, value| Err(ContinuationError::InvalidOption { what, value });
         for (what, v) in [
@@ -122,10 +124,8 @@ impl ArclengthOptions {
         if self.ds < self.ds_min || self.ds > self.ds_max {
             return bad("ds (outside [ds_min, ds_max])", self.ds);
         }
-        let (lo, hi) = self.parameter_range;
-        if lo.is_nan() || hi.is_nan() || lo >= hi {
-            return bad("parameter_range (empty)", hi - lo);
-        }
+        Range::bounds("parameter range", self.parameter_range)
+            .check(Ends::NotNan, Direction::Rising)?;
         if !(self.direction == 1.0 || self.direction == -1.0) {
             return bad("direction (must be +1 or -1)", self.direction);
         }
@@ -152,6 +152,7 @@ impl ArclengthOptions {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::RangeDefect;
 
     #[test]
     fn rejects_bad_options() {
@@ -164,14 +165,6 @@ mod tests {
             },
             ArclengthOptions {
                 ds: f64::NAN,
-                ..Default::default()
-            },
-            ArclengthOptions {
-                parameter_range: (1.0, 1.0),
-                ..Default::default()
-            },
-            ArclengthOptions {
-                parameter_range: (f64::NAN, 1.0),
                 ..Default::default()
             },
             ArclengthOptions {
@@ -202,6 +195,24 @@ mod tests {
             );
         }
         assert!(ArclengthOptions::default().validate().is_ok());
+        for (range, defect) in [
+            ((1.0, 1.0), RangeDefect::Empty),
+            ((2.0, 1.0), RangeDefect::Reversed),
+            ((f64::NAN, 1.0), RangeDefect::NotFinite),
+        ] {
+            let o = ArclengthOptions {
+                parameter_range: range,
+                ..Default::default()
+            };
+            match o.validate() {
+                Err(ContinuationError::Range(r)) => {
+                    assert_eq!(r.defect, defect);
+                    assert_eq!(r.start.to_bits(), range.0.to_bits());
+                    assert_eq!(r.end, range.1);
+                }
+                other => panic!("{range:?}: {other:?}"),
+            }
+        }
         let none_allowed = ArclengthOptions {
             max_rejections: 0,
             ..Default::default()
