@@ -58,8 +58,10 @@ pub enum Verdict {
     Stable,
     /// A multiplier lies outside, where the crossing says.
     Unstable(Crossing),
-    /// The state could not be corrected to a periodic orbit of the grid's map near the
-    /// point's own motion: the multipliers (still reported) describe no motion of the point.
+    /// No verdict: the state could not be corrected to a periodic orbit of the grid's map
+    /// near the point's own motion, or the differences did not find the trivial pair
+    /// ([`Floquet::unresolved`] says which, with the numbers). The multipliers (still
+    /// reported) support no verdict.
     Unresolved,
 }
 
@@ -95,17 +97,31 @@ pub struct Floquet {
     /// counted as on it: exactly 1 for a stable point (a conservative motion has
     /// multipliers on the circle; the grid's projection pulls some inward and the
     /// differences' error splits the multiple multiplier 1 by up to about the square root
-    /// of that error), `max |mu|` otherwise.
+    /// of that error), `max |mu|` otherwise. Of an unresolved point it means nothing (the
+    /// monodromy of a state that is not periodic has moduli such as `sqrt 2` or the golden
+    /// ratio, from the order of its events): writers leave it out.
     pub max_multiplier: f64,
     /// Stable when every multiplier lies within
     /// [`StabilityOptions::tolerance`](super::StabilityOptions::tolerance) of the unit circle
-    /// or inside it, unresolved when the state is not a periodic orbit near the point.
+    /// or inside it, unresolved when the state is not a periodic orbit near the point or the
+    /// trivial pair is not found.
     pub verdict: Verdict,
+    /// Why the verdict is [`Verdict::Unresolved`]: `Some` exactly then.
+    pub unresolved: Option<UnresolvedReason>,
     /// The larger `|mu - 1|` of the two multipliers nearest 1: the trivial pair of the time
-    /// shift and the family direction (a Jordan block at 1), which the differences' error
-    /// splits by about its square root. Within the tolerance, the pair is set to exactly 1 in
+    /// shift and the family direction (a Jordan block at 1), which an error `e` of the matrix
+    /// splits by about `sqrt(e)`. When the pair is found, it is set to exactly 1 in
     /// [`Floquet::multipliers`].
     pub trivial_distance: f64,
+    /// Where the pair lies beyond the tolerance: the size of the perturbation of the
+    /// monodromy matrix that makes it the double multiplier 1, `|(mu_1 + mu_2) / 2 - 1| +
+    /// |mu_1 - mu_2| sin(theta) / 2` with `theta` the angle between the two eigenvectors
+    /// (Wilkinson's distance to a double eigenvalue; see the
+    /// [module docs](super#the-trivial-pair)). The pair is found when this is within the
+    /// tolerance: the error that splits it is then no larger than the error the verdict
+    /// allows every other multiplier. `None` where the pair lies within the tolerance, or
+    /// where the state is not periodic.
+    pub trivial_perturbation: Option<f64>,
     /// Rows of the monodromy matrix.
     pub dimension: usize,
     /// The time step of the grid.
@@ -165,52 +181,148 @@ pub(crate) fn remove_nearest_one(multipliers: &mut Vec<Multiplier>, count: usize
     }
 }
 
-/// The larger `|mu - 1|` of the two multipliers nearest 1 (`inf` without two).
-pub(crate) fn trivial_pair_distance(multipliers: &[Multiplier]) -> f64 {
-    nearest_one(multipliers)
-        .get(1)
-        .map_or(f64::INFINITY, |&i| multipliers[i].distance_to_one())
+/// How nearly the two multipliers nearest 1 are the double multiplier 1 of the time shift
+/// and the family direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TrivialPair {
+    /// The larger `|mu - 1|` of the two (`inf` without two).
+    pub distance: f64,
+    /// The size of the perturbation of the monodromy matrix that makes the pair the double
+    /// multiplier 1 ([`pair_perturbation`]); computed only where `distance` exceeds the
+    /// tolerance (`None` otherwise, or without two multipliers).
+    pub perturbation: Option<f64>,
 }
 
-/// Sets the two multipliers nearest 1 to exactly 1 when both lie within `tolerance` of it:
-/// the time shift and the family direction of a conservative autonomous system make 1 a
-/// double multiplier (a Jordan block), which the differences' error `e` splits by about
-/// `sqrt(e)`, so that the computed pair carries no information beyond that error. Returns
-/// the larger of their distances to 1 (`inf` without two multipliers), and keeps the list
-/// sorted by decreasing modulus.
-fn snap_trivial_pair(multipliers: &mut [Multiplier], tolerance: f64) -> f64 {
-    let [first, second, ..] = nearest_one(multipliers)[..] else {
-        return f64::INFINITY;
+impl TrivialPair {
+    /// How far the pair is from the double multiplier 1: the smaller of its distance and the
+    /// perturbation.
+    pub(crate) fn miss(&self) -> f64 {
+        self.perturbation.map_or(self.distance, |p| p.min(self.distance))
+    }
+
+    /// Whether the pair is found at `tolerance`.
+    pub(crate) fn found(&self, tolerance: f64) -> bool {
+        self.miss() <= tolerance
+    }
+}
+
+/// The trivial pair of `multipliers` (the eigenvalues of `monodromy` without its `spurious`
+/// exact multipliers 1), with the perturbation computed when `refine` and the pair lies
+/// farther than `tolerance` from 1.
+pub(crate) fn trivial_pair(
+    monodromy: &Monodromy,
+    multipliers: &[Multiplier],
+    spurious: usize,
+    tolerance: f64,
+    refine: bool,
+) -> Result<TrivialPair, StabilityError> {
+    let distance = nearest_one(multipliers)
+        .get(1)
+        .map_or(f64::INFINITY, |&i| multipliers[i].distance_to_one());
+    let perturbation = if refine && distance > tolerance && distance.is_finite() {
+        pair_perturbation(monodromy, spurious)?
+    } else {
+        None
     };
-    let distance = multipliers[second].distance_to_one();
-    if distance <= tolerance {
+    Ok(TrivialPair {
+        distance,
+        perturbation,
+    })
+}
+
+/// The size of the smallest perturbation of `monodromy` that makes its two multipliers
+/// nearest 1 (after the `spurious` exact ones) the double multiplier 1:
+///
+/// `|(mu_1 + mu_2) / 2 - 1| + |mu_1 - mu_2| sin(theta) / 2`,
+///
+/// `theta` the angle between their eigenvectors. A Jordan block `[[1, c], [0, 1]]` perturbed
+/// by `E` has the multipliers `1 + tr(E) / 2 +- sqrt(c e_21)`: the mean moves by the
+/// perturbation, the split by its square root, and the eigenvectors `(1, +-sqrt(e_21 / c))`
+/// close up, `sin(theta) ~ 2 sqrt(e_21 / c)`, so that the split times `sin(theta) / 2` is
+/// `2 e_21`, whatever `c`. This is Wilkinson's distance from a matrix to the nearest one with
+/// a double eigenvalue, `|mu_1 - mu_2| / (kappa_1 + kappa_2)`, with the condition numbers
+/// `kappa = 1 / sin(theta)` of the pair's invariant subspace; the mean's term moves the
+/// double eigenvalue to 1. `None` without two multipliers.
+fn pair_perturbation(
+    monodromy: &Monodromy,
+    spurious: usize,
+) -> Result<Option<f64>, StabilityError> {
+    let n = monodromy.nrows();
+    let eigen = monodromy
+        .eigen()
+        .map_err(|_| StabilityError::NoEigenvalues { dimension: n })?;
+    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    let all: Vec<Multiplier> = values
+        .iter()
+        .map(|z| Multiplier { re: z.re, im: z.im })
+        .collect();
+    let Some(&[a, b]) = nearest_one(&all).get(spurious..spurious + 2) else {
+        return Ok(None);
+    };
+    let (mut dot_re, mut dot_im, mut norm_a, mut norm_b) = (0.0, 0.0, 0.0, 0.0);
+    for i in 0..n {
+        let (x, y) = (vectors[(i, a)], vectors[(i, b)]);
+        // conj(x) y
+        dot_re += x.re * y.re + x.im * y.im;
+        dot_im += x.re * y.im - x.im * y.re;
+        norm_a += x.re * x.re + x.im * x.im;
+        norm_b += y.re * y.re + y.im * y.im;
+    }
+    let cos = (dot_re.hypot(dot_im) / (norm_a * norm_b).sqrt()).min(1.0);
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let (mu, nu) = (all[a], all[b]);
+    let mean = (0.5 * (mu.re + nu.re) - 1.0).hypot(0.5 * (mu.im + nu.im));
+    let split = (mu.re - nu.re).hypot(mu.im - nu.im);
+    let perturbation = mean + 0.5 * split * sin;
+    Ok(perturbation.is_finite().then_some(perturbation))
+}
+
+/// Sets the two multipliers nearest 1 to exactly 1 (the trivial pair, found), keeping the
+/// list sorted by decreasing modulus.
+fn snap_trivial_pair(multipliers: &mut [Multiplier]) {
+    if let [first, second, ..] = nearest_one(multipliers)[..] {
         for i in [first, second] {
             multipliers[i] = Multiplier { re: 1.0, im: 0.0 };
         }
         multipliers.sort_by(|a, b| b.modulus().total_cmp(&a.modulus()));
     }
-    distance
+}
+
+/// The size of the map whose multipliers are judged: rows of the matrix, time step, period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MapShape {
+    pub dimension: usize,
+    pub dt: f64,
+    pub period: f64,
 }
 
 /// The verdict of `multipliers` (largest modulus first) at `tolerance`, for a state
-/// `corrected` to a periodic orbit (`periodic` when the correction succeeded). The verdict
-/// is resolved only when the state is periodic and the trivial pair is found within
-/// `tolerance`: where the differences cannot find it, they are not accurate enough for the
-/// others either (an event whose timing is singular, such as a grazing impact).
+/// `corrected` towards a periodic orbit, with its trivial pair `pair`. `failure` is why the
+/// correction does not count (`None` when it reached a periodic orbit near the point). The
+/// verdict is resolved only when the correction counts and the trivial pair is found: where
+/// the differences cannot find it, they are not accurate enough for the others either (an
+/// event whose timing is singular, such as a grazing impact).
 pub(crate) fn verdict(
     mut multipliers: Vec<Multiplier>,
     tolerance: f64,
-    dimension: usize,
-    dt: f64,
-    period: f64,
+    pair: TrivialPair,
+    failure: Option<UnresolvedReason>,
     corrected: &Corrected,
-    periodic: bool,
+    shape: MapShape,
 ) -> Floquet {
-    let trivial_distance = snap_trivial_pair(&mut multipliers, tolerance);
-    let resolved = periodic && trivial_distance <= tolerance;
+    let unresolved = failure.or_else(|| {
+        (!pair.found(tolerance)).then(|| UnresolvedReason::TrivialPairMissing {
+            distance: pair.distance,
+            perturbation: pair.perturbation.unwrap_or(pair.distance),
+            tolerance,
+        })
+    });
+    if unresolved.is_none() {
+        snap_trivial_pair(&mut multipliers);
+    }
     let max_modulus = multipliers.first().map_or(0.0, Multiplier::modulus);
     let verdict = match multipliers.first() {
-        _ if !resolved => Verdict::Unresolved,
+        _ if unresolved.is_some() => Verdict::Unresolved,
         Some(mu) if mu.modulus() > 1.0 + tolerance => {
             Verdict::Unstable(if mu.im.abs() > tolerance * mu.modulus() {
                 Crossing::ComplexPair
@@ -231,14 +343,115 @@ pub(crate) fn verdict(
             max_modulus
         },
         verdict,
-        trivial_distance,
-        dimension,
-        dt,
+        unresolved,
+        trivial_distance: pair.distance,
+        trivial_perturbation: pair.perturbation,
+        dimension: shape.dimension,
+        dt: shape.dt,
         initial_defect: corrected.initial_defect,
         periodicity_defect: corrected.defect,
         correction: corrected.shift,
         displacement_correction: corrected.displacement_shift,
         energy_correction: corrected.energy_change,
-        period,
+        period: shape.period,
+    }
+}
+
+/// Why a point's multipliers give no verdict ([`Verdict::Unresolved`]), with the numbers
+/// that decided it. Its `Display` is one sentence without commas, fit for a CSV cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub enum UnresolvedReason {
+    /// The correction did not reach a periodic orbit of the grid's map: the defect
+    /// `|P(X) - X| / |X|` of the best state stayed above the bound. The multipliers are
+    /// those of the point's own state.
+    NotPeriodic {
+        /// The defect of the best state reached.
+        defect: f64,
+        /// [`RESOLVED_DEFECT`](super::RESOLVED_DEFECT).
+        bound: f64,
+        /// Newton iterations that decreased the defect.
+        iterations: usize,
+        /// The iterations allowed
+        /// ([`StabilityOptions::corrections`](super::StabilityOptions::corrections)): fewer
+        /// taken means that no step along the Newton direction decreased the defect.
+        corrections: usize,
+    },
+    /// The periodic orbit reached has another energy than the point: another motion.
+    EnergyMoved {
+        /// `(E - E0) / E0`.
+        change: f64,
+        /// [`StabilityOptions::max_energy_correction`](super::StabilityOptions::max_energy_correction).
+        bound: f64,
+    },
+    /// The periodic orbit reached has another displacement than the point: another motion.
+    DisplacementMoved {
+        /// `max |u - u0| / max |u0|`.
+        change: f64,
+        /// [`StabilityOptions::max_displacement_correction`](super::StabilityOptions::max_displacement_correction).
+        bound: f64,
+    },
+    /// The differences did not find the double multiplier 1 of the time shift and the family
+    /// direction (with any of the steps tried): a perturbation larger than the tolerance
+    /// separates the pair from it, so the other multipliers are not accurate to the
+    /// tolerance either.
+    TrivialPairMissing {
+        /// The larger `|mu - 1|` of the pair.
+        distance: f64,
+        /// The perturbation of the monodromy matrix that makes the pair the double
+        /// multiplier 1 ([`Floquet::trivial_perturbation`]).
+        perturbation: f64,
+        /// [`StabilityOptions::tolerance`](super::StabilityOptions::tolerance).
+        tolerance: f64,
+    },
+}
+
+impl std::fmt::Display for UnresolvedReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            UnresolvedReason::NotPeriodic {
+                defect,
+                bound,
+                iterations,
+                corrections,
+            } if iterations < corrections => write!(
+                f,
+                "no periodic orbit of the grid's map: the correction stalled at defect \
+                 {defect:.1e} after {iterations} of {corrections} iterations (bound {bound:.0e})"
+            ),
+            UnresolvedReason::NotPeriodic {
+                defect,
+                bound,
+                corrections,
+                ..
+            } => write!(
+                f,
+                "no periodic orbit of the grid's map: defect {defect:.1e} after all \
+                 {corrections} correction iterations (bound {bound:.0e})"
+            ),
+            UnresolvedReason::EnergyMoved { change, bound } => write!(
+                f,
+                "the periodic orbit reached has {:.1} % {} energy than the point (bound {:.1} %)",
+                100.0 * change.abs(),
+                if change < 0.0 { "less" } else { "more" },
+                100.0 * bound
+            ),
+            UnresolvedReason::DisplacementMoved { change, bound } => write!(
+                f,
+                "the periodic orbit reached moves the displacement by {:.1} % (bound {:.1} %)",
+                100.0 * change,
+                100.0 * bound
+            ),
+            UnresolvedReason::TrivialPairMissing {
+                distance,
+                perturbation,
+                tolerance,
+            } => write!(
+                f,
+                "the trivial multiplier pair lies {distance:.1e} from 1 and is a perturbation \
+                 of {perturbation:.1e} from the double multiplier 1 (tolerance {tolerance:.1e})"
+            ),
+        }
     }
 }

@@ -87,7 +87,7 @@ mod monodromy;
 mod shooting;
 
 pub use crate::error::StabilityError;
-pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
+pub use floquet::{Crossing, Floquet, Multiplier, UnresolvedReason, Verdict};
 pub use hill::{
     hill, Exponent, HillOptions, HillSpectrum, HILL_RESIDUAL, MAX_HILL_DIMENSION, MIN_ALIGNMENT,
 };
@@ -100,7 +100,9 @@ use crate::verify::{
     SpringUpdate, State, VerifyError,
 };
 use coordinates::Coordinates;
+use floquet::{MapShape, TrivialPair};
 use monodromy::{Monodromy, PeriodMap};
+use shooting::Corrected;
 
 /// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
 /// `8 n^2` bytes (200 MiB).
@@ -301,46 +303,89 @@ pub fn floquet_of_state(
         options.corrections,
         PERIODIC_DEFECT,
     )?;
-    let periodic = corrected.defect <= RESOLVED_DEFECT
-        && corrected.displacement_shift <= options.max_displacement_correction
-        && corrected.energy_change.abs() <= options.max_energy_correction;
+    let failure = correction_failure(&corrected, options);
     // A point whose correction failed keeps the multipliers of its own state: those of a
     // partial correction depend on the path the iterations took.
     let spurious = coordinates.spurious_unit_multipliers();
-    let multipliers_of = |monodromy: &Monodromy| -> Result<Vec<Multiplier>, StabilityError> {
+    let periodic = failure.is_none();
+    let assess = |monodromy: &Monodromy| -> Result<(Vec<Multiplier>, TrivialPair), StabilityError> {
         let mut multipliers = floquet::eigenvalues(monodromy)?;
         floquet::remove_nearest_one(&mut multipliers, spurious);
-        Ok(multipliers)
+        let pair = floquet::trivial_pair(
+            monodromy,
+            &multipliers,
+            spurious,
+            options.tolerance,
+            periodic,
+        )?;
+        Ok((multipliers, pair))
     };
-    let mut multipliers = match at_corrected {
-        Some(at_corrected) if periodic => multipliers_of(&at_corrected)?,
-        _ => multipliers_of(&at_base)?,
+    let (mut multipliers, mut pair) = match at_corrected {
+        Some(at_corrected) if periodic => assess(&at_corrected)?,
+        _ => assess(&at_base)?,
     };
     // The differences must reproduce the known multiplier 1 of the time shift. Where they
     // miss it, a step that adds or removes a near-grazing impact made them inaccurate: a
     // ten times larger step steps over it, a ten times smaller one stays within the piece.
     if periodic {
         for factor in STEP_FACTORS {
-            if floquet::trivial_pair_distance(&multipliers) <= options.tolerance {
+            if pair.found(options.tolerance) {
                 break;
             }
             let other = map.monodromy(&corrected.x, factor * options.relative_step)?;
-            let other = multipliers_of(&other)?;
-            if floquet::trivial_pair_distance(&other) < floquet::trivial_pair_distance(&multipliers)
-            {
-                multipliers = other;
+            let other = assess(&other)?;
+            if other.1.miss() < pair.miss() {
+                (multipliers, pair) = other;
             }
         }
     }
+    let shape = MapShape {
+        dimension: coordinates.len(),
+        dt: initial.grid().dt(),
+        period,
+    };
     Ok(floquet::verdict(
         multipliers,
         options.tolerance,
-        coordinates.len(),
-        initial.grid().dt(),
-        period,
+        pair,
+        failure,
         &corrected,
-        periodic,
+        shape,
     ))
+}
+
+/// Why the correction `corrected` does not count, in the order of the checks: its state is
+/// not periodic (defect above [`RESOLVED_DEFECT`]), or the periodic orbit it reached has
+/// another energy or displacement than the point's (beyond
+/// [`StabilityOptions::max_energy_correction`] and
+/// [`StabilityOptions::max_displacement_correction`]). `None` when it counts.
+fn correction_failure(
+    corrected: &Corrected,
+    options: &StabilityOptions,
+) -> Option<UnresolvedReason> {
+    let periodic = corrected.defect <= RESOLVED_DEFECT;
+    let energy_kept = corrected.energy_change.abs() <= options.max_energy_correction;
+    let displacement_kept = corrected.displacement_shift <= options.max_displacement_correction;
+    if !periodic {
+        Some(UnresolvedReason::NotPeriodic {
+            defect: corrected.defect,
+            bound: RESOLVED_DEFECT,
+            iterations: corrected.iterations,
+            corrections: options.corrections,
+        })
+    } else if !energy_kept {
+        Some(UnresolvedReason::EnergyMoved {
+            change: corrected.energy_change,
+            bound: options.max_energy_correction,
+        })
+    } else if !displacement_kept {
+        Some(UnresolvedReason::DisplacementMoved {
+            change: corrected.displacement_shift,
+            bound: options.max_displacement_correction,
+        })
+    } else {
+        None
+    }
 }
 
 /// [`StabilityError::TooLarge`] for more than [`MAX_DIMENSION`] coordinates.
