@@ -116,7 +116,7 @@ pub struct Floquet {
     /// Where the pair lies beyond the tolerance: the size of the perturbation of the
     /// monodromy matrix that makes it the double multiplier 1, `|(mu_1 + mu_2) / 2 - 1| +
     /// |mu_1 - mu_2| sin(theta) / 2` with `theta` the angle between the two eigenvectors
-    /// (Wilkinson's distance to a double eigenvalue; see the
+    /// (Wilkinson's estimate of the distance to a double eigenvalue, within a factor 2; see the
     /// [module docs](super#the-trivial-pair)). The pair is found when this is within the
     /// tolerance: the error that splits it is then no larger than the error the verdict
     /// allows every other multiplier. `None` where the pair lies within the tolerance, or
@@ -197,7 +197,8 @@ impl TrivialPair {
     /// How far the pair is from the double multiplier 1: the smaller of its distance and the
     /// perturbation.
     pub(crate) fn miss(&self) -> f64 {
-        self.perturbation.map_or(self.distance, |p| p.min(self.distance))
+        self.perturbation
+            .map_or(self.distance, |p| p.min(self.distance))
     }
 
     /// Whether the pair is found at `tolerance`.
@@ -230,19 +231,20 @@ pub(crate) fn trivial_pair(
     })
 }
 
-/// The size of the smallest perturbation of `monodromy` that makes its two multipliers
-/// nearest 1 (after the `spurious` exact ones) the double multiplier 1:
+/// The size of the perturbation of `monodromy` that makes its two multipliers nearest 1
+/// (after the `spurious` exact ones) the double multiplier 1, to within a factor 2:
 ///
 /// `|(mu_1 + mu_2) / 2 - 1| + |mu_1 - mu_2| sin(theta) / 2`,
 ///
-/// `theta` the angle between their eigenvectors. A Jordan block `[[1, c], [0, 1]]` perturbed
-/// by `E` has the multipliers `1 + tr(E) / 2 +- sqrt(c e_21)`: the mean moves by the
-/// perturbation, the split by its square root, and the eigenvectors `(1, +-sqrt(e_21 / c))`
-/// close up, `sin(theta) ~ 2 sqrt(e_21 / c)`, so that the split times `sin(theta) / 2` is
-/// `2 e_21`, whatever `c`. This is Wilkinson's distance from a matrix to the nearest one with
-/// a double eigenvalue, `|mu_1 - mu_2| / (kappa_1 + kappa_2)`, with the condition numbers
-/// `kappa = 1 / sin(theta)` of the pair's invariant subspace; the mean's term moves the
-/// double eigenvalue to 1. `None` without two multipliers.
+/// `theta` the angle between their eigenvectors. The second term is Wilkinson's estimate
+/// `|mu_1 - mu_2| / (kappa_1 + kappa_2)` of the distance to the nearest matrix with a double
+/// eigenvalue, with the pair's condition numbers `kappa = 1 / sin(theta)` in its invariant
+/// subspace; the first moves the double eigenvalue to 1. For a Jordan block `[[1, c], [0, 1]]`
+/// perturbed by `e` below the diagonal, the multipliers are `1 +- sqrt(c e)` and the
+/// eigenvectors `(1, +-sqrt(e / c))`, so `sin(theta) ~ 2 sqrt(e / c)` and the estimate is
+/// `2 e`, whatever the coupling `c`: the split is the square root of the error, the estimate
+/// the error itself. For two simple multipliers `1 +- s` with orthogonal eigenvectors it is
+/// `s`. `None` without two multipliers.
 fn pair_perturbation(
     monodromy: &Monodromy,
     spurious: usize,
@@ -259,22 +261,48 @@ fn pair_perturbation(
     let Some(&[a, b]) = nearest_one(&all).get(spurious..spurious + 2) else {
         return Ok(None);
     };
-    let (mut dot_re, mut dot_im, mut norm_a, mut norm_b) = (0.0, 0.0, 0.0, 0.0);
-    for i in 0..n {
-        let (x, y) = (vectors[(i, a)], vectors[(i, b)]);
-        // conj(x) y
-        dot_re += x.re * y.re + x.im * y.im;
-        dot_im += x.re * y.im - x.im * y.re;
-        norm_a += x.re * x.re + x.im * x.im;
-        norm_b += y.re * y.re + y.im * y.im;
-    }
-    let cos = (dot_re.hypot(dot_im) / (norm_a * norm_b).sqrt()).min(1.0);
-    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let sin = sine_between(
+        (0..n)
+            .map(|i| vectors[(i, a)])
+            .map(|z| (z.re, z.im))
+            .collect(),
+        (0..n)
+            .map(|i| vectors[(i, b)])
+            .map(|z| (z.re, z.im))
+            .collect(),
+    );
     let (mu, nu) = (all[a], all[b]);
     let mean = (0.5 * (mu.re + nu.re) - 1.0).hypot(0.5 * (mu.im + nu.im));
     let split = (mu.re - nu.re).hypot(mu.im - nu.im);
     let perturbation = mean + 0.5 * split * sin;
     Ok(perturbation.is_finite().then_some(perturbation))
+}
+
+/// The sine of the angle between the complex vectors `x` and `y` (pairs `(re, im)`): the
+/// norm of `y`'s part orthogonal to `x` over `|y|`, computed as a vector so that a small
+/// angle keeps its digits (`sqrt(1 - cos^2)` would lose half of them).
+fn sine_between(x: Vec<(f64, f64)>, y: Vec<(f64, f64)>) -> f64 {
+    let norm = |v: &[(f64, f64)]| v.iter().map(|(re, im)| re * re + im * im).sum::<f64>();
+    let (xx, yy) = (norm(&x), norm(&y));
+    if xx == 0.0 || yy == 0.0 {
+        return 1.0;
+    }
+    // conj(x) . y / |x|^2
+    let (c_re, c_im) = x.iter().zip(&y).fold((0.0, 0.0), |(re, im), (a, b)| {
+        (re + a.0 * b.0 + a.1 * b.1, im + a.0 * b.1 - a.1 * b.0)
+    });
+    let (c_re, c_im) = (c_re / xx, c_im / xx);
+    let orthogonal: Vec<(f64, f64)> = x
+        .iter()
+        .zip(&y)
+        .map(|(a, b)| {
+            (
+                b.0 - (c_re * a.0 - c_im * a.1),
+                b.1 - (c_re * a.1 + c_im * a.0),
+            )
+        })
+        .collect();
+    (norm(&orthogonal) / yy).sqrt().min(1.0)
 }
 
 /// Sets the two multipliers nearest 1 to exactly 1 (the trivial pair, found), keeping the
@@ -452,6 +480,203 @@ impl std::fmt::Display for UnresolvedReason {
                 "the trivial multiplier pair lies {distance:.1e} from 1 and is a perturbation \
                  of {perturbation:.1e} from the double multiplier 1 (tolerance {tolerance:.1e})"
             ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+
+    /// A block-diagonal monodromy: the 2 x 2 block `pair` at the top, then rotations by the
+    /// angles `phases` (multipliers `e^{+-i phi}` on the circle, away from 1).
+    fn monodromy(pair: [[f64; 2]; 2], phases: &[f64]) -> Monodromy {
+        let n = 2 + 2 * phases.len();
+        Mat::from_fn(n, n, |i, j| match (i / 2, j / 2) {
+            (0, 0) => pair[i][j],
+            (b, c) if b == c => {
+                let (cos, sin) = (phases[b - 1].cos(), phases[b - 1].sin());
+                [[cos, -sin], [sin, cos]][i % 2][j % 2]
+            }
+            _ => 0.0,
+        })
+    }
+
+    fn pair_of(m: &Monodromy, tolerance: f64) -> TrivialPair {
+        let multipliers = eigenvalues(m).unwrap();
+        trivial_pair(m, &multipliers, 0, tolerance, true).unwrap()
+    }
+
+    /// A Jordan block at 1 with coupling `c`, perturbed by `e` below the diagonal, has its
+    /// multipliers at `1 +- sqrt(c e)`: the distance is the square root, the perturbation
+    /// found `2 e / (1 + e / c)` (Wilkinson's estimate, within a factor 2), whatever the
+    /// coupling.
+    #[test]
+    fn a_perturbed_jordan_block_gives_back_its_perturbation() {
+        for c in [0.3, 1.0, 7.0] {
+            for e in [1e-8, 1e-6, 1e-4] {
+                let m = monodromy([[1.0, c], [e, 1.0]], &[0.7, 2.0]);
+                let pair = pair_of(&m, 0.0);
+                assert!(
+                    ((pair.distance - (c * e).sqrt()) / (c * e).sqrt()).abs() < 1e-6,
+                    "c {c}, e {e}: {pair:?}"
+                );
+                let found = pair.perturbation.unwrap();
+                let expected = 2.0 * e / (1.0 + e / c);
+                assert!(
+                    (found - expected).abs() <= 1e-6 * e,
+                    "c {c}, e {e}: {pair:?}"
+                );
+                // Found at a tolerance between 2 e and sqrt(c e), not below e.
+                assert!(pair.found(2.0 * e) && !pair.found(e), "c {c}, e {e}");
+            }
+        }
+    }
+
+    /// Two simple multipliers `1 +- s` with orthogonal eigenvectors are `s` from a double
+    /// multiplier 1: a split that is the perturbation itself, not its square root.
+    #[test]
+    fn a_split_with_orthogonal_eigenvectors_is_its_own_perturbation() {
+        for s in [1e-5, 1e-3, 2e-2] {
+            let pair = pair_of(&monodromy([[1.0 + s, 0.0], [0.0, 1.0 - s]], &[1.1]), 0.0);
+            assert!(
+                (pair.perturbation.unwrap() - s).abs() <= 1e-9,
+                "{s}: {pair:?}"
+            );
+        }
+    }
+
+    /// A pair pulled inward together, `(1 - p) J`: the mean's distance counts in full.
+    #[test]
+    fn a_pair_moved_together_counts_the_move() {
+        for p in [1e-4, 1e-2] {
+            let pair = pair_of(&monodromy([[1.0 - p, 0.5], [0.0, 1.0 - p]], &[0.4]), 0.0);
+            let found = pair.perturbation.unwrap();
+            assert!((found - p).abs() <= 1e-6 * p, "{p}: {pair:?}");
+        }
+    }
+
+    /// Within the tolerance, the eigenvectors are not needed: no perturbation is computed.
+    #[test]
+    fn a_pair_within_the_tolerance_is_found_without_eigenvectors() {
+        let pair = pair_of(&monodromy([[1.0, 1.0], [1e-8, 1.0]], &[0.9]), 1e-3);
+        assert!(pair.perturbation.is_none() && pair.found(1e-3), "{pair:?}");
+    }
+
+    fn corrected() -> Corrected {
+        Corrected {
+            x: vec![1.0; 4],
+            initial_defect: 1e-2,
+            defect: 1e-12,
+            energy_change: 1e-3,
+            shift: 1e-2,
+            displacement_shift: 1e-3,
+            iterations: 2,
+        }
+    }
+
+    const SHAPE: MapShape = MapShape {
+        dimension: 4,
+        dt: 0.01,
+        period: 3.5,
+    };
+
+    /// A failed correction is the reason, whatever the pair; a found pair is set to 1 and the
+    /// verdict follows from the others; a missing pair is the reason, with its numbers.
+    #[test]
+    fn the_verdict_names_its_reason() {
+        let m = monodromy([[1.0, 1.0], [1e-4, 1.0]], &[0.5]);
+        let multipliers = eigenvalues(&m).unwrap();
+        let pair = pair_of(&m, 1e-3);
+        let failure = UnresolvedReason::EnergyMoved {
+            change: 0.2,
+            bound: 0.05,
+        };
+        let f = verdict(
+            multipliers.clone(),
+            1e-3,
+            pair,
+            Some(failure),
+            &corrected(),
+            SHAPE,
+        );
+        assert_eq!(
+            (f.verdict, f.unresolved),
+            (Verdict::Unresolved, Some(failure))
+        );
+
+        let f = verdict(multipliers.clone(), 1e-3, pair, None, &corrected(), SHAPE);
+        assert_eq!((f.verdict, f.unresolved), (Verdict::Stable, None), "{f:?}");
+        assert_eq!(f.max_multiplier, 1.0);
+        assert_eq!(f.multipliers.iter().filter(|mu| mu.re == 1.0).count(), 2);
+
+        let pair = pair_of(&m, 1e-5);
+        let f = verdict(multipliers, 1e-5, pair, None, &corrected(), SHAPE);
+        let Some(UnresolvedReason::TrivialPairMissing {
+            distance,
+            perturbation,
+            tolerance,
+        }) = f.unresolved
+        else {
+            panic!("{f:?}");
+        };
+        assert_eq!(f.verdict, Verdict::Unresolved);
+        assert!((distance - 1e-2).abs() < 1e-8 && (perturbation - 2e-4).abs() < 1e-7);
+        assert_eq!(tolerance, 1e-5);
+    }
+
+    /// Every reason's sentence carries its numbers and no comma (a CSV cell).
+    #[test]
+    fn reasons_read_as_one_sentence_with_their_numbers() {
+        let cases = [
+            (
+                UnresolvedReason::NotPeriodic {
+                    defect: 0.23,
+                    bound: 1e-8,
+                    iterations: 3,
+                    corrections: 8,
+                },
+                &["2.3e-1", "3 of 8", "stalled", "1e-8"][..],
+            ),
+            (
+                UnresolvedReason::NotPeriodic {
+                    defect: 4e-3,
+                    bound: 1e-8,
+                    iterations: 8,
+                    corrections: 8,
+                },
+                &["4.0e-3", "all 8"][..],
+            ),
+            (
+                UnresolvedReason::EnergyMoved {
+                    change: -0.12,
+                    bound: 0.05,
+                },
+                &["12.0 % less energy", "5.0 %"][..],
+            ),
+            (
+                UnresolvedReason::DisplacementMoved {
+                    change: 0.071,
+                    bound: 0.05,
+                },
+                &["7.1 %", "5.0 %"][..],
+            ),
+            (
+                UnresolvedReason::TrivialPairMissing {
+                    distance: 1.4e-2,
+                    perturbation: 1.1e-2,
+                    tolerance: 1e-3,
+                },
+                &["1.4e-2", "1.1e-2", "1.0e-3"][..],
+            ),
+        ];
+        for (reason, numbers) in cases {
+            let text = reason.to_string();
+            assert!(!text.contains(',') && !text.contains('\n'), "{text}");
+            for n in numbers {
+                assert!(text.contains(n), "{text} lacks {n}");
+            }
         }
     }
 }
