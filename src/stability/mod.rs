@@ -62,9 +62,9 @@
 //! [`StabilityOptions::max_energy_correction`] of the point's own (a harmonic-balance point's
 //! energy is accurate where its state is not: at a fixed period the exact map has several
 //! periodic orbits near the point, and one with 10 % more energy in high harmonics is
-//! another motion), and the trivial pair found within the tolerance (where the differences
-//! miss it, an event with singular timing, such as a grazing impact, makes them inaccurate
-//! for every multiplier): otherwise the point is [`Verdict::Unresolved`], with the
+//! another motion), and the trivial pair found ([below](#the-trivial-pair); where the
+//! differences miss it, an event with singular timing, such as a grazing impact, or the
+//! grid's projection makes them inaccurate for every multiplier): otherwise the point is [`Verdict::Unresolved`], with the
 //! multipliers of its own state when the correction failed.
 //!
 //! # Why there is no verdict
