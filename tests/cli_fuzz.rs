@@ -738,3 +738,59 @@ fn gallery_refuses_bad_arguments() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
 }
+
+/// `backbone --stability` writes `stable,max_multiplier,stability_reason` last: a number and
+/// no reason where there is a verdict, no number and a reason where there is none (the
+/// clamped bar at `T = 3.95 ... 3.94`, where both occur).
+#[test]
+fn backbone_stability_columns_say_why_there_is_no_verdict() {
+    let binary = example_binary("backbone", "examples/backbone");
+    let dir = TempDir::new("stability-columns");
+    let csv = dir.0.join("s.csv");
+    let args = [
+        "--system",
+        "ds",
+        "--period-start",
+        "3.95",
+        "--period-end",
+        "3.94",
+        "--steps",
+        "3",
+        "--stability",
+        "--out",
+    ];
+    let output = Command::new(&binary)
+        .args(args)
+        .arg(&csv)
+        .output()
+        .expect("spawn the backbone example");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    let text = std::fs::read_to_string(&csv).expect("the CSV");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    assert_eq!(
+        header[header.len() - 3..],
+        ["stable", "max_multiplier", "stability_reason"]
+    );
+    let (mut verdicts, mut reasons) = (0, 0);
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells.len(), header.len(), "{line}");
+        let [stable, max, reason] = cells[cells.len() - 3..] else {
+            unreachable!()
+        };
+        match stable {
+            "true" | "false" => {
+                assert!(max.parse::<f64>().is_ok_and(f64::is_finite), "{line}");
+                assert!(reason.is_empty(), "{line}");
+                verdicts += 1;
+            }
+            _ => {
+                assert!(max.is_empty() && !reason.is_empty(), "{line}");
+                reasons += 1;
+            }
+        }
+    }
+    assert!(verdicts >= 1 && reasons >= 1, "{text}");
+}

@@ -7,8 +7,8 @@ use nonsmooth_modes::branches::{
 };
 use nonsmooth_modes::reference::clamped_bar_with_obstacle;
 use nonsmooth_modes::stability::{
-    floquet, floquet_of_state, HillOptions, StabilityError, StabilityOptions, Verdict,
-    MAX_DIMENSION,
+    floquet, floquet_of_state, Floquet, HillOptions, StabilityError, StabilityOptions,
+    UnresolvedReason, Verdict, MAX_DIMENSION, RESOLVED_DEFECT,
 };
 use nonsmooth_modes::system::BarSystem;
 use nonsmooth_modes::verify::{clamped_first_mode, Grid, Model, State};
@@ -221,6 +221,121 @@ fn a_verdict_belongs_to_an_orbit_with_the_points_energy() {
         }
     }
     assert!(resolved >= 2, "{resolved} resolved");
+}
+
+/// `f` says why it has no verdict exactly when it has none, in one sentence without commas
+/// (a CSV cell), and its numbers are finite.
+fn assert_verdict_or_reason(f: &Floquet, what: &str) {
+    assert_eq!(
+        f.verdict == Verdict::Unresolved,
+        f.unresolved.is_some(),
+        "{what}: {f:?}"
+    );
+    if let Some(reason) = f.unresolved {
+        let text = reason.to_string();
+        assert!(!text.is_empty() && !text.contains(','), "{what}: {text}");
+    }
+    assert!(
+        f.max_multiplier.is_finite() && f.trivial_distance >= 0.0,
+        "{what}: {f:?}"
+    );
+}
+
+/// Every converged point of the clamped backbone asked with its multipliers (the default
+/// request, `Method::Auto`, at gaps `1e-3` and `3e-2`, 100 cells) has a verdict or says why
+/// not: the reason of an unresolved verdict, or the error where the multipliers could not be
+/// computed.
+#[test]
+fn every_converged_point_has_a_verdict_or_a_reason() {
+    for gap in [1e-3, 3e-2] {
+        let system = clamped_bar_with_obstacle(gap).unwrap();
+        let request = Request::for_method(Method::Auto(Some(clamped_grid())))
+            .harmonics(20)
+            .with_stability(options(100.0));
+        let result = compute(&system, &request).unwrap();
+        let mut seen = 0;
+        for p in result.converged() {
+            let what = format!("gap {gap}, T = {}", p.period);
+            match p.stability.as_ref().expect("asked") {
+                Ok(f) => assert_verdict_or_reason(f, &what),
+                Err(e) => assert!(!e.to_string().is_empty(), "{what}"),
+            }
+            seen += 1;
+        }
+        assert!(seen >= 4, "gap {gap}: {seen} converged points");
+    }
+}
+
+/// The exact first mode of the clamped bar at `T = 3.5`, 100 cells, as the state of a
+/// motion of period `period` with `options`.
+fn exact_state_over(period: f64, options: &StabilityOptions) -> Floquet {
+    let state = clamped_first_mode(1e-3, 3.5, 1.0 / 100.0).unwrap();
+    let f = floquet_of_state(&state, period, options).unwrap();
+    assert_verdict_or_reason(&f, &format!("T = {period}"));
+    f
+}
+
+/// Each way to no verdict names itself with its numbers: a state that is not periodic and
+/// not corrected, a correction that reaches another energy or another displacement (the
+/// exact `T = 3.5` state as a motion of period `3.52`: the orbit its correction reaches has
+/// 23 % more energy, where the family's has 7.5 % less), and a trivial pair beyond a zero
+/// tolerance.
+#[test]
+fn every_reason_path_is_named() {
+    let base = options(100.0);
+    let f = exact_state_over(
+        3.52,
+        &StabilityOptions {
+            corrections: 0,
+            ..base
+        },
+    );
+    match f.unresolved {
+        Some(UnresolvedReason::NotPeriodic {
+            defect,
+            bound,
+            iterations: 0,
+            corrections: 0,
+        }) => assert!(defect > bound && bound == RESOLVED_DEFECT, "{f:?}"),
+        other => panic!("{other:?}"),
+    }
+    let f = exact_state_over(3.52, &base);
+    match f.unresolved {
+        Some(UnresolvedReason::EnergyMoved { change, bound }) => {
+            assert!(
+                change.abs() > bound && bound == base.max_energy_correction,
+                "{f:?}"
+            )
+        }
+        other => panic!("{other:?}: {f:?}"),
+    }
+    let loose_energy = StabilityOptions {
+        max_energy_correction: 1.0,
+        max_displacement_correction: 1e-3,
+        ..base
+    };
+    let f = exact_state_over(3.52, &loose_energy);
+    match f.unresolved {
+        Some(UnresolvedReason::DisplacementMoved { change, bound }) => {
+            assert!(change > bound && bound == 1e-3, "{f:?}")
+        }
+        other => panic!("{other:?}: {f:?}"),
+    }
+    let exact = StabilityOptions {
+        tolerance: 0.0,
+        ..base
+    };
+    let f = exact_state_over(3.5, &exact);
+    match f.unresolved {
+        Some(UnresolvedReason::TrivialPairMissing {
+            distance,
+            perturbation,
+            tolerance: 0.0,
+        }) => assert!(distance > 0.0 && perturbation > 0.0, "{f:?}"),
+        other => panic!("{other:?}: {f:?}"),
+    }
+    // The same state at the default tolerance: a verdict, and no reason.
+    assert_eq!(exact_state_over(3.5, &base).unresolved, None);
 }
 
 /// Bad options, a state at rest and a grid too large are typed errors.

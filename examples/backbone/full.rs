@@ -66,7 +66,8 @@ pub fn run_full_basis(
                 "rejected"
             };
             let omega = 2.0 * std::f64::consts::PI / period;
-            let verdicts = 2 * (usize::from(a.stability) + usize::from(a.hill));
+            let columns = |on: bool, names: &str| usize::from(on) * names.matches(',').count();
+            let verdicts = columns(a.stability, STABILITY_COLUMNS) + columns(a.hill, HILL_COLUMNS);
             let empty = ",".repeat(6 + 3 * usize::from(a.verify) + verdicts);
             writeln!(out, "{step},{period},{omega},,,false,{status}{empty}")?;
             continue;

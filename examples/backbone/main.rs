@@ -63,9 +63,12 @@
 //! `--stability` asks the library for the Floquet multipliers of every converged point
 //! (`stability`, default options: 200 cells per shortest travel time, the state corrected to
 //! a periodic orbit of the exact map first) and adds, after every other column,
-//! `stable,max_multiplier`: `true`, `false` or `unresolved` (no periodic orbit of the map
-//! within 5 % of the point's displacement, or its trivial multipliers not found), and the
-//! largest multiplier modulus (1 when every multiplier lies within `1e-3` of the unit circle).
+//! `stable,max_multiplier,stability_reason`: `true`, `false` or `unresolved` (no periodic
+//! orbit of the map within 5 % of the point's energy and displacement, or its trivial
+//! multipliers not found); the largest multiplier modulus (1 when every multiplier lies
+//! within `1e-3` of the unit circle), empty where unresolved; and, empty where there is a
+//! verdict, why there is none: the `stability::UnresolvedReason` with its numbers, or the
+//! error where the multipliers could not be computed (commas written as semicolons).
 //! Changes of verdict along a branch appear in `event` as `stability-lost` and
 //! `stability-gained`. Period and energy runs only; empty cells for `--parameter` runs.
 //!
@@ -101,7 +104,7 @@
 //! is the phase-locked system's `mu`, `sine_share` and `asymmetry` say how far the motion is
 //! from even about `t = 0` and about any instant; `label` as below), then with `--verify`
 //! `periodicity_defect,displacement_defect,max_penetration`, with `--stability`
-//! `stable,max_multiplier` and with `--hill` `hill_stable,hill_max_multiplier`, as for the
+//! `stable,max_multiplier,stability_reason` and with `--hill` `hill_stable,hill_max_multiplier`, as for the
 //! cosine basis. It takes `--parameter omega`,
 //! sequential steps and `--subharmonic 1`; other combinations are usage errors.
 

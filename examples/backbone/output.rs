@@ -37,7 +37,7 @@ pub fn header(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> 
 }
 
 /// The columns of `--stability`.
-pub const STABILITY_COLUMNS: &str = ",stable,max_multiplier";
+pub const STABILITY_COLUMNS: &str = ",stable,max_multiplier,stability_reason";
 
 /// The columns of `--hill`.
 pub const HILL_COLUMNS: &str = ",hill_stable,hill_max_multiplier";
@@ -62,7 +62,7 @@ pub struct Sink<'a> {
     pub progress: bool,
     /// The subharmonic order `K` of the run: `subharmonic_share` is written for `K > 1`.
     pub subharmonic: usize,
-    /// `--stability`: write `stable,max_multiplier`.
+    /// `--stability`: write `stable,max_multiplier,stability_reason`.
     pub stability: bool,
     /// `--hill`: write `hill_stable,hill_max_multiplier`.
     pub hill: bool,
@@ -216,41 +216,53 @@ pub fn verification_cells(p: &BackbonePoint) -> String {
     }
 }
 
-/// `,stable,max_multiplier` of a point: `true`, `false` or `unresolved` and
-/// `Floquet::max_multiplier`; empty for a point without multipliers (with a message when it
-/// converged).
+/// `,stable,max_multiplier,stability_reason` of a point: `true`, `false` or `unresolved`,
+/// `Floquet::max_multiplier` where there is a verdict (empty where unresolved: the number
+/// means nothing there), and why there is no verdict (empty where there is one): the
+/// `UnresolvedReason`, or the error where the multipliers could not be computed (with a
+/// message on stderr). All empty for a point without multipliers.
 pub fn stability_cells(p: &BackbonePoint) -> String {
-    let outcome = (p.stability.as_ref()).map(|r| r.as_ref().map(|f| (f.verdict, f.max_multiplier)));
-    verdict_cells(p.step, "multipliers", outcome)
-}
-
-/// `,hill_stable,hill_max_multiplier` of a point, as [`stability_cells`] for
-/// `HillSpectrum`.
-pub fn hill_cells(p: &BackbonePoint) -> String {
-    let outcome = (p.hill.as_ref()).map(|r| r.as_ref().map(|h| (h.verdict, h.max_multiplier)));
-    verdict_cells(p.step, "Hill exponents", outcome)
-}
-
-/// `,verdict,max_multiplier` of step `step`'s outcome; empty cells (with a message naming
-/// `what` for an error) where there is none.
-fn verdict_cells<E: std::fmt::Display>(
-    step: usize,
-    what: &str,
-    outcome: Option<Result<(Verdict, f64), E>>,
-) -> String {
-    match outcome {
-        Some(Ok((verdict, max_multiplier))) => {
-            let stable = match verdict {
-                Verdict::Stable => "true",
-                Verdict::Unstable(_) => "false",
-                Verdict::Unresolved => "unresolved",
-            };
-            format!(",{stable},{max_multiplier:.10e}")
+    match &p.stability {
+        Some(Ok(f)) => {
+            let reason = f.unresolved.map(|r| csv_text(&r.to_string()));
+            format!(
+                "{},{}",
+                verdict_cells(f.verdict, f.max_multiplier),
+                reason.unwrap_or_default()
+            )
         }
         Some(Err(e)) => {
-            eprintln!("backbone: no {what} for step {step}: {e}");
+            eprintln!("backbone: no multipliers for step {}: {e}", p.step);
+            format!(",,,{}", csv_text(&e.to_string()))
+        }
+        None => ",,,".to_string(),
+    }
+}
+
+/// `,hill_stable,hill_max_multiplier` of a point, as the first two of [`stability_cells`]
+/// for `HillSpectrum`.
+pub fn hill_cells(p: &BackbonePoint) -> String {
+    match &p.hill {
+        Some(Ok(h)) => verdict_cells(h.verdict, h.max_multiplier),
+        Some(Err(e)) => {
+            eprintln!("backbone: no Hill exponents for step {}: {e}", p.step);
             ",,".to_string()
         }
         None => ",,".to_string(),
     }
+}
+
+/// `,verdict,max_multiplier`: `true`, `false` or `unresolved`, and the largest multiplier
+/// where there is a verdict.
+fn verdict_cells(verdict: Verdict, max_multiplier: f64) -> String {
+    match verdict {
+        Verdict::Stable => format!(",true,{max_multiplier:.10e}"),
+        Verdict::Unstable(_) => format!(",false,{max_multiplier:.10e}"),
+        Verdict::Unresolved => ",unresolved,".to_string(),
+    }
+}
+
+/// `text` as one CSV cell: commas become semicolons and line breaks spaces.
+fn csv_text(text: &str) -> String {
+    text.replace(',', ";").replace(['\n', '\r'], " ")
 }

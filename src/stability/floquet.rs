@@ -58,8 +58,10 @@ pub enum Verdict {
     Stable,
     /// A multiplier lies outside, where the crossing says.
     Unstable(Crossing),
-    /// The state could not be corrected to a periodic orbit of the grid's map near the
-    /// point's own motion: the multipliers (still reported) describe no motion of the point.
+    /// No verdict: the state could not be corrected to a periodic orbit of the grid's map
+    /// near the point's own motion, or the differences did not find the trivial pair
+    /// ([`Floquet::unresolved`] says which, with the numbers). The multipliers (still
+    /// reported) support no verdict.
     Unresolved,
 }
 
@@ -95,17 +97,31 @@ pub struct Floquet {
     /// counted as on it: exactly 1 for a stable point (a conservative motion has
     /// multipliers on the circle; the grid's projection pulls some inward and the
     /// differences' error splits the multiple multiplier 1 by up to about the square root
-    /// of that error), `max |mu|` otherwise.
+    /// of that error), `max |mu|` otherwise. Of an unresolved point it means nothing (the
+    /// monodromy of a state that is not periodic has moduli such as `sqrt 2` or the golden
+    /// ratio, from the order of its events): writers leave it out.
     pub max_multiplier: f64,
     /// Stable when every multiplier lies within
     /// [`StabilityOptions::tolerance`](super::StabilityOptions::tolerance) of the unit circle
-    /// or inside it, unresolved when the state is not a periodic orbit near the point.
+    /// or inside it, unresolved when the state is not a periodic orbit near the point or the
+    /// trivial pair is not found.
     pub verdict: Verdict,
+    /// Why the verdict is [`Verdict::Unresolved`]: `Some` exactly then.
+    pub unresolved: Option<UnresolvedReason>,
     /// The larger `|mu - 1|` of the two multipliers nearest 1: the trivial pair of the time
-    /// shift and the family direction (a Jordan block at 1), which the differences' error
-    /// splits by about its square root. Within the tolerance, the pair is set to exactly 1 in
+    /// shift and the family direction (a Jordan block at 1), which an error `e` of the matrix
+    /// splits by about `sqrt(e)`. When the pair is found, it is set to exactly 1 in
     /// [`Floquet::multipliers`].
     pub trivial_distance: f64,
+    /// Where the pair lies beyond the tolerance: the size of the perturbation of the
+    /// monodromy matrix that makes it the double multiplier 1, `|(mu_1 + mu_2) / 2 - 1| +
+    /// |mu_1 - mu_2| sin(theta) / 2` with `theta` the angle between the two eigenvectors
+    /// (Wilkinson's estimate of the distance to a double eigenvalue, within a factor 2; see the
+    /// [module docs](super#the-trivial-pair)). The pair is found when this is within the
+    /// tolerance: the error that splits it is then no larger than the error the verdict
+    /// allows every other multiplier. `None` where the pair lies within the tolerance, or
+    /// where the state is not periodic.
+    pub trivial_perturbation: Option<f64>,
     /// Rows of the monodromy matrix.
     pub dimension: usize,
     /// The time step of the grid.
@@ -165,52 +181,176 @@ pub(crate) fn remove_nearest_one(multipliers: &mut Vec<Multiplier>, count: usize
     }
 }
 
-/// The larger `|mu - 1|` of the two multipliers nearest 1 (`inf` without two).
-pub(crate) fn trivial_pair_distance(multipliers: &[Multiplier]) -> f64 {
-    nearest_one(multipliers)
-        .get(1)
-        .map_or(f64::INFINITY, |&i| multipliers[i].distance_to_one())
+/// How nearly the two multipliers nearest 1 are the double multiplier 1 of the time shift
+/// and the family direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TrivialPair {
+    /// The larger `|mu - 1|` of the two (`inf` without two).
+    pub distance: f64,
+    /// The size of the perturbation of the monodromy matrix that makes the pair the double
+    /// multiplier 1 ([`pair_perturbation`]); computed only where `distance` exceeds the
+    /// tolerance (`None` otherwise, or without two multipliers).
+    pub perturbation: Option<f64>,
 }
 
-/// Sets the two multipliers nearest 1 to exactly 1 when both lie within `tolerance` of it:
-/// the time shift and the family direction of a conservative autonomous system make 1 a
-/// double multiplier (a Jordan block), which the differences' error `e` splits by about
-/// `sqrt(e)`, so that the computed pair carries no information beyond that error. Returns
-/// the larger of their distances to 1 (`inf` without two multipliers), and keeps the list
-/// sorted by decreasing modulus.
-fn snap_trivial_pair(multipliers: &mut [Multiplier], tolerance: f64) -> f64 {
-    let [first, second, ..] = nearest_one(multipliers)[..] else {
-        return f64::INFINITY;
+impl TrivialPair {
+    /// How far the pair is from the double multiplier 1: the smaller of its distance and the
+    /// perturbation.
+    pub(crate) fn miss(&self) -> f64 {
+        self.perturbation
+            .map_or(self.distance, |p| p.min(self.distance))
+    }
+
+    /// Whether the pair is found at `tolerance`.
+    pub(crate) fn found(&self, tolerance: f64) -> bool {
+        self.miss() <= tolerance
+    }
+}
+
+/// The trivial pair of `multipliers` (the eigenvalues of `monodromy` without its `spurious`
+/// exact multipliers 1), with the perturbation computed when `refine` and the pair lies
+/// farther than `tolerance` from 1.
+pub(crate) fn trivial_pair(
+    monodromy: &Monodromy,
+    multipliers: &[Multiplier],
+    spurious: usize,
+    tolerance: f64,
+    refine: bool,
+) -> Result<TrivialPair, StabilityError> {
+    let distance = nearest_one(multipliers)
+        .get(1)
+        .map_or(f64::INFINITY, |&i| multipliers[i].distance_to_one());
+    let perturbation = if refine && distance > tolerance && distance.is_finite() {
+        pair_perturbation(monodromy, spurious)?
+    } else {
+        None
     };
-    let distance = multipliers[second].distance_to_one();
-    if distance <= tolerance {
+    Ok(TrivialPair {
+        distance,
+        perturbation,
+    })
+}
+
+/// The size of the perturbation of `monodromy` that makes its two multipliers nearest 1
+/// (after the `spurious` exact ones) the double multiplier 1, to within a factor 2:
+///
+/// `|(mu_1 + mu_2) / 2 - 1| + |mu_1 - mu_2| sin(theta) / 2`,
+///
+/// `theta` the angle between their eigenvectors. The second term is Wilkinson's estimate
+/// `|mu_1 - mu_2| / (kappa_1 + kappa_2)` of the distance to the nearest matrix with a double
+/// eigenvalue, with the pair's condition numbers `kappa = 1 / sin(theta)` in its invariant
+/// subspace; the first moves the double eigenvalue to 1. For a Jordan block `[[1, c], [0, 1]]`
+/// perturbed by `e` below the diagonal, the multipliers are `1 +- sqrt(c e)` and the
+/// eigenvectors `(1, +-sqrt(e / c))`, so `sin(theta) ~ 2 sqrt(e / c)` and the estimate is
+/// `2 e`, whatever the coupling `c`: the split is the square root of the error, the estimate
+/// the error itself. For two simple multipliers `1 +- s` with orthogonal eigenvectors it is
+/// `s`. `None` without two multipliers.
+fn pair_perturbation(
+    monodromy: &Monodromy,
+    spurious: usize,
+) -> Result<Option<f64>, StabilityError> {
+    let n = monodromy.nrows();
+    let eigen = monodromy
+        .eigen()
+        .map_err(|_| StabilityError::NoEigenvalues { dimension: n })?;
+    let (values, vectors) = (eigen.S().column_vector(), eigen.U());
+    let all: Vec<Multiplier> = values
+        .iter()
+        .map(|z| Multiplier { re: z.re, im: z.im })
+        .collect();
+    let Some(&[a, b]) = nearest_one(&all).get(spurious..spurious + 2) else {
+        return Ok(None);
+    };
+    let sin = sine_between(
+        (0..n)
+            .map(|i| vectors[(i, a)])
+            .map(|z| (z.re, z.im))
+            .collect(),
+        (0..n)
+            .map(|i| vectors[(i, b)])
+            .map(|z| (z.re, z.im))
+            .collect(),
+    );
+    let (mu, nu) = (all[a], all[b]);
+    let mean = (0.5 * (mu.re + nu.re) - 1.0).hypot(0.5 * (mu.im + nu.im));
+    let split = (mu.re - nu.re).hypot(mu.im - nu.im);
+    let perturbation = mean + 0.5 * split * sin;
+    Ok(perturbation.is_finite().then_some(perturbation))
+}
+
+/// The sine of the angle between the complex vectors `x` and `y` (pairs `(re, im)`): the
+/// norm of `y`'s part orthogonal to `x` over `|y|`, computed as a vector so that a small
+/// angle keeps its digits (`sqrt(1 - cos^2)` would lose half of them).
+fn sine_between(x: Vec<(f64, f64)>, y: Vec<(f64, f64)>) -> f64 {
+    let norm = |v: &[(f64, f64)]| v.iter().map(|(re, im)| re * re + im * im).sum::<f64>();
+    let (xx, yy) = (norm(&x), norm(&y));
+    if xx == 0.0 || yy == 0.0 {
+        return 1.0;
+    }
+    // conj(x) . y / |x|^2
+    let (c_re, c_im) = x.iter().zip(&y).fold((0.0, 0.0), |(re, im), (a, b)| {
+        (re + a.0 * b.0 + a.1 * b.1, im + a.0 * b.1 - a.1 * b.0)
+    });
+    let (c_re, c_im) = (c_re / xx, c_im / xx);
+    let orthogonal: Vec<(f64, f64)> = x
+        .iter()
+        .zip(&y)
+        .map(|(a, b)| {
+            (
+                b.0 - (c_re * a.0 - c_im * a.1),
+                b.1 - (c_re * a.1 + c_im * a.0),
+            )
+        })
+        .collect();
+    (norm(&orthogonal) / yy).sqrt().min(1.0)
+}
+
+/// Sets the two multipliers nearest 1 to exactly 1 (the trivial pair, found), keeping the
+/// list sorted by decreasing modulus.
+fn snap_trivial_pair(multipliers: &mut [Multiplier]) {
+    if let [first, second, ..] = nearest_one(multipliers)[..] {
         for i in [first, second] {
             multipliers[i] = Multiplier { re: 1.0, im: 0.0 };
         }
         multipliers.sort_by(|a, b| b.modulus().total_cmp(&a.modulus()));
     }
-    distance
+}
+
+/// The size of the map whose multipliers are judged: rows of the matrix, time step, period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MapShape {
+    pub dimension: usize,
+    pub dt: f64,
+    pub period: f64,
 }
 
 /// The verdict of `multipliers` (largest modulus first) at `tolerance`, for a state
-/// `corrected` to a periodic orbit (`periodic` when the correction succeeded). The verdict
-/// is resolved only when the state is periodic and the trivial pair is found within
-/// `tolerance`: where the differences cannot find it, they are not accurate enough for the
-/// others either (an event whose timing is singular, such as a grazing impact).
+/// `corrected` towards a periodic orbit, with its trivial pair `pair`. `failure` is why the
+/// correction does not count (`None` when it reached a periodic orbit near the point). The
+/// verdict is resolved only when the correction counts and the trivial pair is found: where
+/// the differences cannot find it, they are not accurate enough for the others either (an
+/// event whose timing is singular, such as a grazing impact).
 pub(crate) fn verdict(
     mut multipliers: Vec<Multiplier>,
     tolerance: f64,
-    dimension: usize,
-    dt: f64,
-    period: f64,
+    pair: TrivialPair,
+    failure: Option<UnresolvedReason>,
     corrected: &Corrected,
-    periodic: bool,
+    shape: MapShape,
 ) -> Floquet {
-    let trivial_distance = snap_trivial_pair(&mut multipliers, tolerance);
-    let resolved = periodic && trivial_distance <= tolerance;
+    let unresolved = failure.or_else(|| {
+        (!pair.found(tolerance)).then(|| UnresolvedReason::TrivialPairMissing {
+            distance: pair.distance,
+            perturbation: pair.perturbation.unwrap_or(pair.distance),
+            tolerance,
+        })
+    });
+    if unresolved.is_none() {
+        snap_trivial_pair(&mut multipliers);
+    }
     let max_modulus = multipliers.first().map_or(0.0, Multiplier::modulus);
     let verdict = match multipliers.first() {
-        _ if !resolved => Verdict::Unresolved,
+        _ if unresolved.is_some() => Verdict::Unresolved,
         Some(mu) if mu.modulus() > 1.0 + tolerance => {
             Verdict::Unstable(if mu.im.abs() > tolerance * mu.modulus() {
                 Crossing::ComplexPair
@@ -231,14 +371,312 @@ pub(crate) fn verdict(
             max_modulus
         },
         verdict,
-        trivial_distance,
-        dimension,
-        dt,
+        unresolved,
+        trivial_distance: pair.distance,
+        trivial_perturbation: pair.perturbation,
+        dimension: shape.dimension,
+        dt: shape.dt,
         initial_defect: corrected.initial_defect,
         periodicity_defect: corrected.defect,
         correction: corrected.shift,
         displacement_correction: corrected.displacement_shift,
         energy_correction: corrected.energy_change,
-        period,
+        period: shape.period,
+    }
+}
+
+/// Why a point's multipliers give no verdict ([`Verdict::Unresolved`]), with the numbers
+/// that decided it. Its `Display` is one sentence without commas, fit for a CSV cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub enum UnresolvedReason {
+    /// The correction did not reach a periodic orbit of the grid's map: the defect
+    /// `|P(X) - X| / |X|` of the best state stayed above the bound. The multipliers are
+    /// those of the point's own state.
+    NotPeriodic {
+        /// The defect of the best state reached.
+        defect: f64,
+        /// [`RESOLVED_DEFECT`](super::RESOLVED_DEFECT).
+        bound: f64,
+        /// Newton iterations that decreased the defect.
+        iterations: usize,
+        /// The iterations allowed
+        /// ([`StabilityOptions::corrections`](super::StabilityOptions::corrections)): fewer
+        /// taken means that no step along the Newton direction decreased the defect.
+        corrections: usize,
+    },
+    /// The periodic orbit reached has another energy than the point: another motion.
+    EnergyMoved {
+        /// `(E - E0) / E0`.
+        change: f64,
+        /// [`StabilityOptions::max_energy_correction`](super::StabilityOptions::max_energy_correction).
+        bound: f64,
+    },
+    /// The periodic orbit reached has another displacement than the point: another motion.
+    DisplacementMoved {
+        /// `max |u - u0| / max |u0|`.
+        change: f64,
+        /// [`StabilityOptions::max_displacement_correction`](super::StabilityOptions::max_displacement_correction).
+        bound: f64,
+    },
+    /// The differences did not find the double multiplier 1 of the time shift and the family
+    /// direction (with any of the steps tried): a perturbation larger than the tolerance
+    /// separates the pair from it, so the other multipliers are not accurate to the
+    /// tolerance either.
+    TrivialPairMissing {
+        /// The larger `|mu - 1|` of the pair.
+        distance: f64,
+        /// The perturbation of the monodromy matrix that makes the pair the double
+        /// multiplier 1 ([`Floquet::trivial_perturbation`]).
+        perturbation: f64,
+        /// [`StabilityOptions::tolerance`](super::StabilityOptions::tolerance).
+        tolerance: f64,
+    },
+}
+
+impl std::fmt::Display for UnresolvedReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            UnresolvedReason::NotPeriodic {
+                defect,
+                bound,
+                iterations,
+                corrections,
+            } if iterations < corrections => write!(
+                f,
+                "no periodic orbit of the grid's map: the correction stalled at defect \
+                 {defect:.1e} after {iterations} of {corrections} iterations (bound {bound:.0e})"
+            ),
+            UnresolvedReason::NotPeriodic {
+                defect,
+                bound,
+                corrections,
+                ..
+            } => write!(
+                f,
+                "no periodic orbit of the grid's map: defect {defect:.1e} after all \
+                 {corrections} correction iterations (bound {bound:.0e})"
+            ),
+            UnresolvedReason::EnergyMoved { change, bound } => write!(
+                f,
+                "the periodic orbit reached has {:.1} % {} energy than the point (bound {:.1} %)",
+                100.0 * change.abs(),
+                if change < 0.0 { "less" } else { "more" },
+                100.0 * bound
+            ),
+            UnresolvedReason::DisplacementMoved { change, bound } => write!(
+                f,
+                "the periodic orbit reached moves the displacement by {:.1} % (bound {:.1} %)",
+                100.0 * change,
+                100.0 * bound
+            ),
+            UnresolvedReason::TrivialPairMissing {
+                distance,
+                perturbation,
+                tolerance,
+            } => write!(
+                f,
+                "the trivial multiplier pair lies {distance:.1e} from 1 and is a perturbation \
+                 of {perturbation:.1e} from the double multiplier 1 (tolerance {tolerance:.1e})"
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+
+    /// A block-diagonal monodromy: the 2 x 2 block `pair` at the top, then rotations by the
+    /// angles `phases` (multipliers `e^{+-i phi}` on the circle, away from 1).
+    fn monodromy(pair: [[f64; 2]; 2], phases: &[f64]) -> Monodromy {
+        let n = 2 + 2 * phases.len();
+        Mat::from_fn(n, n, |i, j| match (i / 2, j / 2) {
+            (0, 0) => pair[i][j],
+            (b, c) if b == c => {
+                let (cos, sin) = (phases[b - 1].cos(), phases[b - 1].sin());
+                [[cos, -sin], [sin, cos]][i % 2][j % 2]
+            }
+            _ => 0.0,
+        })
+    }
+
+    fn pair_of(m: &Monodromy, tolerance: f64) -> TrivialPair {
+        let multipliers = eigenvalues(m).unwrap();
+        trivial_pair(m, &multipliers, 0, tolerance, true).unwrap()
+    }
+
+    /// A Jordan block at 1 with coupling `c`, perturbed by `e` below the diagonal, has its
+    /// multipliers at `1 +- sqrt(c e)`: the distance is the square root, the perturbation
+    /// found `2 e / (1 + e / c)` (Wilkinson's estimate, within a factor 2), whatever the
+    /// coupling.
+    #[test]
+    fn a_perturbed_jordan_block_gives_back_its_perturbation() {
+        for c in [0.3, 1.0, 7.0] {
+            for e in [1e-8, 1e-6, 1e-4] {
+                let m = monodromy([[1.0, c], [e, 1.0]], &[0.7, 2.0]);
+                let pair = pair_of(&m, 0.0);
+                assert!(
+                    ((pair.distance - (c * e).sqrt()) / (c * e).sqrt()).abs() < 1e-6,
+                    "c {c}, e {e}: {pair:?}"
+                );
+                let found = pair.perturbation.unwrap();
+                let expected = 2.0 * e / (1.0 + e / c);
+                assert!(
+                    (found - expected).abs() <= 1e-6 * e,
+                    "c {c}, e {e}: {pair:?}"
+                );
+                // Found at a tolerance between 2 e and sqrt(c e), not below e.
+                assert!(pair.found(2.0 * e) && !pair.found(e), "c {c}, e {e}");
+            }
+        }
+    }
+
+    /// Two simple multipliers `1 +- s` with orthogonal eigenvectors are `s` from a double
+    /// multiplier 1: a split that is the perturbation itself, not its square root.
+    #[test]
+    fn a_split_with_orthogonal_eigenvectors_is_its_own_perturbation() {
+        for s in [1e-5, 1e-3, 2e-2] {
+            let pair = pair_of(&monodromy([[1.0 + s, 0.0], [0.0, 1.0 - s]], &[1.1]), 0.0);
+            assert!(
+                (pair.perturbation.unwrap() - s).abs() <= 1e-9,
+                "{s}: {pair:?}"
+            );
+        }
+    }
+
+    /// A pair pulled inward together, `(1 - p) J`: the mean's distance counts in full.
+    #[test]
+    fn a_pair_moved_together_counts_the_move() {
+        for p in [1e-4, 1e-2] {
+            let pair = pair_of(&monodromy([[1.0 - p, 0.5], [0.0, 1.0 - p]], &[0.4]), 0.0);
+            let found = pair.perturbation.unwrap();
+            assert!((found - p).abs() <= 1e-6 * p, "{p}: {pair:?}");
+        }
+    }
+
+    /// Within the tolerance, the eigenvectors are not needed: no perturbation is computed.
+    #[test]
+    fn a_pair_within_the_tolerance_is_found_without_eigenvectors() {
+        let pair = pair_of(&monodromy([[1.0, 1.0], [1e-8, 1.0]], &[0.9]), 1e-3);
+        assert!(pair.perturbation.is_none() && pair.found(1e-3), "{pair:?}");
+    }
+
+    fn corrected() -> Corrected {
+        Corrected {
+            x: vec![1.0; 4],
+            initial_defect: 1e-2,
+            defect: 1e-12,
+            energy_change: 1e-3,
+            shift: 1e-2,
+            displacement_shift: 1e-3,
+            iterations: 2,
+        }
+    }
+
+    const SHAPE: MapShape = MapShape {
+        dimension: 4,
+        dt: 0.01,
+        period: 3.5,
+    };
+
+    /// A failed correction is the reason, whatever the pair; a found pair is set to 1 and the
+    /// verdict follows from the others; a missing pair is the reason, with its numbers.
+    #[test]
+    fn the_verdict_names_its_reason() {
+        let m = monodromy([[1.0, 1.0], [1e-4, 1.0]], &[0.5]);
+        let multipliers = eigenvalues(&m).unwrap();
+        let pair = pair_of(&m, 1e-3);
+        let failure = UnresolvedReason::EnergyMoved {
+            change: 0.2,
+            bound: 0.05,
+        };
+        let f = verdict(
+            multipliers.clone(),
+            1e-3,
+            pair,
+            Some(failure),
+            &corrected(),
+            SHAPE,
+        );
+        assert_eq!(
+            (f.verdict, f.unresolved),
+            (Verdict::Unresolved, Some(failure))
+        );
+
+        let f = verdict(multipliers.clone(), 1e-3, pair, None, &corrected(), SHAPE);
+        assert_eq!((f.verdict, f.unresolved), (Verdict::Stable, None), "{f:?}");
+        assert_eq!(f.max_multiplier, 1.0);
+        assert_eq!(f.multipliers.iter().filter(|mu| mu.re == 1.0).count(), 2);
+
+        let pair = pair_of(&m, 1e-5);
+        let f = verdict(multipliers, 1e-5, pair, None, &corrected(), SHAPE);
+        let Some(UnresolvedReason::TrivialPairMissing {
+            distance,
+            perturbation,
+            tolerance,
+        }) = f.unresolved
+        else {
+            panic!("{f:?}");
+        };
+        assert_eq!(f.verdict, Verdict::Unresolved);
+        assert!((distance - 1e-2).abs() < 1e-8 && (perturbation - 2e-4).abs() < 1e-7);
+        assert_eq!(tolerance, 1e-5);
+    }
+
+    /// Every reason's sentence carries its numbers and no comma (a CSV cell).
+    #[test]
+    fn reasons_read_as_one_sentence_with_their_numbers() {
+        let cases = [
+            (
+                UnresolvedReason::NotPeriodic {
+                    defect: 0.23,
+                    bound: 1e-8,
+                    iterations: 3,
+                    corrections: 8,
+                },
+                &["2.3e-1", "3 of 8", "stalled", "1e-8"][..],
+            ),
+            (
+                UnresolvedReason::NotPeriodic {
+                    defect: 4e-3,
+                    bound: 1e-8,
+                    iterations: 8,
+                    corrections: 8,
+                },
+                &["4.0e-3", "all 8"][..],
+            ),
+            (
+                UnresolvedReason::EnergyMoved {
+                    change: -0.12,
+                    bound: 0.05,
+                },
+                &["12.0 % less energy", "5.0 %"][..],
+            ),
+            (
+                UnresolvedReason::DisplacementMoved {
+                    change: 0.071,
+                    bound: 0.05,
+                },
+                &["7.1 %", "5.0 %"][..],
+            ),
+            (
+                UnresolvedReason::TrivialPairMissing {
+                    distance: 1.4e-2,
+                    perturbation: 1.1e-2,
+                    tolerance: 1e-3,
+                },
+                &["1.4e-2", "1.1e-2", "1.0e-3"][..],
+            ),
+        ];
+        for (reason, numbers) in cases {
+            let text = reason.to_string();
+            assert!(!text.contains(',') && !text.contains('\n'), "{text}");
+            for n in numbers {
+                assert!(text.contains(n), "{text} lacks {n}");
+            }
+        }
     }
 }

@@ -27,7 +27,8 @@
 //!
 //! - The time shift of the motion is a fixed direction of `M`: `M X*' = X*'`, a multiplier 1.
 //!   The family direction adds a Jordan block at 1; numerically the pair splits by about the
-//!   square root of the differences' error ([`Floquet::trivial_distance`] reports the nearest).
+//!   square root of the differences' error ([`Floquet::trivial_distance`] reports the nearest;
+//!   see [the trivial pair](#the-trivial-pair)).
 //! - The map is symplectic, so multipliers come in pairs `mu`, `1 / conj(mu)`: an unstable
 //!   motion has `|mu| > 1` and `1 / |mu|` both. No conservative motion has every multiplier
 //!   strictly inside the circle, hence `max |mu| >= 1` (up to the differences' error).
@@ -61,10 +62,60 @@
 //! [`StabilityOptions::max_energy_correction`] of the point's own (a harmonic-balance point's
 //! energy is accurate where its state is not: at a fixed period the exact map has several
 //! periodic orbits near the point, and one with 10 % more energy in high harmonics is
-//! another motion), and the trivial pair found within the tolerance (where the differences
-//! miss it, an event with singular timing, such as a grazing impact, makes them inaccurate
-//! for every multiplier): otherwise the point is [`Verdict::Unresolved`], with the
+//! another motion), and the trivial pair found ([below](#the-trivial-pair); where the
+//! differences miss it, an event with singular timing, such as a grazing impact, or the
+//! grid's projection makes them inaccurate for every multiplier): otherwise the point is [`Verdict::Unresolved`], with the
 //! multipliers of its own state when the correction failed.
+//!
+//! # Why there is no verdict
+//!
+//! An unresolved point says why in [`Floquet::unresolved`], an [`UnresolvedReason`] with the
+//! numbers, checked in this order:
+//!
+//! - [`UnresolvedReason::NotPeriodic`]: the correction ended above [`RESOLVED_DEFECT`]
+//!   (the defect, and the iterations taken of those allowed: fewer means it stalled, no
+//!   step along the Newton direction decreasing the defect);
+//! - [`UnresolvedReason::EnergyMoved`], [`UnresolvedReason::DisplacementMoved`]: the
+//!   periodic orbit reached is another motion (the change and the bound);
+//! - [`UnresolvedReason::TrivialPairMissing`]: the pair's distance from 1, the perturbation
+//!   of `M` it implies and the tolerance (below).
+//!
+//! Where the multipliers cannot be computed at all, [`floquet`] returns the
+//! [`StabilityError`] instead (a grid over [`MAX_DIMENSION`] rows, marches over
+//! [`MAX_MARCH_STEPS`] steps, a state at rest, a march or a decomposition that fails). Each
+//! reason's `Display` is one sentence without commas. The multipliers of an unresolved point
+//! are kept for inspection, but its [`Floquet::max_multiplier`] means nothing: the
+//! monodromy of a state that is not periodic has moduli such as `sqrt 2`, the golden ratio
+//! or 2, set by the order of its events, not by the motion.
+//!
+//! # The trivial pair
+//!
+//! The time shift and the family direction make 1 a double multiplier with a Jordan block:
+//! in an orthonormal basis of their invariant subspace `M` acts as `[[1, c], [0, 1]]`, `c`
+//! the change of phase per period along the family. An error `E` of the computed matrix moves
+//! the pair to `1 + tr(E) / 2 +- sqrt(c e_21)`: its mean by the error, its split by the
+//! square root. The pair lying within the tolerance of 1 is then too strict a test: an
+//! error of `1e-6` that leaves every simple multiplier accurate to the tolerance `1e-3`
+//! already splits a pair with `c = 1` by `1e-3`. What the split does tell is the error,
+//! through the eigenvectors: those of the perturbed block, `(1, +-sqrt(e_21 / c))`, close up
+//! as the error vanishes. With `theta` the angle between the two eigenvectors,
+//!
+//! `delta = |(mu_1 + mu_2) / 2 - 1| + |mu_1 - mu_2| sin(theta) / 2`
+//!
+//! is Wilkinson's estimate of the distance from `M` to a matrix with the double multiplier 1
+//! (`|mu_1 - mu_2| / (kappa_1 + kappa_2)`, with the condition numbers `kappa = 1 / sin(theta)`
+//! of the pair, plus the move of their mean to 1): `2 e_21` for the perturbed Jordan block,
+//! whatever `c`, and `s` for two simple multipliers `1 +- s` with orthogonal eigenvectors. The
+//! pair is found when it lies within the tolerance of 1 or when `delta` does
+//! ([`Floquet::trivial_perturbation`]): the error it implies is then no larger than the
+//! error the verdict allows every other multiplier. A pair that is not a split double
+//! multiplier (its eigenvectors far apart, `delta` close to the distance) means an error of
+//! the map near 1 of about its distance, which no verdict at the tolerance survives. On the
+//! clamped bar at `T = 3.945` (200 cells) the three steps of the differences put the family's
+//! multiplier at `0.978`, `0.971` and `0.986` (the time shift's within `3e-4` of 1), with
+//! `sin(theta) = 0.5` to `0.8` and its neighbours pulled inward alike (`0.983 +- 0.020 i`,
+//! `0.981 +- 0.036 i`, ...): the multipliers near 1 change by `1.5e-2` with the step, and
+//! `delta = 1.1e-2` says as much.
 //!
 //! The verdict is **stable** when `max |mu| <= 1 + tolerance`
 //! ([`StabilityOptions::tolerance`]).
@@ -87,7 +138,7 @@ mod monodromy;
 mod shooting;
 
 pub use crate::error::StabilityError;
-pub use floquet::{Crossing, Floquet, Multiplier, Verdict};
+pub use floquet::{Crossing, Floquet, Multiplier, UnresolvedReason, Verdict};
 pub use hill::{
     hill, Exponent, HillOptions, HillSpectrum, HILL_RESIDUAL, MAX_HILL_DIMENSION, MIN_ALIGNMENT,
 };
@@ -100,7 +151,9 @@ use crate::verify::{
     SpringUpdate, State, VerifyError,
 };
 use coordinates::Coordinates;
+use floquet::{MapShape, TrivialPair};
 use monodromy::{Monodromy, PeriodMap};
+use shooting::Corrected;
 
 /// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
 /// `8 n^2` bytes (200 MiB).
@@ -301,46 +354,89 @@ pub fn floquet_of_state(
         options.corrections,
         PERIODIC_DEFECT,
     )?;
-    let periodic = corrected.defect <= RESOLVED_DEFECT
-        && corrected.displacement_shift <= options.max_displacement_correction
-        && corrected.energy_change.abs() <= options.max_energy_correction;
+    let failure = correction_failure(&corrected, options);
     // A point whose correction failed keeps the multipliers of its own state: those of a
     // partial correction depend on the path the iterations took.
     let spurious = coordinates.spurious_unit_multipliers();
-    let multipliers_of = |monodromy: &Monodromy| -> Result<Vec<Multiplier>, StabilityError> {
+    let periodic = failure.is_none();
+    let assess = |monodromy: &Monodromy| -> Result<(Vec<Multiplier>, TrivialPair), StabilityError> {
         let mut multipliers = floquet::eigenvalues(monodromy)?;
         floquet::remove_nearest_one(&mut multipliers, spurious);
-        Ok(multipliers)
+        let pair = floquet::trivial_pair(
+            monodromy,
+            &multipliers,
+            spurious,
+            options.tolerance,
+            periodic,
+        )?;
+        Ok((multipliers, pair))
     };
-    let mut multipliers = match at_corrected {
-        Some(at_corrected) if periodic => multipliers_of(&at_corrected)?,
-        _ => multipliers_of(&at_base)?,
+    let (mut multipliers, mut pair) = match at_corrected {
+        Some(at_corrected) if periodic => assess(&at_corrected)?,
+        _ => assess(&at_base)?,
     };
     // The differences must reproduce the known multiplier 1 of the time shift. Where they
     // miss it, a step that adds or removes a near-grazing impact made them inaccurate: a
     // ten times larger step steps over it, a ten times smaller one stays within the piece.
     if periodic {
         for factor in STEP_FACTORS {
-            if floquet::trivial_pair_distance(&multipliers) <= options.tolerance {
+            if pair.found(options.tolerance) {
                 break;
             }
             let other = map.monodromy(&corrected.x, factor * options.relative_step)?;
-            let other = multipliers_of(&other)?;
-            if floquet::trivial_pair_distance(&other) < floquet::trivial_pair_distance(&multipliers)
-            {
-                multipliers = other;
+            let other = assess(&other)?;
+            if other.1.miss() < pair.miss() {
+                (multipliers, pair) = other;
             }
         }
     }
+    let shape = MapShape {
+        dimension: coordinates.len(),
+        dt: initial.grid().dt(),
+        period,
+    };
     Ok(floquet::verdict(
         multipliers,
         options.tolerance,
-        coordinates.len(),
-        initial.grid().dt(),
-        period,
+        pair,
+        failure,
         &corrected,
-        periodic,
+        shape,
     ))
+}
+
+/// Why the correction `corrected` does not count, in the order of the checks: its state is
+/// not periodic (defect above [`RESOLVED_DEFECT`]), or the periodic orbit it reached has
+/// another energy or displacement than the point's (beyond
+/// [`StabilityOptions::max_energy_correction`] and
+/// [`StabilityOptions::max_displacement_correction`]). `None` when it counts.
+fn correction_failure(
+    corrected: &Corrected,
+    options: &StabilityOptions,
+) -> Option<UnresolvedReason> {
+    let periodic = corrected.defect <= RESOLVED_DEFECT;
+    let energy_kept = corrected.energy_change.abs() <= options.max_energy_correction;
+    let displacement_kept = corrected.displacement_shift <= options.max_displacement_correction;
+    if !periodic {
+        Some(UnresolvedReason::NotPeriodic {
+            defect: corrected.defect,
+            bound: RESOLVED_DEFECT,
+            iterations: corrected.iterations,
+            corrections: options.corrections,
+        })
+    } else if !energy_kept {
+        Some(UnresolvedReason::EnergyMoved {
+            change: corrected.energy_change,
+            bound: options.max_energy_correction,
+        })
+    } else if !displacement_kept {
+        Some(UnresolvedReason::DisplacementMoved {
+            change: corrected.displacement_shift,
+            bound: options.max_displacement_correction,
+        })
+    } else {
+        None
+    }
 }
 
 /// [`StabilityError::TooLarge`] for more than [`MAX_DIMENSION`] coordinates.
