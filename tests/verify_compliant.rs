@@ -6,8 +6,8 @@
 use nonsmooth_modes::bar::{Bar, BarId};
 use nonsmooth_modes::system::AssemblyBuilder;
 use nonsmooth_modes::verify::{
-    clamped_first_mode, march, BarCells, Condition, Grid, MarchOptions, Model, SpringUpdate,
-    State, Trajectory,
+    clamped_first_mode, march, BarCells, Condition, Grid, MarchOptions, Model, SpringUpdate, State,
+    Trajectory,
 };
 
 const DT: f64 = 1.0 / 400.0;
@@ -141,10 +141,8 @@ fn compliant_energy_error_is_second_order() {
         )
         .unwrap();
         let grid = Grid::new(&model, 1.0 / n as f64).unwrap();
-        let initial = State::from_fields(&model, &grid, |_, x| {
-            (0.02 * (1.3 * x).sin(), 0.01 * x)
-        })
-        .unwrap();
+        let initial =
+            State::from_fields(&model, &grid, |_, x| (0.02 * (1.3 * x).sin(), 0.01 * x)).unwrap();
         let exact = march(&initial, 100.0, &MarchOptions::default()).unwrap();
         let options = MarchOptions {
             spring: SpringUpdate::Midpoint,
@@ -203,9 +201,17 @@ fn stiff_compliant_obstacle_tends_to_the_rigid_one() {
         let grid = Grid::new(&model, DT).unwrap();
         let initial = State::from_cells(&model, &grid, &cells).unwrap();
         let compliant = march(&initial, period, &MarchOptions::default()).unwrap();
-        let (a, b) = (&compliant.ends[1].displacement, &reference.ends[1].displacement);
+        let (a, b) = (
+            &compliant.ends[1].displacement,
+            &reference.ends[1].displacement,
+        );
         assert_eq!(a.len(), b.len());
-        let error = a.iter().zip(b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max) / GAP;
+        let error = a
+            .iter()
+            .zip(b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max)
+            / GAP;
         errors.push(error);
     }
     eprintln!("largest end displacement difference / g0, k = 1e2 .. 1e6: {errors:?}");

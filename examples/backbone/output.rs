@@ -211,7 +211,11 @@ pub fn verification_cells(p: &BackbonePoint) -> String {
         ),
         None => ",,,".to_string(),
     };
-    let outcome = p.check.as_ref().map(ToString::to_string).unwrap_or_default();
+    let outcome = p
+        .check
+        .as_ref()
+        .map(ToString::to_string)
+        .unwrap_or_default();
     if let Some(reason) = p.check.as_ref().and_then(|c| c.reason()) {
         eprintln!(
             "backbone: step {} not checked in the time domain ({outcome}): {reason}",

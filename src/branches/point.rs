@@ -223,9 +223,9 @@ impl CheckOutcome {
     pub fn reason(&self) -> Option<String> {
         match self {
             CheckOutcome::Passed | CheckOutcome::Failed => None,
-            CheckOutcome::Unchecked { condition } => {
-                Some(format!("condition `{condition}` declares no time-domain form"))
-            }
+            CheckOutcome::Unchecked { condition } => Some(format!(
+                "condition `{condition}` declares no time-domain form"
+            )),
             CheckOutcome::OverBudget { steps, max_steps } => Some(format!(
                 "its march would take {steps:.3e} steps, over the check's budget of {max_steps:.3e}"
             )),
@@ -257,7 +257,9 @@ impl BackbonePoint {
             && !matches!(
                 self.check,
                 Some(
-                    CheckOutcome::Failed | CheckOutcome::OverBudget { .. } | CheckOutcome::NotRun(_)
+                    CheckOutcome::Failed
+                        | CheckOutcome::OverBudget { .. }
+                        | CheckOutcome::NotRun(_)
                 )
             )
             && self.label != Some(Label::Unverified)

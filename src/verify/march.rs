@@ -311,10 +311,7 @@ impl Integrator {
                     }
                     ports[0] = Some(p);
                 }
-                (
-                    Condition::CompliantObstacle { gap, stiffness, .. },
-                    [Some(mut p), _],
-                ) => {
+                (Condition::CompliantObstacle { gap, stiffness, .. }, [Some(mut p), _]) => {
                     let (n, beta) = (p.n, stiffness / p.z);
                     let update = self.options.spring;
                     for q in &inc[0] {
@@ -336,11 +333,7 @@ impl Integrator {
                                 let h = (stop - s) * dt;
                                 let rate = update.mean_rate(w - beta * c, beta, h);
                                 p.emit(&mut out[0], stop, a, 2.0 * n * rate - a, stop - s);
-                                let after = if release.is_some() {
-                                    0.0
-                                } else {
-                                    c + rate * h
-                                };
+                                let after = if release.is_some() { 0.0 } else { c + rate * h };
                                 p.u = n * (gap + after);
                                 // Mean force Z (w - rate) = k (mean c); c is monotone.
                                 watch.force += p.z * (w - rate) * (stop - s);

@@ -333,7 +333,10 @@ mod tests {
                 gap: 0.1,
                 stiffness,
             };
-            let model = Model::new(vec![Bar::unit()], vec![Condition::Free { end: id.left() }, c]);
+            let model = Model::new(
+                vec![Bar::unit()],
+                vec![Condition::Free { end: id.left() }, c],
+            );
             assert!(matches!(model, Err(VerifyError::InvalidParameter { .. })));
         }
     }
