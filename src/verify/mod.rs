@@ -125,8 +125,9 @@
 //! [`Model::from_system`](crate::verify::Model::from_system) takes each condition of a
 //! [`BarSystem`](crate::system::BarSystem) as the form it declares,
 //! [`BoundaryCondition::time_domain_form`](crate::bc::BoundaryCondition::time_domain_form)
-//! ([`TimeDomainForm`](crate::bc::TimeDomainForm), which is [`Condition`]): clamped, free,
-//! ground spring, rigid or compliant obstacle, two-end contact. Every built-in condition
+//! ([`TimeDomainForm`](crate::bc::TimeDomainForm), which is
+//! [`Condition`](crate::verify::Condition)): clamped, free, ground spring, rigid or compliant
+//! obstacle, two-end contact. Every built-in condition
 //! declares its own. Nothing is read from rows or observables: a unilateral law's residual is
 //! an opaque function, so a penalty law `lambda - k max(0, -g)` has the same gap and force
 //! as a rigid obstacle, and marching what the observables suggest would check a motion of
