@@ -545,6 +545,17 @@ pub enum ContinuationError {
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum VerifyError {
+    /// A condition declares no time-domain form
+    /// ([`BoundaryCondition::time_domain_form`](crate::bc::BoundaryCondition::time_domain_form)
+    /// is `None`): its law in time is not known, so the system is not marched.
+    #[error(
+        "condition `{condition}` declares no time-domain form: the integrator does not know \
+         its law in time"
+    )]
+    NoTimeDomainForm {
+        /// Name of the condition.
+        condition: String,
+    },
     /// A boundary condition has a form the integrator cannot advance exactly.
     #[error("condition `{condition}` is not supported by the time-domain integrator: {reason}")]
     Unsupported {

@@ -179,6 +179,7 @@ mod tests {
             events: vec![Event::Fold { parameter: 1.8 }],
             branch: 0,
             time_domain: None,
+            check: None,
             character: None,
             label: None,
             stability: None,

@@ -4,6 +4,7 @@
 use crate::args::Args;
 use crate::output::{
     hill_cells, stability_cells, verification_cells, HILL_COLUMNS, STABILITY_COLUMNS,
+    VERIFY_COLUMNS,
 };
 use nonsmooth_modes::branches::{
     compute, full_basis_branch, to_full_basis, Method, Request, TimeDomainCheck,
@@ -27,11 +28,7 @@ pub fn run_full_basis(
     (t0, t1): (f64, f64),
     out: &mut dyn Write,
 ) -> Result<(usize, usize), Box<dyn std::error::Error>> {
-    let verify = if a.verify {
-        ",periodicity_defect,displacement_defect,max_penetration"
-    } else {
-        ""
-    };
+    let verify = if a.verify { VERIFY_COLUMNS } else { "" };
     let stability = if a.stability { STABILITY_COLUMNS } else { "" };
     let hill = if a.hill { HILL_COLUMNS } else { "" };
     writeln!(out, "{HEADER}{verify}{stability}{hill}")?;

@@ -47,8 +47,11 @@
 //! continued parameter's value). `--verify` asks the library to check every converged point
 //! (`branches::TimeDomainCheck::for_system`: one period of the exact integrator with a step of
 //! 1/400 of the shortest travel time, at most 10^6 steps per point) and adds the columns
-//! `periodicity_defect,displacement_defect,max_penetration` (empty, with a message, for a
-//! point it could not check).
+//! `periodicity_defect,displacement_defect,max_penetration,time_domain_check`: the numbers
+//! are empty for a point that was not marched, and `time_domain_check` is `passed`,
+//! `failed` (the point is labelled `unverified`), `unchecked` (a condition declares no
+//! time-domain form: the label stays that of the harmonic content), `over-budget` or
+//! `not-run` (with the reason on stderr).
 //!
 //! `--resonance-band C` holds at zero every harmonic `n >= 2` whose frequency lies within
 //! `C / m` (relative) of an open- or closed-contact natural frequency
@@ -103,7 +106,7 @@
 //! `before-start` for the periods before the cosine run's first converged one; `unfolding`
 //! is the phase-locked system's `mu`, `sine_share` and `asymmetry` say how far the motion is
 //! from even about `t = 0` and about any instant; `label` as below), then with `--verify`
-//! `periodicity_defect,displacement_defect,max_penetration`, with `--stability`
+//! `periodicity_defect,displacement_defect,max_penetration,time_domain_check`, with `--stability`
 //! `stable,max_multiplier,stability_reason` and with `--hill` `hill_stable,hill_max_multiplier`, as for the
 //! cosine basis. It takes `--parameter omega`,
 //! sequential steps and `--subharmonic 1`; other combinations are usage errors.

@@ -20,7 +20,7 @@ pub const HEADER: &str = "step,period,omega,energy,energy_normalized,exact_energ
 pub fn header(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> String {
     let mut header = HEADER.to_string();
     if verify {
-        header.push_str(",periodicity_defect,displacement_defect,max_penetration");
+        header.push_str(VERIFY_COLUMNS);
     }
     header.push_str(",contacts_per_period");
     if subharmonic > 1 {
@@ -35,6 +35,10 @@ pub fn header(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> 
     }
     header
 }
+
+/// The columns of `--verify`.
+pub const VERIFY_COLUMNS: &str =
+    ",periodicity_defect,displacement_defect,max_penetration,time_domain_check";
 
 /// The columns of `--stability`.
 pub const STABILITY_COLUMNS: &str = ",stable,max_multiplier,stability_reason";
@@ -195,25 +199,30 @@ impl Sink<'_> {
     }
 }
 
-/// `,periodicity_defect,displacement_defect,max_penetration` of a point (the library's
-/// time-domain check of the run), or empty cells where it was not checked (with a message
-/// when it converged).
+/// [`VERIFY_COLUMNS`] of a point (the library's time-domain check of the run): the defects
+/// and penetration where it was marched, and the outcome (`passed`, `failed`, `unchecked`,
+/// `over-budget`, `not-run`); empty cells for a point that did not converge, and a message
+/// saying why for a converged one that was not marched.
 pub fn verification_cells(p: &BackbonePoint) -> String {
-    match (p.time_domain, p.converged) {
-        (Some(r), _) => format!(
+    let numbers = match p.time_domain {
+        Some(r) => format!(
             ",{:.6e},{:.6e},{:.6e}",
             r.defect, r.displacement_defect, r.max_penetration
         ),
-        (None, true) => {
-            eprintln!(
-                "backbone: step {} not checked in the time domain (its march is over the \
-                 check's budget, or failed): unverified",
-                p.step
-            );
-            ",,,".to_string()
-        }
-        (None, false) => ",,,".to_string(),
+        None => ",,,".to_string(),
+    };
+    let outcome = p
+        .check
+        .as_ref()
+        .map(ToString::to_string)
+        .unwrap_or_default();
+    if let Some(reason) = p.check.as_ref().and_then(|c| c.reason()) {
+        eprintln!(
+            "backbone: step {} not checked in the time domain ({outcome}): {reason}",
+            p.step
+        );
     }
+    format!("{numbers},{outcome}")
 }
 
 /// `,stable,max_multiplier,stability_reason` of a point: `true`, `false` or `unresolved`,

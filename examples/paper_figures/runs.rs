@@ -281,6 +281,7 @@ pub fn solved_point(
         events: Vec::new(),
         branch: 0,
         time_domain: None,
+        check: None,
         character: None,
         label: None,
         stability: None,

@@ -2,7 +2,7 @@
 
 use super::{
     complementarity_samples, smoothed_complementarity, BoundaryCondition, LawSamples, LawValue,
-    LinearRows, Observable, Quantity, Term, UnilateralLaw,
+    LinearRows, Observable, Quantity, Term, TimeDomainForm, UnilateralLaw,
 };
 use crate::bar::EndRef;
 use crate::check::positive;
@@ -60,6 +60,13 @@ impl BoundaryCondition for Contact {
     }
     fn unilateral(&self) -> Option<&dyn UnilateralLaw> {
         Some(self)
+    }
+    fn time_domain_form(&self) -> Option<TimeDomainForm> {
+        Some(TimeDomainForm::Contact {
+            first: self.first,
+            second: self.second,
+            gap: self.gap,
+        })
     }
 }
 

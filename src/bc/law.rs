@@ -167,8 +167,12 @@ pub fn complementarity_samples(
 ///   force it carries.
 ///
 /// The time-domain check [`verify::periodicity_check`](crate::verify::periodicity_check)
-/// marches rigid obstacles and contacts only: for a gap with strain or force terms it returns
-/// [`VerifyError::Unsupported`](crate::error::VerifyError::Unsupported) instead.
+/// marches the law the condition declares
+/// ([`BoundaryCondition::time_domain_form`](super::BoundaryCondition::time_domain_form)), never
+/// one inferred from the observables: a law without a declared form is not marched
+/// ([`VerifyError::NoTimeDomainForm`](crate::error::VerifyError::NoTimeDomainForm)), and
+/// the points of [`compute`](crate::branches::compute) are then unchecked. The example below
+/// declares the integrator's compliant obstacle.
 ///
 /// # Example: a compliant obstacle
 ///
@@ -181,8 +185,12 @@ pub fn complementarity_samples(
 ///
 /// ```
 /// use nonsmooth_modes::bar::{Bar, EndRef};
-/// use nonsmooth_modes::bc::{BoundaryCondition, Observable, Quantity, Term, UnilateralLaw};
-/// use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
+/// use nonsmooth_modes::bc::{
+///     BoundaryCondition, Observable, Quantity, Term, TimeDomainForm, UnilateralLaw,
+/// };
+/// use nonsmooth_modes::branches::{
+///     compute, BackboneOptions, CheckOutcome, Method, PeriodGrid, Request, TimeDomainCheck,
+/// };
 /// use nonsmooth_modes::modal::{natural_frequencies, ContactState};
 /// use nonsmooth_modes::solve::Solver;
 /// use nonsmooth_modes::system::AssemblyBuilder;
@@ -209,6 +217,14 @@ pub fn complementarity_samples(
 ///     fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
 ///         let force = value(self.end, Quantity::ContactForce).max(0.0);
 ///         0.5 * force * force / self.stiffness
+///     }
+///     // In time: the integrator's compliant obstacle, same gap and stiffness.
+///     fn time_domain_form(&self) -> Option<TimeDomainForm> {
+///         Some(TimeDomainForm::CompliantObstacle {
+///             end: self.end,
+///             gap: self.gap,
+///             stiffness: self.stiffness,
+///         })
 ///     }
 /// }
 ///
@@ -251,21 +267,28 @@ pub fn complementarity_samples(
 /// }
 ///
 /// // A backbone of its first nonsmooth mode, as for a built-in condition: it hardens (the
-/// // energy grows as the period falls).
+/// // energy grows as the period falls). Each point is marched one period against the
+/// // declared compliant obstacle, and comes back.
 /// let grid = PeriodGrid { start: 3.95, end: 3.6, steps: 8 };
 /// let request = Request {
 ///     solver: Some(Solver::default()),
-///     ..Request::new(1).harmonics(10).method(Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)))
+///     ..Request::new(1)
+///         .harmonics(10)
+///         .method(Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)))
+///         .checked(TimeDomainCheck::for_system(&system))
 /// };
 /// let points = compute(&system, &request)?.points;
 /// assert!(points.iter().all(|p| p.converged));
 /// assert!(points.windows(2).all(|w| w[1].energy_normalized > w[0].energy_normalized));
+/// assert!(points.iter().all(|p| p.check == Some(CheckOutcome::Passed)));
 /// # Ok::<(), nonsmooth_modes::Error>(())
 /// ```
 ///
 /// `tests/custom_condition.rs` writes the same obstacle with its own residual instead (the
 /// complementarity of `g + lambda / k`, or a penalty `lambda - k max(0, -g)`) and checks that
-/// its backbone tends to the rigid obstacle's as `k` grows.
+/// its backbone tends to the rigid obstacle's as `k` grows, that its points pass the check,
+/// and that the penalty law without a declared form is unchecked rather than marched as a
+/// rigid wall.
 ///
 /// [`AssemblyBuilder::add_condition`]: crate::system::AssemblyBuilder::add_condition
 pub trait UnilateralLaw: Debug + Send + Sync {

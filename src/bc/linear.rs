@@ -1,6 +1,6 @@
 //! Linear end conditions: one row per harmonic.
 
-use super::{BoundaryCondition, LinearRows, Quantity, Term};
+use super::{BoundaryCondition, LinearRows, Quantity, Term, TimeDomainForm};
 use crate::bar::EndRef;
 use crate::check::positive;
 use crate::error::ModelError;
@@ -29,6 +29,9 @@ impl BoundaryCondition for Dirichlet {
     fn linear_rows(&self, _: f64, _: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
         rows.push(&[Term::new(self.end, Quantity::Displacement, 1.0)]);
     }
+    fn time_domain_form(&self) -> Option<TimeDomainForm> {
+        Some(TimeDomainForm::Clamped { end: self.end })
+    }
 }
 
 /// Free end: `u_x = 0`.
@@ -54,6 +57,9 @@ impl BoundaryCondition for Neumann {
     }
     fn linear_rows(&self, _: f64, _: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
         rows.push(&[Term::new(self.end, Quantity::OutwardStrain, 1.0)]);
+    }
+    fn time_domain_form(&self) -> Option<TimeDomainForm> {
+        Some(TimeDomainForm::Free { end: self.end })
     }
 }
 
@@ -104,5 +110,11 @@ impl BoundaryCondition for Robin {
     fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
         let u = value(self.end, Quantity::Displacement);
         0.5 * self.stiffness * u * u
+    }
+    fn time_domain_form(&self) -> Option<TimeDomainForm> {
+        Some(TimeDomainForm::Spring {
+            end: self.end,
+            stiffness: self.stiffness,
+        })
     }
 }

@@ -6,13 +6,21 @@
 //! [`Term`]s on end [`Quantity`]s, so a condition never sees the harmonic-balance unknowns and a
 //! downstream crate can add its own condition by implementing [`BoundaryCondition`] (and
 //! [`UnilateralLaw`] for a nonsmooth one).
+//!
+//! A condition also declares how it acts in time ([`TimeDomainForm`], through
+//! [`BoundaryCondition::time_domain_form`]): the end rule the exact time-domain check
+//! ([`crate::verify`]) marches for it. Every built-in condition declares its own; a
+//! condition written downstream declares none unless it says so, and the check then reports
+//! the system unchecked instead of marching another law than the one that was solved.
 
 mod contact;
+mod form;
 mod law;
 mod linear;
 mod signorini;
 
 pub use contact::Contact;
+pub use form::TimeDomainForm;
 pub use law::{
     complementarity, complementarity_samples, smoothed_complementarity, LawSamples, LawValue,
     Observable, UnilateralLaw,
@@ -183,5 +191,49 @@ pub trait BoundaryCondition: Debug + Send + Sync {
     fn stored_energy(&self, value: &dyn Fn(EndRef, Quantity) -> f64) -> f64 {
         let _ = value;
         0.0
+    }
+
+    /// The law the condition enforces in time, as one of the end rules of the exact
+    /// integrator ([`TimeDomainForm`]); `None` (the default) if it has none of those forms.
+    ///
+    /// The time-domain check ([`crate::verify::periodicity_check`], the `check` of a
+    /// [`Request`](crate::branches::Request)) marches exactly the declared forms: a system
+    /// with a condition that declares none is not marched (the check says it is unchecked,
+    /// naming the condition), because its rows and residual do not determine the law in time
+    /// (a penalty residual and Signorini's share their observables). The form must be the
+    /// same law as the rows and the residual, with the same parameters, and act on
+    /// [`BoundaryCondition::ends`]: the check verifies a motion of the declared law, so a
+    /// form that differs from the law solved makes it judge another system.
+    ///
+    /// ```
+    /// use nonsmooth_modes::bar::{Bar, EndRef};
+    /// use nonsmooth_modes::bc::{BoundaryCondition, LinearRows, Quantity, Term, TimeDomainForm};
+    /// use nonsmooth_modes::system::AssemblyBuilder;
+    /// use nonsmooth_modes::verify::{Condition, Model};
+    ///
+    /// /// A clamped end written downstream: the row `u = 0`, and in time the clamped rule.
+    /// #[derive(Debug)]
+    /// struct Pinned(EndRef);
+    ///
+    /// impl BoundaryCondition for Pinned {
+    ///     fn name(&self) -> String { format!("pinned at {}", self.0) }
+    ///     fn ends(&self) -> Vec<EndRef> { vec![self.0] }
+    ///     fn linear_rows(&self, _: f64, _: &dyn Fn(EndRef) -> f64, rows: &mut LinearRows) {
+    ///         rows.push(&[Term::new(self.0, Quantity::Displacement, 1.0)]);
+    ///     }
+    ///     fn time_domain_form(&self) -> Option<TimeDomainForm> {
+    ///         Some(TimeDomainForm::Clamped { end: self.0 })
+    ///     }
+    /// }
+    ///
+    /// let mut b = AssemblyBuilder::new();
+    /// let bar = b.add_bar(Bar::unit());
+    /// b.add_condition(Pinned(bar.left()))?.signorini(bar.right(), 1e-3)?;
+    /// let model = Model::from_system(&b.build()?)?;
+    /// assert_eq!(model.conditions()[0], Condition::Clamped { end: bar.left() });
+    /// # Ok::<(), nonsmooth_modes::Error>(())
+    /// ```
+    fn time_domain_form(&self) -> Option<TimeDomainForm> {
+        None
     }
 }

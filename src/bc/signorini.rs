@@ -2,7 +2,7 @@
 
 use super::{
     complementarity_samples, smoothed_complementarity, BoundaryCondition, LawSamples, LawValue,
-    Observable, Quantity, Term, UnilateralLaw,
+    Observable, Quantity, Term, TimeDomainForm, UnilateralLaw,
 };
 use crate::bar::EndRef;
 use crate::check::positive;
@@ -47,6 +47,12 @@ impl BoundaryCondition for Signorini {
     }
     fn unilateral(&self) -> Option<&dyn UnilateralLaw> {
         Some(self)
+    }
+    fn time_domain_form(&self) -> Option<TimeDomainForm> {
+        Some(TimeDomainForm::Obstacle {
+            end: self.end,
+            gap: self.gap,
+        })
     }
 }
 

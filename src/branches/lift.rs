@@ -158,6 +158,7 @@ pub(crate) fn lifted_points(
             events: jumps.cloned().collect(),
             branch: coarse.branch,
             time_domain: None,
+            check: None,
             character: None,
             label: None,
             stability: None,

@@ -48,7 +48,7 @@ pub use groups::{group_by_label, PointGroup};
 pub use level::EnergyLevel;
 pub use lift::lift;
 pub use parameter::{parameter_branch, ParameterSteps};
-pub use point::{Backbone, BackbonePoint, PointStatus};
+pub use point::{Backbone, BackbonePoint, CheckOutcome, PointStatus};
 pub use request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 pub use result::ModeBranches;
 pub use start::{

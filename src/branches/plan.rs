@@ -13,7 +13,6 @@ use crate::branches::start::BackboneStart;
 use crate::branches::subharmonic::genuine_subharmonic_backbone_with;
 use crate::continuation::{EndReason, Rejection};
 use crate::error::Error;
-use crate::modal::Label;
 use crate::solve::Solver;
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::ops::ControlFlow;
@@ -38,7 +37,9 @@ pub(crate) struct QuietRun {
     pub e_g: f64,
     pub end: EndReason,
     pub rejected: usize,
-    /// Converged points not labelled [`Label::Unverified`].
+    /// Converged points not labelled
+    /// [`Label::Unverified`](crate::modal::Label::Unverified) whose check, if asked, was not
+    /// prevented from running ([`BackbonePoint::is_good`]).
     pub good: usize,
 }
 
@@ -50,9 +51,7 @@ impl QuietRun {
         end: EndReason,
         rejected: usize,
     ) -> Self {
-        let good = (points.iter())
-            .filter(|p| p.converged && p.label != Some(Label::Unverified))
-            .count();
+        let good = points.iter().filter(|p| p.is_good()).count();
         Self {
             points,
             e_g,

@@ -8,7 +8,8 @@ use crate::modal::{Character, Label};
 use crate::solution::Solution;
 use crate::stability::{Floquet, HillSpectrum, StabilityError};
 use crate::system::NonsmoothSystem;
-use crate::verify::PeriodicityReport;
+use crate::verify::{PeriodicityReport, VerifyError};
+use std::fmt;
 use std::ops::ControlFlow;
 
 /// One point of a backbone.
@@ -44,9 +45,13 @@ pub struct BackbonePoint {
     /// Index of the branch the point lies on within its run: 0 for the branch the run
     /// started on, one more after each jump (a stall escape, a switch at a branch point).
     pub branch: usize,
-    /// The time-domain check of a converged point, where one was asked
+    /// The report of the time-domain check of a converged point, where one was asked
     /// ([`Request::check`](crate::branches::Request::check)) and could run.
     pub time_domain: Option<PeriodicityReport>,
+    /// What became of the time-domain check of a converged point, where one was asked:
+    /// passed, failed, unchecked (a condition without a time-domain form) or not run (and
+    /// why).
+    pub check: Option<CheckOutcome>,
     /// What a converged point's motion is like: contacts and grazings per period, energy
     /// shares by bar and harmonic, dominant harmonic and linear modes.
     pub character: Option<Character>,
@@ -121,6 +126,7 @@ impl BackbonePoint {
             events: p.events.clone(),
             branch: 0,
             time_domain: None,
+            check: None,
             character: None,
             label: None,
             stability: None,
@@ -158,11 +164,105 @@ impl BackbonePoint {
             events: Vec::new(),
             branch: 0,
             time_domain: None,
+            check: None,
             character: None,
             label,
             stability: None,
             hill: None,
         }
+    }
+}
+
+/// What became of the time-domain check of a converged point
+/// ([`BackbonePoint::check`]). Only [`CheckOutcome::Failed`] makes the point
+/// [`Label::Unverified`]; the others keep the label its harmonic content gives.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum CheckOutcome {
+    /// Marched: the displacement defect ([`BackbonePoint::time_domain`]) is within the
+    /// check's tolerance.
+    Passed,
+    /// Marched: the displacement defect exceeds the tolerance. The point is not a motion of
+    /// the bars to tolerance.
+    Failed,
+    /// Not marched: condition `condition` declares no time-domain form
+    /// ([`BoundaryCondition::time_domain_form`](crate::bc::BoundaryCondition::time_domain_form)),
+    /// so the law in time is unknown. Nothing was checked, nothing failed.
+    Unchecked {
+        /// Name of the condition.
+        condition: String,
+    },
+    /// Not marched: the march would take `steps` time steps, over the check's budget
+    /// [`TimeDomainCheck::max_steps`](crate::branches::TimeDomainCheck::max_steps).
+    OverBudget {
+        /// Steps of the march.
+        steps: f64,
+        /// The budget.
+        max_steps: f64,
+    },
+    /// The march could not run or complete (its cost or memory bound, a state it cannot
+    /// build): the error.
+    NotRun(
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] VerifyError,
+    ),
+}
+
+impl CheckOutcome {
+    /// `Some(passed)` where the point was marched, `None` where it was not: the `verified`
+    /// argument of [`label`](crate::modal::label).
+    pub fn verified(&self) -> Option<bool> {
+        match self {
+            CheckOutcome::Passed => Some(true),
+            CheckOutcome::Failed => Some(false),
+            _ => None,
+        }
+    }
+
+    /// Why a point was not marched, `None` where it was.
+    pub fn reason(&self) -> Option<String> {
+        match self {
+            CheckOutcome::Passed | CheckOutcome::Failed => None,
+            CheckOutcome::Unchecked { condition } => Some(format!(
+                "condition `{condition}` declares no time-domain form"
+            )),
+            CheckOutcome::OverBudget { steps, max_steps } => Some(format!(
+                "its march would take {steps:.3e} steps, over the check's budget of {max_steps:.3e}"
+            )),
+            CheckOutcome::NotRun(error) => Some(error.to_string()),
+        }
+    }
+}
+
+/// CSV-safe words: `passed`, `failed`, `unchecked`, `over-budget`, `not-run`.
+impl fmt::Display for CheckOutcome {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            CheckOutcome::Passed => "passed",
+            CheckOutcome::Failed => "failed",
+            CheckOutcome::Unchecked { .. } => "unchecked",
+            CheckOutcome::OverBudget { .. } => "over-budget",
+            CheckOutcome::NotRun(_) => "not-run",
+        })
+    }
+}
+
+impl BackbonePoint {
+    /// Whether a run may count the point as good: converged, and its time-domain check, if
+    /// one was asked, did not fail and was not prevented from running. An unchecked point
+    /// (a condition without a time-domain form) counts: there is no law in time to hold it
+    /// against.
+    pub(crate) fn is_good(&self) -> bool {
+        self.converged
+            && !matches!(
+                self.check,
+                Some(
+                    CheckOutcome::Failed
+                        | CheckOutcome::OverBudget { .. }
+                        | CheckOutcome::NotRun(_)
+                )
+            )
+            && self.label != Some(Label::Unverified)
     }
 }
 

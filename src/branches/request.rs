@@ -183,8 +183,10 @@ pub struct TimeDomainCheck {
     /// [`Label::Unverified`](crate::modal::Label::Unverified).
     pub max_displacement_defect: f64,
     /// Most time steps one point's march may take: a point whose march would take more is
-    /// not checked, and so is unverified (a budget of time per point; the march itself
-    /// refuses what would exceed its memory).
+    /// not checked ([`CheckOutcome::OverBudget`](crate::branches::CheckOutcome::OverBudget):
+    /// it keeps its label, and a run does not count it as good); a budget of time per point,
+    /// the march itself refuses what would exceed its memory or work bound
+    /// ([`CheckOutcome::NotRun`](crate::branches::CheckOutcome::NotRun)).
     pub max_steps: f64,
 }
 
@@ -233,7 +235,10 @@ pub struct Request {
     /// ([`Speculation`]); the points are the same bit for bit.
     pub speculation: Option<Speculation>,
     /// Check every converged point in the time domain and label those that fail it
-    /// (`None`: no check; points are labelled by their harmonic content alone).
+    /// (`None`: no check; points are labelled by their harmonic content alone). The outcome
+    /// of each point's check is [`BackbonePoint::check`](crate::branches::BackbonePoint::check):
+    /// a system with a condition that declares no time-domain form is not marched, and its
+    /// points are [`CheckOutcome::Unchecked`](crate::branches::CheckOutcome::Unchecked).
     pub check: Option<TimeDomainCheck>,
     /// Compute the Floquet multipliers of every converged point
     /// ([`stability`](crate::stability); `None`: no stability).

@@ -3,7 +3,7 @@
 
 use crate::branches::backbone::BackboneObserver;
 use crate::branches::continuity::{BranchTail, Sample};
-use crate::branches::point::BackbonePoint;
+use crate::branches::point::{BackbonePoint, CheckOutcome};
 use crate::branches::request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
 use crate::error::{ContinuationError, SettingsError};
@@ -13,7 +13,7 @@ use crate::modal::{character, label, nearest_mode, ContactState, Label};
 use crate::solution::Solution;
 use crate::stability::{floquet, hill, Floquet, HillOptions, StabilityOptions, Verdict};
 use crate::system::{HarmonicBalanceSettings, NonsmoothSystem};
-use crate::verify::periodicity_check;
+use crate::verify::{periodicity_check, VerifyError};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -195,9 +195,10 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
     }
 
     /// The character, time-domain check and label of a converged point. A point whose
-    /// character cannot be computed (its motion overflows) keeps none and no label; a check
-    /// that was asked but could not run (a march beyond the cost bound) leaves the point
-    /// unverified.
+    /// character cannot be computed (its motion overflows) keeps none and no label. Only a
+    /// check that ran and failed labels the point unverified; a check that did not run (a
+    /// condition without a time-domain form, a march beyond the cost bound) keeps the label
+    /// of its harmonic content and says why in [`BackbonePoint::check`].
     fn describe(&mut self, point: &mut BackbonePoint) {
         let (x, omega) = (&point.x, point.omega);
         let Ok(mut described) = character(&mut self.problem, x, omega, &self.natural) else {
@@ -208,17 +209,33 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         if self.extend_natural_frequencies(described.named_frequencies(omega)) {
             described.name_modes(omega, &self.natural);
         }
-        let verified = self.check.map(|check| {
+        if let Some(check) = self.check {
             let (system, basis) = (self.problem.system(), self.problem.basis());
             let options = &check.options;
             let steps = point.period / options.dt * options.periods as f64;
-            point.time_domain = (steps <= check.max_steps)
-                .then(|| periodicity_check(system, basis, x, omega, options).ok())
-                .flatten();
-            point
-                .time_domain
-                .is_some_and(|r| r.displacement_defect <= check.max_displacement_defect)
-        });
+            point.check = Some(if steps > check.max_steps {
+                CheckOutcome::OverBudget {
+                    steps,
+                    max_steps: check.max_steps,
+                }
+            } else {
+                match periodicity_check(system, basis, x, omega, options) {
+                    Ok(r) if r.displacement_defect <= check.max_displacement_defect => {
+                        point.time_domain = Some(r);
+                        CheckOutcome::Passed
+                    }
+                    Ok(r) => {
+                        point.time_domain = Some(r);
+                        CheckOutcome::Failed
+                    }
+                    Err(VerifyError::NoTimeDomainForm { condition }) => {
+                        CheckOutcome::Unchecked { condition }
+                    }
+                    Err(e) => CheckOutcome::NotRun(e),
+                }
+            });
+        }
+        let verified = point.check.as_ref().and_then(CheckOutcome::verified);
         let natural = &self.natural;
         let content = label(&described, self.order, omega, natural, verified).ok();
         point.character = Some(described);

@@ -95,8 +95,8 @@ pub(crate) fn judged_with_selection(
     Ok((kept, Some(judgement)))
 }
 
-/// The periods of `grid` that a converged point labelled [`Label::Skeleton`] lies within
-/// half a grid step of.
+/// The periods of `grid` that a good point ([`BackbonePoint::is_good`]) labelled
+/// [`Label::Skeleton`] lies within half a grid step of.
 pub(crate) fn covered_periods(points: &[BackbonePoint], grid: &PeriodGrid) -> usize {
     let steps = grid.steps;
     if steps < 2 {
@@ -105,7 +105,7 @@ pub(crate) fn covered_periods(points: &[BackbonePoint], grid: &PeriodGrid) -> us
     let h = (grid.end - grid.start) / (steps - 1) as f64;
     let mut covered = vec![false; steps];
     for p in points {
-        if !(p.converged && p.label == Some(Label::Skeleton)) {
+        if !(p.is_good() && p.label == Some(Label::Skeleton)) {
             continue;
         }
         let j = ((p.period - grid.start) / h).round();

@@ -506,7 +506,9 @@ fn open_instant(initial: &State, period: f64, spring: SpringUpdate) -> Result<f6
 /// The gap `g0` of condition `index` (0 for a linear condition).
 fn law_gap(model: &Model, index: usize) -> f64 {
     match model.conditions()[index] {
-        Condition::Obstacle { gap, .. } | Condition::Contact { gap, .. } => gap,
+        Condition::Obstacle { gap, .. }
+        | Condition::CompliantObstacle { gap, .. }
+        | Condition::Contact { gap, .. } => gap,
         _ => 0.0,
     }
 }

@@ -6,18 +6,52 @@ use super::wave::{Piece, TINY};
 use super::{Condition, VerifyError};
 use crate::bar::{End, EndRef};
 
-/// How a ground spring is advanced over a piece of constant incoming wave `a`.
+/// How a ground spring, or a compliant obstacle while it is compressed, is advanced over a
+/// piece of constant incoming wave `a`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SpringUpdate {
     /// Exact solution of `u' = a - beta u` (`beta = k_s / Z`); the outgoing wave is the exact
-    /// mean of `b(t) = a - 2 beta u(t)` over the piece. End displacement exact; the
-    /// projection of `b` on constants loses a relative energy `O((beta dt)^2)` per unit time.
-    /// The default.
+    /// mean of `b(t) = a - 2 beta u(t)` over the piece. End displacement exact, and with it
+    /// the release of a compliant obstacle; the projection of `b` on constants loses a
+    /// relative energy `O((beta dt)^2)` per unit time. The default.
     #[default]
     Exact,
     /// Spring law imposed at the midpoint of the piece (implicit midpoint rule): energy is
-    /// conserved to rounding, the end displacement has an `O((beta dt)^2)` relative error.
+    /// conserved to rounding, the end displacement has an `O((beta dt)^2)` relative error
+    /// (and a compliant obstacle releases where that displacement says).
     Midpoint,
+}
+
+impl SpringUpdate {
+    /// The mean rate `Delta x / h` over a time `h` of `x' = f - beta x` (`f` constant), where
+    /// `drive = f - beta x(0)` is the rate at the start: exactly
+    /// `drive (1 - e^(-beta h)) / (beta h)`, or by the implicit midpoint rule
+    /// `drive / (1 + beta h / 2)`.
+    fn mean_rate(self, drive: f64, beta: f64, h: f64) -> f64 {
+        match self {
+            SpringUpdate::Exact => {
+                let z = beta * h;
+                let phi = if z > 0.0 { -(-z).exp_m1() / z } else { 1.0 };
+                drive * phi
+            }
+            SpringUpdate::Midpoint => drive / (1.0 + 0.5 * beta * h),
+        }
+    }
+
+    /// The time after which a compression `x0 > 0` obeying `x' = f - beta x` (`f` constant)
+    /// returns to zero, `None` if it does not. Exactly, `x(t) = f/beta + (x0 - f/beta)
+    /// e^(-beta t)` vanishes at `ln(1 + beta x0 / (-f)) / beta` when `f < 0` (never
+    /// otherwise); by the midpoint rule, `x` is linear over a piece, `x0 + t (f - beta x0) /
+    /// (1 + beta t / 2)`, and vanishes at `x0 / (beta x0 / 2 - f)` when that is positive.
+    fn release(self, x0: f64, f: f64, beta: f64) -> Option<f64> {
+        match self {
+            SpringUpdate::Exact => (f < 0.0).then(|| (beta * x0 / -f).ln_1p() / beta),
+            SpringUpdate::Midpoint => {
+                let rate = 0.5 * beta * x0 - f;
+                (rate > 0.0).then(|| x0 / rate)
+            }
+        }
+    }
 }
 
 /// Options of [`march`](super::march) and [`Integrator`].
@@ -105,7 +139,12 @@ fn impact(s: f64, end: f64, g: f64, rate: f64) -> Option<f64> {
     if rate <= 0.0 {
         return None;
     }
-    let hit = s + g / rate;
+    within(s, end, s + g / rate)
+}
+
+/// The clock `hit >= s` if it falls within `[s, end]`, snapped to `s` or `end` when within
+/// rounding of them; `None` beyond `end`.
+fn within(s: f64, end: f64, hit: f64) -> Option<f64> {
     let tol = TINY.max(64.0 * f64::EPSILON * end.abs());
     if hit - s < tol {
         Some(s)
@@ -124,7 +163,8 @@ fn ends_of(condition: &Condition) -> ([EndRef; 2], usize) {
         Condition::Clamped { end }
         | Condition::Free { end }
         | Condition::Spring { end, .. }
-        | Condition::Obstacle { end, .. } => ([end, end], 1),
+        | Condition::Obstacle { end, .. }
+        | Condition::CompliantObstacle { end, .. } => ([end, end], 1),
         Condition::Contact { first, second, .. } => ([first, second], 2),
     }
 }
@@ -232,14 +272,7 @@ impl Integrator {
                         let h = (q.end - q.start) * dt;
                         let a = q.value;
                         // Mean end velocity over the piece, Delta u / h.
-                        let rate = match self.options.spring {
-                            SpringUpdate::Exact => {
-                                let z = beta * h;
-                                let phi = if z > 0.0 { -(-z).exp_m1() / z } else { 1.0 };
-                                (a - beta * p.u) * phi
-                            }
-                            SpringUpdate::Midpoint => (a - beta * p.u) / (1.0 + 0.5 * beta * h),
-                        };
+                        let rate = self.options.spring.mean_rate(a - beta * p.u, beta, h);
                         let b = 2.0 * rate - a;
                         p.emit(&mut out[0], q.end, a, b, q.end - q.start);
                         p.u += rate * h;
@@ -274,6 +307,51 @@ impl Integrator {
                                 s = stop;
                             }
                             watch.penetration = watch.penetration.max(n * p.u - gap);
+                        }
+                    }
+                    ports[0] = Some(p);
+                }
+                (Condition::CompliantObstacle { gap, stiffness, .. }, [Some(mut p), _]) => {
+                    let (n, beta) = (p.n, stiffness / p.z);
+                    let update = self.options.spring;
+                    for q in &inc[0] {
+                        let a = q.value;
+                        let w = n * a;
+                        let mut s = q.start;
+                        while s < q.end {
+                            // Compression of the spring, c = v - g0 (negative while open).
+                            let c = n * p.u - gap;
+                            let tol = gap_tolerance(gap, &[p.u]);
+                            if c > tol || (c >= -tol && w > 0.0) {
+                                // Pressed: c' = w - beta c, released where c returns to 0.
+                                let c = c.max(0.0);
+                                let release = (c > tol)
+                                    .then(|| update.release(c, w, beta))
+                                    .flatten()
+                                    .and_then(|t| within(s, q.end, s + t / dt));
+                                let stop = release.unwrap_or(q.end);
+                                let h = (stop - s) * dt;
+                                let rate = update.mean_rate(w - beta * c, beta, h);
+                                p.emit(&mut out[0], stop, a, 2.0 * n * rate - a, stop - s);
+                                let after = if release.is_some() { 0.0 } else { c + rate * h };
+                                p.u = n * (gap + after);
+                                // Mean force Z (w - rate) = k (mean c); c is monotone.
+                                watch.force += p.z * (w - rate) * (stop - s);
+                                let low = stiffness * c.min(after).max(0.0);
+                                watch.min_force = watch.min_force.min(low);
+                                s = stop;
+                            } else {
+                                let hit = impact(s, q.end, -c, w * dt);
+                                let stop = hit.unwrap_or(q.end);
+                                p.emit(&mut out[0], stop, a, a, stop - s);
+                                watch.min_force = watch.min_force.min(0.0);
+                                if hit.is_some() {
+                                    p.u = n * gap; // touches the spring: c = 0 exactly
+                                } else {
+                                    p.u += (stop - s) * dt * a;
+                                }
+                                s = stop;
+                            }
                         }
                     }
                     ports[0] = Some(p);

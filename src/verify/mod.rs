@@ -30,6 +30,9 @@
 //!   two ends A, B (g = g0 - n_A u_A - n_B u_B): free unless g <= 0 and w_A + w_B > 0; then
 //!       stuck with the common outward velocity V = (Z_A w_A - Z_B w_B)/(Z_A + Z_B) and
 //!       lambda = Z_A Z_B (w_A + w_B)/(Z_A + Z_B) >= 0.
+//!   compliant obstacle (spring k at gap g0, compression p = n u - g0): free (b = a) while
+//!       p < 0; pressed while p > 0 (or p = 0 and w > 0): p' = w - (k/Z) p,
+//!       b = a - 2 n (k/Z) p, lambda = k p >= 0.
 //! ```
 //!
 //! Within a piece the incoming value is constant, so in free flight the gap is linear in time:
@@ -40,6 +43,15 @@
 //! free, obstacle and contact ends are lossless (`|b| = |a|` or a lossless impedance junction),
 //! so the discrete energy — computed exactly from the pieces — is conserved to rounding (up
 //! to what the merges below remove, which is reported).
+//!
+//! A **compliant obstacle** is free flight until the spring is touched, and a ground spring on
+//! the compression `p` while it is pressed. Onset is found as an impact is (the gap `-p` is
+//! linear in time within a piece); **release**, where `p` returns to zero, from the spring's
+//! exact solution over the piece, `p(t) = w/beta + (p0 - w/beta) e^(-beta t)`: it happens only
+//! if `w < 0`, at `t = ln(1 + beta p0 / (-w)) / beta`, and the piece is split there. The
+//! spring stores `k p^2 / 2`; the pressed part is advanced as a ground spring below, with the
+//! same energy error (exact update) or none (midpoint update). Unlike an obstacle's
+//! penetration, the compression is the law: it is not reported as one.
 //!
 //! A ground spring is advanced with the **exact** solution of `u' = a - beta u`
 //! (`beta = k_s / Z`) over each piece, and the outgoing wave keeps the exact mean of
@@ -108,15 +120,21 @@
 //! history costs nothing per step: each wave keeps the integral of its square up to date
 //! (compensated sums) as pieces come and go.
 //!
-//! # Which conditions are supported
+//! # Which conditions are marched
 //!
-//! [`Model::from_system`](crate::verify::Model::from_system) reads each condition of a [`BarSystem`](crate::system::BarSystem) from
-//! its rows and observables (it does not need to know the concrete type): one row
-//! `alpha u + gamma u_x = 0` gives clamped (`gamma = 0`), free (`alpha = 0`) or a ground spring
-//! (`k_s = n EA alpha / gamma > 0`); a law with gap `g0 - kappa v` and a compressive force gives an
-//! obstacle; a law on two ends with gap `g0 - kappa (v_A + v_B)` and the balance
-//! `lambda_A = lambda_B` gives a two-end contact. Anything else (frequency-dependent rows such
-//! as an end mass, tensile springs, other laws) is [`VerifyError::Unsupported`](crate::verify::VerifyError::Unsupported).
+//! [`Model::from_system`](crate::verify::Model::from_system) takes each condition of a
+//! [`BarSystem`](crate::system::BarSystem) as the form it declares,
+//! [`BoundaryCondition::time_domain_form`](crate::bc::BoundaryCondition::time_domain_form)
+//! ([`TimeDomainForm`](crate::bc::TimeDomainForm), which is
+//! [`Condition`](crate::verify::Condition)): clamped, free, ground spring, rigid or compliant
+//! obstacle, two-end contact. Every built-in condition
+//! declares its own. Nothing is read from rows or observables: a unilateral law's residual is
+//! an opaque function, so a penalty law `lambda - k max(0, -g)` has the same gap and force
+//! as a rigid obstacle, and marching what the observables suggest would check a motion of
+//! another system. A condition that declares no form (an end mass, a law of another kind)
+//! gives [`VerifyError::NoTimeDomainForm`](crate::verify::VerifyError::NoTimeDomainForm), and
+//! the annotated points of [`compute`](crate::branches::compute) are then
+//! [`CheckOutcome::Unchecked`](crate::branches::CheckOutcome::Unchecked), not unverified.
 //!
 //! # The periodicity check
 //!

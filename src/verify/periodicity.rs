@@ -226,7 +226,8 @@ fn check_report(r: &PeriodicityReport) -> Result<(), VerifyError> {
 /// [`PeriodicityReport::projection_error`].
 ///
 /// # Errors
-/// Unsupported conditions, a time step longer than a bar's travel time
+/// A condition without a time-domain form ([`VerifyError::NoTimeDomainForm`]), a time step
+/// longer than a bar's travel time
 /// ([`VerifyError::NonMatchingGrid`]), a solution vector of the wrong length or with NaN, an
 /// `omega` that is not positive and finite or is below
 /// [`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY) ([`VerifyError`]);

@@ -285,10 +285,12 @@ impl State {
         self.bars[end.bar.index()].ends[usize::from(end.end == End::Right)]
     }
 
-    /// Gap of condition `index` (`None` if it is not an obstacle or a contact).
+    /// Gap of condition `index` (`None` if it is not an obstacle or a contact): for a
+    /// compliant obstacle, the distance `g0 - v` from the end to the spring's free end,
+    /// negative by the spring's compression while the end presses it.
     pub fn gap(&self, index: usize) -> Option<f64> {
         match *self.model.conditions().get(index)? {
-            Condition::Obstacle { end, gap } => {
+            Condition::Obstacle { end, gap } | Condition::CompliantObstacle { end, gap, .. } => {
                 Some(gap - end.end.normal() * self.end_displacement(end))
             }
             Condition::Contact { first, second, gap } => Some(
@@ -299,16 +301,20 @@ impl State {
         }
     }
 
-    /// Largest penetration `max(0, -g)` over the unilateral conditions.
+    /// Largest penetration `max(0, -g)` over the rigid obstacles and contacts (a compliant
+    /// obstacle's compression is its law, not a violation of it).
     pub fn penetration(&self) -> f64 {
-        (0..self.model.conditions().len())
-            .filter_map(|i| self.gap(i))
+        let conditions = self.model.conditions().iter().enumerate();
+        conditions
+            .filter(|(_, c)| !matches!(c, Condition::CompliantObstacle { .. }))
+            .filter_map(|(i, _)| self.gap(i))
             .fold(0.0, |m, g| m.max(-g))
     }
 
-    /// Energy `sum_b EA_b / (4 c_b^2) int (R^2 + L^2) dx + sum k_s u^2 / 2`, exact for the
-    /// piecewise-constant waves (it equals `sum_b EA_b/2 int (u_t^2/c_b^2 + u_x^2) dx` plus the
-    /// springs).
+    /// Energy `sum_b EA_b / (4 c_b^2) int (R^2 + L^2) dx + sum k_s u^2 / 2 + sum k p^2 / 2`,
+    /// exact for the piecewise-constant waves (it equals
+    /// `sum_b EA_b/2 int (u_t^2/c_b^2 + u_x^2) dx` plus the ground springs and the compliant
+    /// obstacles, each compressed by `p = max(0, v - g0)`).
     pub fn energy(&self) -> f64 {
         self.energy_with(|b| {
             let (w, nu) = (&self.bars[b], self.grid.travel_steps(b));
@@ -332,10 +338,19 @@ impl State {
             e += bar.stiffness() / (4.0 * c * c) * c * self.grid.dt() * squares(b);
         }
         for c in self.model.conditions() {
-            if let Condition::Spring { end, stiffness } = *c {
-                let u = self.end_displacement(end);
-                e += 0.5 * stiffness * u * u;
-            }
+            let (stretch, stiffness) = match *c {
+                Condition::Spring { end, stiffness } => (self.end_displacement(end), stiffness),
+                Condition::CompliantObstacle {
+                    end,
+                    gap,
+                    stiffness,
+                } => {
+                    let v = end.end.normal() * self.end_displacement(end);
+                    ((v - gap).max(0.0), stiffness)
+                }
+                _ => continue,
+            };
+            e += 0.5 * stiffness * stretch * stretch;
         }
         e
     }

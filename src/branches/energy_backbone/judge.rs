@@ -285,6 +285,7 @@ impl Judge {
                 events: Vec::new(),
                 branch: 0,
                 time_domain: None,
+                check: None,
                 character: None,
                 label: None,
                 stability: None,
