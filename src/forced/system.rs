@@ -93,7 +93,8 @@ impl ForcedSystem {
         free.driven = (forcing.excitations.iter())
             .map(|&e| Driven::new(system, e))
             .collect::<Result<Vec<_>, _>>()?;
-        free.selection = Selection::for_band(settings.resonance_band, settings.harmonics)?;
+        free.selection = Selection::for_band(settings.resonance_band, settings.harmonics)?
+            .map(Selection::dropping_low_harmonics);
         Ok(free)
     }
 

@@ -81,13 +81,15 @@ pub(crate) struct Selection {
     dropped: Vec<usize>,
     /// Scratch for `x` with the dropped unknowns zeroed.
     masked: Vec<f64>,
+    /// Whether harmonics with `n^2 < m` may be dropped ([`Selection::dropping_low_harmonics`]).
+    low_harmonics: bool,
 }
 
 /// Whether harmonic `n` of a basis of `m` harmonics may be dropped: never the constant or
-/// the fundamental, and only where its genuine content (`~ 1/n^2`) is below the truncation's
-/// error (`~ 1/m`), `n^2 >= m` (module docs).
-fn droppable(n: usize, m: usize) -> bool {
-    n >= 2 && n.saturating_mul(n) >= m
+/// the fundamental, and, unless `low` says otherwise, only where its genuine content
+/// (`~ 1/n^2`) is below the truncation's error (`~ 1/m`), `n^2 >= m` (module docs).
+fn droppable(n: usize, m: usize, low: bool) -> bool {
+    n >= 2 && (low || n.saturating_mul(n) >= m)
 }
 
 impl Selection {
@@ -116,7 +118,18 @@ impl Selection {
             covered: 0.0,
             dropped: Vec::new(),
             masked: Vec::new(),
+            low_harmonics: false,
         })
+    }
+
+    /// The same selection, which may also drop the harmonics `2 <= n < sqrt(m)`: for a
+    /// forced response, whose motion near the linear resonance it sweeps through is the
+    /// forcing's harmonic 1 with little else. There every harmonic of a bar whose natural
+    /// frequencies are multiples of the first meets one at once, and the sweep up the
+    /// resonance passes only with them held (`tests/forced.rs`, the peak on the backbone).
+    pub(crate) fn dropping_low_harmonics(mut self) -> Self {
+        self.low_harmonics = true;
+        self
     }
 
     /// Whether a harmonic is dropped at the current frequency.
@@ -170,7 +183,7 @@ impl Selection {
         (0..basis.len())
             .filter(|&i| {
                 let n = basis.harmonic(i);
-                droppable(n, basis.harmonics())
+                droppable(n, basis.harmonics(), self.low_harmonics)
                     && natural
                         .iter()
                         .any(|w| (n as f64 * omega / w - 1.0).abs() < band)
