@@ -33,6 +33,18 @@ fn system(clamped: bool, (l, c, ea, gap): (f64, f64, f64, f64)) -> BarSystem {
     b.build().expect("a system")
 }
 
+/// Uniform draws in `[lo, hi)` from a seeded 64-bit linear congruential generator (the
+/// runs do not depend on the machine).
+fn draws(seed: u64) -> impl FnMut(f64, f64) -> f64 {
+    let mut state = seed;
+    move |lo, hi| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
 /// The exact `E/E_g` at period `t` of a bar with travel time `tau`.
 fn exact(clamped: bool, tau: f64, t: f64) -> f64 {
     let s = if clamped {
@@ -108,13 +120,7 @@ fn the_free_free_bars_skeleton_converges_in_m() {
 /// (89 % within 5 %, against 95 % for the unit bar), hence the lower floor.
 #[test]
 fn generated_bars_converge_in_m() {
-    let mut state = 0x5eed_u64;
-    let mut draw = |lo: f64, hi: f64| {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
-    };
+    let mut draw = draws(0x5eed);
     for clamped in [true, false] {
         let bar = (
             draw(0.3, 3.0),
@@ -168,13 +174,7 @@ fn label_counts(run: &ModeBranches, clamped: bool, tau: f64) -> (usize, usize, u
 /// 90 % of the points within 2 % are skeleton, on the unit bars and on generated ones.
 #[test]
 fn no_skeleton_point_is_far_from_the_exact_family() {
-    let mut state = 0x1abe1_u64;
-    let mut draw = |lo: f64, hi: f64| {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
-    };
+    let mut draw = draws(0x1abe1);
     let mut cases = vec![
         (true, (1.0, 1.0, 1.0, 1e-3), 20),
         (true, (1.0, 1.0, 1.0, 1e-3), 40),

@@ -124,6 +124,28 @@ impl Port {
         out.push((until, b));
         self.strain += h * self.n * (b - a) / (2.0 * self.c);
     }
+
+    /// Free flight of an end facing an obstacle at offset `gap` from `s` towards `end`: the
+    /// wave `a` goes out unchanged until the gap `g` (linear in time, closing at `n a` per
+    /// unit time) closes, where the end is put on the obstacle exactly. Returns where it
+    /// stopped.
+    fn fly(
+        &mut self,
+        out: &mut Vec<(f64, f64)>,
+        (s, end): (f64, f64),
+        (g, a, dt): (f64, f64, f64),
+        gap: f64,
+    ) -> f64 {
+        let hit = impact(s, end, g, self.n * a * dt);
+        let stop = hit.unwrap_or(end);
+        self.emit(out, stop, a, a, stop - s);
+        if hit.is_some() {
+            self.u = self.n * gap; // on the obstacle: g = 0 exactly
+        } else {
+            self.u += (stop - s) * dt * a;
+        }
+        stop
+    }
 }
 
 /// Rounding tolerance for a closed gap.
@@ -295,16 +317,8 @@ impl Integrator {
                                 watch.min_force = watch.min_force.min(lambda);
                                 s = q.end;
                             } else {
-                                let hit = impact(s, q.end, g, w * dt);
-                                let stop = hit.unwrap_or(q.end);
-                                p.emit(&mut out[0], stop, a, a, stop - s);
+                                s = p.fly(&mut out[0], (s, q.end), (g, a, dt), gap);
                                 watch.min_force = watch.min_force.min(0.0);
-                                if hit.is_some() {
-                                    p.u = n * gap; // at the obstacle: g = 0 exactly
-                                } else {
-                                    p.u += (stop - s) * dt * a;
-                                }
-                                s = stop;
                             }
                             watch.penetration = watch.penetration.max(n * p.u - gap);
                         }
@@ -341,16 +355,8 @@ impl Integrator {
                                 watch.min_force = watch.min_force.min(low);
                                 s = stop;
                             } else {
-                                let hit = impact(s, q.end, -c, w * dt);
-                                let stop = hit.unwrap_or(q.end);
-                                p.emit(&mut out[0], stop, a, a, stop - s);
+                                s = p.fly(&mut out[0], (s, q.end), (-c, a, dt), gap);
                                 watch.min_force = watch.min_force.min(0.0);
-                                if hit.is_some() {
-                                    p.u = n * gap; // touches the spring: c = 0 exactly
-                                } else {
-                                    p.u += (stop - s) * dt * a;
-                                }
-                                s = stop;
                             }
                         }
                     }
