@@ -6,17 +6,29 @@
 //! converged point, and it stops as soon as the energy exceeds a threshold. Both drivers
 //! return the same `Step`, so one loop (`follow`) serves both.
 //!
+//! Then a loop in a system parameter: a Robin bar's mode at a fixed frequency, continued in
+//! the spring's stiffness (`ParameterFamily`). As the spring stiffens the linear frequency
+//! passes the loop's and the mode leaves it: the equations are then solved by the state of
+//! rest only, which the driver refuses by default (a rejected step, reported), so the loop
+//! stays on its branch or says where it left it. Each accepted point is also measured against
+//! the secant of the two before it in `E / E_g` (`branches::JUMP_RATIO`), and a jump is
+//! reported.
+//!
 //! ```text
 //! cargo run --release --example custom_loop -- [E_OVER_EG_THRESHOLD (default 20)]
 //! ```
 
+use nonsmooth_modes::branches::{compute, Request, JUMP_RATIO};
 use nonsmooth_modes::continuation::{
-    Arclength, ArclengthOptions, PeriodParametrised, Point, Sequential, SequentialOptions, Step,
+    Arclength, ArclengthOptions, PeriodParametrised, Point, RejectReason, Sequential,
+    SequentialOptions, Step,
 };
 use nonsmooth_modes::modal::{branch_seed, energy, grazing_energy};
-use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, robin_bar_with_obstacle, ClampedFirstMode,
+};
 use nonsmooth_modes::solve::SemismoothNewton;
-use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem};
+use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily};
 use std::f64::consts::PI;
 
 /// How a phase of the loop ended.
@@ -123,5 +135,67 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Phase::Threshold = phase {
         println!("energy threshold {threshold} reached");
     }
-    Ok(())
+    stiffness_loop(gap)
+}
+
+/// Phase 3: the Robin bar's first mode at the frequency of its sixth backbone point at
+/// `k = 3`, continued in the spring stiffness `k` from 3 to 13.
+fn stiffness_loop(gap: f64) -> Result<(), Box<dyn std::error::Error>> {
+    let request = Request::new(1).harmonics(10);
+    let run = compute(&robin_bar_with_obstacle(3.0, gap)?, &request)?;
+    let from = run.converged().nth(5).ok_or("no backbone point at k = 3")?;
+    let settings = HarmonicBalanceSettings {
+        resonance_band: run.problem().resonance_band(),
+        ..request.settings
+    };
+    let family = |k: f64| robin_bar_with_obstacle(k, gap);
+    let problem = ParameterFamily::at(family, settings, from.omega, 3.0)?;
+    let values: Vec<f64> = (0..=40).map(|i| 3.0 + 0.25 * i as f64).collect();
+    let mut driver = Sequential::new(
+        problem,
+        SemismoothNewton::default(),
+        from.x.clone(),
+        values,
+        SequentialOptions::default(),
+    )?;
+    println!("stiffness loop at Omega = {:.4}", from.omega);
+    // The last two accepted `(k, E / E_g)`, for the secant that measures the next.
+    let mut last: Vec<(f64, f64)> = Vec::new();
+    loop {
+        match driver.step() {
+            Step::Accepted(p) => {
+                let system = robin_bar_with_obstacle(p.parameter, gap)?;
+                let basis = NonsmoothSystem::new(&system, settings)?.basis().clone();
+                let e = energy(&system, &basis, &p.x, from.omega) / grazing_energy(&system)?.0;
+                let jump = match last.as_slice() {
+                    [.., (ka, ea), (kb, eb)] => {
+                        let predicted = eb + (p.parameter - kb) / (kb - ka) * (eb - ea);
+                        let ratio = ((e - predicted) / (predicted - eb)).abs();
+                        (ratio > JUMP_RATIO).then_some(ratio)
+                    }
+                    _ => None,
+                };
+                match jump {
+                    Some(ratio) => println!(
+                        "stiffness  k {:.2}  E/Eg {e:9.4}  jump: {ratio:.1} predicted steps off",
+                        p.parameter
+                    ),
+                    None => println!("stiffness  k {:.2}  E/Eg {e:9.4}", p.parameter),
+                }
+                last.push((p.parameter, e));
+            }
+            // Without an acceptance test of its own, the loop's points are refused only at
+            // rest.
+            Step::Rejected(r) => match r.reason {
+                RejectReason::NotAccepted => {
+                    println!("stiffness  k {:.2}  refused: at rest", r.parameter)
+                }
+                other => println!("stiffness  k {:.2}  rejected: {other:?}", r.parameter),
+            },
+            Step::Finished(end) => {
+                println!("stiffness loop ended: {end:?}");
+                return Ok(());
+            }
+        }
+    }
 }

@@ -256,6 +256,8 @@ fn drive_backbone<S: NonlinearSolver>(
         values,
         seq_options,
     )?
+    // The energy floor below decides what counts as rest.
+    .with_rest_accepted()
     .with_acceptance(|x, period| {
         let time = Timescale::of_period(period);
         let e = energy(system, &basis, x, time.omega);
@@ -509,7 +511,9 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         arclength,
         (options.escape, floor),
     );
+    // The energy floor decides what counts as rest.
     let driver = Arclength::new(problem, solver, start, omega0, arclength)?
+        .with_rest_accepted()
         .with_acceptance(|x, omega| energy(system, &basis, x, omega) > floor);
     let offset = walked.len();
     let backbone_point = |p: &Point, offset: usize| {

@@ -271,6 +271,8 @@ pub fn full_basis_branch(
         periods,
         SequentialOptions::default(),
     )?
+    // `in_motion` decides what counts as rest.
+    .with_rest_accepted()
     .with_acceptance(in_motion);
     let (mut measures, mut rejected) = (Vec::new(), Vec::new());
     let end = loop {

@@ -167,12 +167,18 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
 
     /// Shows points annotated by another annotator of the same request to the observer and
     /// keeps them, up to the one at which it stops the run; returns `end`, or
-    /// [`EndReason::StoppedByObserver`] if it stopped. The multipliers and Hill exponents this
-    /// request asks are added to converged points that the other run left without them.
+    /// [`EndReason::StoppedByObserver`] if it stopped. The time-domain check, multipliers and
+    /// Hill exponents this request asks are added to converged points that the other run left
+    /// without them; a point that fails the check becomes
+    /// [`Label::Unverified`].
     pub(crate) fn replay(&mut self, points: Vec<BackbonePoint>, end: EndReason) -> EndReason {
         for mut point in points {
             self.converged += usize::from(point.converged);
             if point.converged && point.character.is_some() {
+                self.check(&mut point);
+                if matches!(point.check, Some(CheckOutcome::Failed)) {
+                    point.label = Some(Label::Unverified);
+                }
                 self.assess(&mut point);
             }
             let flow = self.observer.point(&point);
@@ -209,38 +215,46 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         if self.extend_natural_frequencies(described.named_frequencies(omega)) {
             described.name_modes(omega, &self.natural);
         }
-        if let Some(check) = self.check {
-            let (system, basis) = (self.problem.system(), self.problem.basis());
-            let options = &check.options;
-            let steps = point.period / options.dt * options.periods as f64;
-            point.check = Some(if steps > check.max_steps {
-                CheckOutcome::OverBudget {
-                    steps,
-                    max_steps: check.max_steps,
-                }
-            } else {
-                match periodicity_check(system, basis, x, omega, options) {
-                    Ok(r) if r.displacement_defect <= check.max_displacement_defect => {
-                        point.time_domain = Some(r);
-                        CheckOutcome::Passed
-                    }
-                    Ok(r) => {
-                        point.time_domain = Some(r);
-                        CheckOutcome::Failed
-                    }
-                    Err(VerifyError::NoTimeDomainForm { condition }) => {
-                        CheckOutcome::Unchecked { condition }
-                    }
-                    Err(e) => CheckOutcome::NotRun(e),
-                }
-            });
-        }
+        self.check(point);
         let verified = point.check.as_ref().and_then(CheckOutcome::verified);
         let natural = &self.natural;
         let content = label(&described, self.order, omega, natural, verified).ok();
         point.character = Some(described);
         point.label = content.map(|l| self.on_branch(l, point));
         self.assess(point);
+    }
+
+    /// The time-domain check the request asks of a converged point, where it has none yet
+    /// (a point replayed from a run judged without it); the report goes to
+    /// [`BackbonePoint::time_domain`].
+    fn check(&mut self, point: &mut BackbonePoint) {
+        let (Some(check), None) = (self.check, &point.check) else {
+            return;
+        };
+        let (system, basis) = (self.problem.system(), self.problem.basis());
+        let options = &check.options;
+        let steps = point.period / options.dt * options.periods as f64;
+        point.check = Some(if steps > check.max_steps {
+            CheckOutcome::OverBudget {
+                steps,
+                max_steps: check.max_steps,
+            }
+        } else {
+            match periodicity_check(system, basis, &point.x, point.omega, options) {
+                Ok(r) if r.displacement_defect <= check.max_displacement_defect => {
+                    point.time_domain = Some(r);
+                    CheckOutcome::Passed
+                }
+                Ok(r) => {
+                    point.time_domain = Some(r);
+                    CheckOutcome::Failed
+                }
+                Err(VerifyError::NoTimeDomainForm { condition }) => {
+                    CheckOutcome::Unchecked { condition }
+                }
+                Err(e) => CheckOutcome::NotRun(e),
+            }
+        });
     }
 
     /// `label` where the point continues the mode's own branch, [`Label::OffBranch`] where

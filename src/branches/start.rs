@@ -434,7 +434,10 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
     };
     let (system, basis) = (problem.system(), problem.basis());
     let driver = match Arclength::new(problem.clone(), solver, x.to_vec(), from, walk) {
-        Ok(driver) => driver.with_acceptance(|y, at| energy(system, basis, y, at) > floor),
+        // The energy floor decides what counts as rest.
+        Ok(driver) => driver
+            .with_rest_accepted()
+            .with_acceptance(|y, at| energy(system, basis, y, at) > floor),
         Err(_) => return (Vec::new(), 0),
     };
     let mut go_on = |_: &Step| ControlFlow::Continue(());

@@ -218,6 +218,8 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
         values,
         options.sequential(),
     )?
+    // The energy floor below decides what counts as rest.
+    .with_rest_accepted()
     .with_acceptance(|x, period| {
         let omega = frequency_of_period(period);
         energy(system, &basis, x, omega) > floor

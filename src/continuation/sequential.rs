@@ -5,7 +5,7 @@ use super::{
     Branch, ContinuationProblem, EndReason, Observer, Point, RejectReason, Rejection, Step,
 };
 use crate::error::{ContinuationError, SolveError};
-use crate::solve::{failed_point, NonlinearSolver, SolveInfo};
+use crate::solve::{at_rest, failed_point, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
 
 /// How the next starting guess is formed.
@@ -101,6 +101,9 @@ pub struct Sequential<'a, P, S> {
     done: bool,
     pub(super) accept: Option<Acceptance<'a>>,
     measure: Option<Measure<'a>>,
+    /// Whether a solution at the problem's state of rest may join the branch
+    /// ([`Sequential::with_rest_accepted`]).
+    pub(super) rest_accepted: bool,
 }
 
 /// One solve of a step: where it ended, how, and from which start.
@@ -123,19 +126,18 @@ impl Attempt {
 /// A scalar ranking accepted solutions `(x, lambda)` for [`Selection::LowestMeasure`].
 type Measure<'a> = Box<dyn FnMut(&[f64], f64) -> f64 + 'a>;
 
-/// Whether a solve's outcome joins the branch: it converged and the acceptance test (if any)
-/// takes the solution.
+/// Whether a solve's outcome joins the branch: it converged, it is not the problem's state of
+/// rest (unless `rest_accepted`), and the acceptance test (if any) takes the solution.
 pub(super) fn accepts(
-    accept: &mut Option<Acceptance<'_>>,
+    (accept, rest_accepted): (&mut Option<Acceptance<'_>>, bool),
+    problem: &mut impl ContinuationProblem,
     result: &Result<SolveInfo, SolveError>,
-    x: &[f64],
-    lambda: f64,
+    (x, lambda): (&[f64], f64),
 ) -> bool {
-    match (result, accept.as_mut()) {
-        (Ok(_), Some(accept)) => accept(x, lambda),
-        (Ok(_), None) => true,
-        (Err(_), _) => false,
+    if result.is_err() || (!rest_accepted && at_rest(problem, x)) {
+        return false;
     }
+    accept.as_mut().is_none_or(|accept| accept(x, lambda))
 }
 
 impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
@@ -192,6 +194,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
             done: false,
             accept: None,
             measure: None,
+            rest_accepted: false,
         })
     }
 
@@ -201,6 +204,18 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     /// energies with): it lives as long as the driver's lifetime `'a`.
     pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'a) -> Self {
         self.accept = Some(Box::new(accept));
+        self
+    }
+
+    /// Lets solutions at the problem's state of rest join the branch. By default a problem
+    /// that knows its rest state ([`Structured::at_rest`](crate::solve::Structured::at_rest):
+    /// every harmonic-balance system of this crate) has such solutions refused, as failed
+    /// steps ([`RejectReason::NotAccepted`]): rest solves the equations of every unforced
+    /// mode, and a run that slides to it has left its branch. A caller whose own acceptance
+    /// test decides (the backbones' energy floor) or who studies the approach to rest opts
+    /// out here.
+    pub fn with_rest_accepted(mut self) -> Self {
+        self.rest_accepted = true;
         self
     }
 
@@ -266,7 +281,12 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     ) -> (Result<SolveInfo, SolveError>, bool) {
         self.problem.set_parameter(lambda);
         let result = self.solver.solve(&mut self.problem, x);
-        let accepted = accepts(&mut self.accept, &result, x, lambda);
+        let accepted = accepts(
+            (&mut self.accept, self.rest_accepted),
+            &mut self.problem,
+            &result,
+            (x, lambda),
+        );
         (result, accepted)
     }
 

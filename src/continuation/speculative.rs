@@ -277,7 +277,12 @@ where
             d.problem.set_parameter(lambda);
             d.solver.solve_monitored(&mut d.problem, &mut x, &mut watch)
         };
-        let accepted = accepts(&mut d.accept, &result, &x, lambda);
+        let accepted = accepts(
+            (&mut d.accept, d.rest_accepted),
+            &mut d.problem,
+            &result,
+            (&x, lambda),
+        );
         let first = Attempt {
             x,
             result,
@@ -308,7 +313,12 @@ where
         let chosen = match speculated {
             // The worker ran the first retry: judge it as `step` would have, then go deeper.
             Some((y, result)) => {
-                let accepted = accepts(&mut d.accept, &result, &y, lambda);
+                let accepted = accepts(
+                    (&mut d.accept, d.rest_accepted),
+                    &mut d.problem,
+                    &result,
+                    (&y, lambda),
+                );
                 let retried = Attempt {
                     x: y,
                     result,

@@ -109,6 +109,17 @@ pub trait Structured {
         None
     }
 
+    /// Whether `x` is the problem's state of rest (no motion), where the problem knows it
+    /// (`None` by default). Continuation drivers refuse a point at rest unless told otherwise
+    /// ([`Sequential::with_rest_accepted`](crate::continuation::Sequential::with_rest_accepted),
+    /// [`Arclength::with_rest_accepted`](crate::continuation::Arclength::with_rest_accepted)):
+    /// rest solves the equations of every unforced mode, and a run that slides to it has
+    /// left its branch.
+    fn at_rest(&mut self, x: &[f64]) -> Option<bool> {
+        let _ = x;
+        None
+    }
+
     /// For nonsmooth problems: the size of the active set of each unilateral law at `x` (for
     /// harmonic balance, the number of time samples in contact). Continuation drivers report
     /// a grazing event when one appears or vanishes. `None` by default.
@@ -116,6 +127,12 @@ pub trait Structured {
         let _ = x;
         None
     }
+}
+
+/// Whether `x` is the state of rest of `problem`, as far as it knows ([`Structured::at_rest`];
+/// `false` where it does not).
+pub fn at_rest(problem: &mut (impl Problem + ?Sized), x: &[f64]) -> bool {
+    problem.structure().and_then(|s| s.at_rest(x)) == Some(true)
 }
 
 /// [`Structured::residual_scale`] of a problem (1 without structure).

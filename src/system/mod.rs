@@ -22,5 +22,5 @@ pub use layout::Layout;
 pub use phase::PhaseLocked;
 pub use problem::{
     Discretization, HarmonicBalanceSettings, NonsmoothSystem, COMPLEMENTARITY_RANGE, MAX_OFFSET,
-    MAX_PHASE, RESONANCE_BAND,
+    MAX_PHASE, RESONANCE_BAND, REST_AMPLITUDE,
 };

@@ -196,6 +196,8 @@ pub(crate) fn energy_backbone_with<S: NonlinearSolver>(
             values,
             seq_options,
         )?
+        // The judge decides what counts as rest.
+        .with_rest_accepted()
         .with_acceptance(|y, _| {
             augmented::split(y).is_some_and(|(x, omega)| judge.accepts(x, omega))
         });

@@ -42,7 +42,7 @@ use super::{
 };
 use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::solve::{NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
+use crate::solve::{at_rest, NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
 use bordered::{BorderScratch, Bordered, Metric};
 use branching::Bracket;
 
@@ -66,6 +66,9 @@ pub struct Arclength<'a, P, S> {
     /// Rejected steps so far.
     rejections: usize,
     accept: Option<Acceptance<'a>>,
+    /// Whether a point at the problem's state of rest may join the branch
+    /// ([`Arclength::with_rest_accepted`]).
+    rest_accepted: bool,
     border: BorderScratch,
     /// The sign of `det [J, F_lambda; t^T W]` at the current point (`None` when not watched
     /// or exactly singular).
@@ -139,6 +142,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
             done: false,
             rejections: 0,
             accept: None,
+            rest_accepted: false,
             border: BorderScratch::default(),
             orientation: None,
             bracket: None,
@@ -151,6 +155,16 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         driver.active = driver.active_set();
         driver.start = Some(driver.point(0, &info, Vec::new()));
         Ok(driver)
+    }
+
+    /// Lets points at the problem's state of rest join the branch, which a problem that knows
+    /// it ([`Structured::at_rest`](crate::solve::Structured::at_rest)) has refused by default
+    /// ([`RejectReason::NotAccepted`]), as
+    /// [`Sequential::with_rest_accepted`](crate::continuation::Sequential::with_rest_accepted)
+    /// says.
+    pub fn with_rest_accepted(mut self) -> Self {
+        self.rest_accepted = true;
+        self
     }
 
     /// Adds a test every accepted point must pass (for instance "not the state of rest"); a
@@ -225,9 +239,14 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         self.solver.solve(&mut self.problem, x)
     }
 
-    /// Whether the acceptance test ([`Arclength::with_acceptance`]) takes the state `x` at
-    /// `lambda` (`true` without a test).
+    /// Whether the state `x` at `lambda` may join the branch: not at the problem's state of
+    /// rest (unless [`Arclength::with_rest_accepted`]) and taken by the acceptance test
+    /// ([`Arclength::with_acceptance`]; `true` without a test). The problem is not moved to
+    /// `lambda`.
     pub fn accepts(&mut self, x: &[f64], lambda: f64) -> bool {
+        if !self.rest_accepted && at_rest(&mut self.problem, x) {
+            return false;
+        }
         self.accept.as_mut().is_none_or(|accept| accept(x, lambda))
     }
 
@@ -420,10 +439,8 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
             Ok(info) => info,
             Err(e) => return self.reject(predicted[n], RejectReason::Solver(e)),
         };
-        if let Some(accept) = self.accept.as_mut() {
-            if !accept(&y[..n], y[n]) {
-                return self.reject(y[n], RejectReason::NotAccepted);
-            }
+        if !self.accepts(&y[..n], y[n]) {
+            return self.reject(y[n], RejectReason::NotAccepted);
         }
         let distance: Vec<f64> = y.iter().zip(&predicted).map(|(a, b)| a - b).collect();
         let ratio = self.metric.norm(&distance) / self.ds;

@@ -48,6 +48,11 @@ use selection::Selection;
 use state::{Frequency, Samples};
 use step::Reduced;
 
+/// The largest swing of every gap, as a fraction of its offset, of a state of rest
+/// ([`Structured::at_rest`]): `sqrt(TRIVIAL_ENERGY)`, the backbone's floor of `E / E_g` in
+/// amplitude.
+pub const REST_AMPLITUDE: f64 = 1e-3;
+
 /// Harmonic-balance settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HarmonicBalanceSettings {
@@ -461,6 +466,34 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
     /// order.
     fn residual_scale(&self) -> f64 {
         self.description.residual_scale()
+    }
+
+    /// At rest: the gap of every unilateral law swings over the period by at most
+    /// [`REST_AMPLITUDE`] times its offset `g0`. A motion that touches closes some gap by
+    /// `g0`; one of energy `E` swings by about `sqrt(E / E_g) g0`, so the bound is the
+    /// backbone's [`TRIVIAL_ENERGY`](crate::branches::TRIVIAL_ENERGY) of `E_g` in amplitude.
+    /// `None` for a law whose offset is zero (no scale to measure against) or a state of
+    /// the wrong length.
+    fn at_rest(&mut self, x: &[f64]) -> Option<bool> {
+        if x.len() != self.dimension() {
+            return None;
+        }
+        let offsets: Vec<f64> = (self.description.system().laws())
+            .map(|l| l.gap().offset.abs())
+            .collect();
+        if offsets.iter().any(|g| !(g.is_finite() && *g > 0.0)) {
+            return None;
+        }
+        let omega = self.ws.frequency.omega;
+        let mut rest = true;
+        for (l, g0) in offsets.iter().enumerate() {
+            let gaps = self.gap_history(x, omega, l);
+            let (lo, hi) = (gaps.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), g| {
+                (lo.min(*g), hi.max(*g))
+            });
+            rest &= hi - lo <= 2.0 * REST_AMPLITUDE * g0;
+        }
+        Some(rest)
     }
 
     /// The Newton step with the linear rows condensed (formulation §5): only a dense LU of
