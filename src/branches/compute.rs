@@ -25,7 +25,8 @@ use std::ops::ControlFlow;
 ///   pseudo-arclength from the grid's first period walks the branch back and follows it
 ///   through its folds ([`ArclengthBackboneOptions::over_grid`](crate::branches::ArclengthBackboneOptions::over_grid)).
 /// - A period grid is judged before its points are shown: where it stalls or fewer than
-///   half its steps are good (converged, labelled as the mode's own branch), as where its branch saturates at a period inside the grid or it walks the
+///   half its steps are good (converged and, when the request asks for a time-domain check,
+///   verified), as where its branch saturates at a period inside the grid or it walks the
 ///   truncated system's resonances, pseudo-arclength over the grid's range is run too, and
 ///   the run with more good points is returned ([`AutoChoice::GridFellShort`](crate::branches::AutoChoice::GridFellShort) when it is
 ///   arclength; the other run's points are not returned).
@@ -50,19 +51,18 @@ use std::ops::ControlFlow;
 ///   under harmonic selection of band
 ///   [`RESONANCE_BAND`](crate::system::RESONANCE_BAND), on two threads when the request
 ///   allows a second core ([`Request::speculation`]). The run whose converged skeleton
-///   points cover more periods of the grid is returned, a tie keeping the selected
-///   equations ([`ModeBranches::selection`]): the
+///   points (verified, where the request asks for the check) cover more periods of the grid
+///   is returned, a tie keeping the selected equations ([`ModeBranches::selection`]): the
 ///   selection removes the truncation's internal resonances, so that the skeleton converges
 ///   in `m` (`docs/theory.md`, "Harmonic selection"), but on assemblies with dense natural
 ///   frequencies it can drop harmonics the motion needs. [`ModeBranches::problem`] gives
 ///   the equations the points solve.
 ///
 /// The choice is [`ModeBranches::auto`]. `Auto`'s points reach an observer
-/// ([`compute_observed`]) once its runs are judged. The runs are judged without the
-/// time-domain check ([`Request::check`]), so that a request returns the same points whether
-/// it asks to see the check or not: the check then annotates the run kept (each point's
-/// [`BackbonePoint::check`], and [`Label::Unverified`](crate::modal::Label::Unverified) for
-/// a point that fails it).
+/// ([`compute_observed`]) once its runs are judged. Where the request asks for the
+/// time-domain check, the runs are judged with it, so that the answer can differ from the
+/// same request without it (on chains with a floating bar the check is what tells a start
+/// whose points are motions of the bars).
 ///
 /// # Errors
 /// Only when no point was computed: invalid settings or options, no linear mode `i`, an
@@ -123,15 +123,9 @@ pub fn compute_observed(
     let (plan, method) = match asked(request) {
         Ok(planned) => planned,
         Err(given) => {
-            // Auto's runs are judged before they are shown, without the time-domain check:
-            // asking to see it must not change the answer. The run kept gets it as its
-            // points are shown.
-            let unchecked = Request {
-                check: None,
-                ..request.clone()
-            };
+            // Auto's runs are judged before they are shown.
             let ((run, method, auto, problem), selection) =
-                judged_with_selection(system, &unchecked, given, problem)?;
+                judged_with_selection(system, request, given, problem)?;
             let mut annotator = Annotator::new(problem, request, observer);
             let end = annotator.replay(run.points, run.end);
             let mut result = annotator.finish((method, auto), run.e_g, end, run.rejected);

@@ -92,13 +92,16 @@ where
         observer(p.parameter, &point)
     };
     let mut see = |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report);
+    // The energy floor above decides what counts as rest, and says so in the status.
     let branch = match steps {
         ParameterSteps::Values(values, options) => {
-            Sequential::new(problem, solver, x, values, options)?.run(&mut see)
+            Sequential::new(problem, solver, x, values, options)?
+                .with_rest_accepted()
+                .run(&mut see)
         }
-        ParameterSteps::Arclength(options) => {
-            Arclength::new(problem, solver, x, value, options)?.run(&mut see)
-        }
+        ParameterSteps::Arclength(options) => Arclength::new(problem, solver, x, value, options)?
+            .with_rest_accepted()
+            .run(&mut see),
     };
     Ok(branch)
 }

@@ -488,6 +488,10 @@ impl<B: Basis> Structured for NonsmoothSystem<B> {
         let mut rest = true;
         for (l, g0) in offsets.iter().enumerate() {
             let gaps = self.gap_history(x, omega, l);
+            // A gap that overflows says nothing of rest (and `min`/`max` would skip a NaN).
+            if gaps.iter().any(|g| !g.is_finite()) {
+                return None;
+            }
             let (lo, hi) = (gaps.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), g| {
                 (lo.min(*g), hi.max(*g))
             });
