@@ -45,6 +45,17 @@ fn draws(seed: u64) -> impl FnMut(f64, f64) -> f64 {
     }
 }
 
+/// A bar `(l, c, EA, g0)`: length and speed over a factor of 10, stiffness over two decades,
+/// gap over four.
+fn random_bar(draw: &mut impl FnMut(f64, f64) -> f64) -> (f64, f64, f64, f64) {
+    (
+        draw(0.3, 3.0),
+        draw(0.3, 3.0),
+        draw(0.1, 10.0),
+        10f64.powf(draw(-5.0, -1.0)),
+    )
+}
+
 /// The exact `E/E_g` at period `t` of a bar with travel time `tau`.
 fn exact(clamped: bool, tau: f64, t: f64) -> f64 {
     let s = if clamped {
@@ -122,13 +133,7 @@ fn the_free_free_bars_skeleton_converges_in_m() {
 fn generated_bars_converge_in_m() {
     let mut draw = draws(0x5eed);
     for clamped in [true, false] {
-        let bar = (
-            draw(0.3, 3.0),
-            draw(0.3, 3.0),
-            draw(0.1, 10.0),
-            10f64.powf(draw(-5.0, -1.0)),
-        );
-        converges_in_m(clamped, bar, 0.85);
+        converges_in_m(clamped, random_bar(&mut draw), 0.85);
     }
 }
 
@@ -182,13 +187,7 @@ fn no_skeleton_point_is_far_from_the_exact_family() {
         (false, (1.0, 1.0, 1.0, 1e-3), 40),
     ];
     for clamped in [true, false] {
-        let bar = (
-            draw(0.3, 3.0),
-            draw(0.3, 3.0),
-            draw(0.1, 10.0),
-            10f64.powf(draw(-5.0, -1.0)),
-        );
-        cases.push((clamped, bar, 20));
+        cases.push((clamped, random_bar(&mut draw), 20));
     }
     for (clamped, bar, m) in cases {
         let mut request = Request::new(1).harmonics(m);

@@ -21,13 +21,23 @@ fn first_bar() -> BarId {
 /// A unit bar (`EA = c = 1`, impedance 1), free at `x = 0`, against a compliant obstacle of
 /// stiffness `k` at `x = 1`.
 fn free_bar_against_spring(k: f64) -> Model {
-    let bar = first_bar();
+    bar_against_spring(
+        Condition::Free {
+            end: first_bar().left(),
+        },
+        k,
+    )
+}
+
+/// A unit bar held at `x = 0` by `left`, against a compliant obstacle of stiffness `k` at
+/// `x = 1`.
+fn bar_against_spring(left: Condition, k: f64) -> Model {
     Model::new(
         vec![Bar::unit()],
         vec![
-            Condition::Free { end: bar.left() },
+            left,
             Condition::CompliantObstacle {
-                end: bar.right(),
+                end: first_bar().right(),
                 gap: GAP,
                 stiffness: k,
             },
@@ -186,18 +196,7 @@ fn stiff_compliant_obstacle_tends_to_the_rigid_one() {
     let bar = first_bar();
     let mut errors = Vec::new();
     for k in [1e2, 1e3, 1e4, 1e5, 1e6] {
-        let model = Model::new(
-            vec![Bar::unit()],
-            vec![
-                Condition::Clamped { end: bar.left() },
-                Condition::CompliantObstacle {
-                    end: bar.right(),
-                    gap: GAP,
-                    stiffness: k,
-                },
-            ],
-        )
-        .unwrap();
+        let model = bar_against_spring(Condition::Clamped { end: bar.left() }, k);
         let grid = Grid::new(&model, DT).unwrap();
         let initial = State::from_cells(&model, &grid, &cells).unwrap();
         let compliant = march(&initial, period, &MarchOptions::default()).unwrap();
