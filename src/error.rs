@@ -428,7 +428,8 @@ pub enum SolveError {
     /// The residual or the Jacobian contains NaN or infinity.
     #[error("non-finite {what} at iteration {iteration}")]
     NonFinite {
-        /// "residual", "Jacobian" or "initial guess".
+        /// "residual", "Jacobian", "initial guess" or "dogleg step" (a trust-region step or
+        /// radius that overflows).
         what: &'static str,
         /// Iteration at which it appeared.
         iteration: usize,

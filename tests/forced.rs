@@ -402,3 +402,35 @@ fn the_resonance_peak_lies_on_the_backbone() {
         assert!(last.converged && last.amplitude < 0.1 && last.omega == 2.0);
     }
 }
+
+/// A force so large that `|F|^2` overflows: the dogleg's trust-region ratio was NaN, its
+/// radius stopped changing and the same trial point was evaluated for ever (the reproducer of
+/// the reliability issue, as drawn). It now ends with a typed error or a result, at once.
+#[test]
+fn a_force_whose_residual_overflows_when_squared_ends_the_dogleg() {
+    use nonsmooth_modes::solve::{Dogleg, Solver};
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let end = system.bar_id(0).unwrap().left();
+    let request = ResponseRequest {
+        settings: HarmonicBalanceSettings {
+            harmonics: 6,
+            samples_per_harmonic: 3,
+            ..Default::default()
+        },
+        forcing: Forcing {
+            damping: Damping::PerBar(vec![0.121]),
+            excitations: vec![Excitation::force(end, -3.3e153)],
+        },
+        omega_range: (0.6158, 0.7939),
+        steps: 9,
+        method: ResponseMethod::Sequential,
+        solver: Solver::Dogleg(Dogleg::default()),
+    };
+    match forced_response(&system, &request) {
+        Ok(response) => assert!(response
+            .points
+            .iter()
+            .all(|p| !p.converged || p.energy.is_finite())),
+        Err(e) => assert!(!e.to_string().is_empty()),
+    }
+}

@@ -168,19 +168,28 @@ impl NonlinearSolver for Dogleg {
                     }
                     let rt = it.residual_into(trial, f_trial, iteration)?;
                     jac.mul_vec(step, jp);
+                    // Reductions of |F|^2 relative to r^2, so that residuals up to the
+                    // largest finite ones do not overflow when squared.
                     let predicted_r2 = f
                         .iter()
                         .zip(jp.iter())
-                        .map(|(f, d)| (f + d) * (f + d))
+                        .map(|(f, d)| ((f + d) / r).powi(2))
                         .sum::<f64>();
-                    let predicted = r * r - predicted_r2;
-                    let actual = r * r - rt * rt;
+                    let predicted = 1.0 - predicted_r2;
+                    let actual = 1.0 - (rt / r).powi(2);
                     let ratio = if predicted > 0.0 {
                         actual / predicted
                     } else {
                         -1.0
                     };
                     let length = norm(step);
+                    // A step or a radius that is not finite cannot shrink to a decision.
+                    if !(length.is_finite() && radius.is_finite() && actual.is_finite()) {
+                        return Err(SolveError::NonFinite {
+                            what: "dogleg step",
+                            iteration,
+                        });
+                    }
                     if ratio < 0.25 {
                         radius = 0.5 * length.min(radius);
                     } else if ratio > 0.75 {
