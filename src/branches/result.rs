@@ -167,18 +167,13 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
 
     /// Shows points annotated by another annotator of the same request to the observer and
     /// keeps them, up to the one at which it stops the run; returns `end`, or
-    /// [`EndReason::StoppedByObserver`] if it stopped. The time-domain check, multipliers and
-    /// Hill exponents this request asks are added to converged points that the other run left
-    /// without them; a point that fails the check becomes
-    /// [`Label::Unverified`].
+    /// [`EndReason::StoppedByObserver`] if it stopped. The multipliers and Hill exponents this
+    /// request asks are added to converged points that the other run left without them (the
+    /// runs are judged with the time-domain check, so their points have it).
     pub(crate) fn replay(&mut self, points: Vec<BackbonePoint>, end: EndReason) -> EndReason {
         for mut point in points {
             self.converged += usize::from(point.converged);
             if point.converged && point.character.is_some() {
-                self.check(&mut point);
-                if matches!(point.check, Some(CheckOutcome::Failed)) {
-                    point.label = Some(Label::Unverified);
-                }
                 self.assess(&mut point);
             }
             let flow = self.observer.point(&point);
@@ -224,11 +219,10 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         self.assess(point);
     }
 
-    /// The time-domain check the request asks of a converged point, where it has none yet
-    /// (a point replayed from a run judged without it); the report goes to
+    /// The time-domain check the request asks of a converged point; the report goes to
     /// [`BackbonePoint::time_domain`].
     fn check(&mut self, point: &mut BackbonePoint) {
-        let (Some(check), None) = (self.check, &point.check) else {
+        let Some(check) = self.check else {
             return;
         };
         let (system, basis) = (self.problem.system(), self.problem.basis());

@@ -10,6 +10,7 @@
 
 use super::Point;
 use crate::error::{ContinuationError, SolveError};
+use crate::solve::{at_rest, Problem};
 use std::ops::ControlFlow;
 
 /// What one call of a driver's `step()` did.
@@ -192,6 +193,28 @@ impl<F: FnMut(&Step) -> ControlFlow<()>> Observer for F {
 /// A test that a converged solution `(x, lambda)` belongs to the branch. It lives as long as
 /// the driver's lifetime `'a`, so it may borrow what the caller owns (the system, a judge).
 pub(super) type Acceptance<'a> = Box<dyn FnMut(&[f64], f64) -> bool + 'a>;
+
+/// What a driver lets join its branch: not the problem's state of rest
+/// ([`Structured::at_rest`](crate::solve::Structured::at_rest)) unless `rest` allows it, and
+/// what the caller's acceptance test (if any) takes. One for every driver, so that they refuse
+/// alike.
+#[derive(Default)]
+pub(super) struct Admission<'a> {
+    /// The caller's test (`with_acceptance`).
+    pub(super) test: Option<Acceptance<'a>>,
+    /// Whether the state of rest may join (`with_rest_accepted`).
+    pub(super) rest: bool,
+}
+
+impl Admission<'_> {
+    /// Whether the converged solution `x` at `lambda` of `problem` joins the branch.
+    pub(super) fn admits(&mut self, problem: &mut impl Problem, x: &[f64], lambda: f64) -> bool {
+        if !self.rest && at_rest(problem, x) {
+            return false;
+        }
+        self.test.as_mut().is_none_or(|test| test(x, lambda))
+    }
+}
 
 /// Steps `driver` with `step` until the run ends or `observer` stops it, collecting the
 /// branch. `stop` records an observer's stop in the driver, so that later steps report it.

@@ -1,11 +1,11 @@
 //! Sequential (natural-parameter) continuation.
 
-use super::driver::{next_point, run_with, Acceptance};
+use super::driver::{next_point, run_with, Admission};
 use super::{
     Branch, ContinuationProblem, EndReason, Observer, Point, RejectReason, Rejection, Step,
 };
 use crate::error::{ContinuationError, SolveError};
-use crate::solve::{at_rest, failed_point, NonlinearSolver, SolveInfo};
+use crate::solve::{failed_point, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
 
 /// How the next starting guess is formed.
@@ -99,11 +99,9 @@ pub struct Sequential<'a, P, S> {
     finished: Option<EndReason>,
     /// Whether the iterator has handed out the end.
     done: bool,
-    pub(super) accept: Option<Acceptance<'a>>,
+    /// What joins the branch: the acceptance test and the state of rest.
+    pub(super) admission: Admission<'a>,
     measure: Option<Measure<'a>>,
-    /// Whether a solution at the problem's state of rest may join the branch
-    /// ([`Sequential::with_rest_accepted`]).
-    pub(super) rest_accepted: bool,
 }
 
 /// One solve of a step: where it ended, how, and from which start.
@@ -125,20 +123,6 @@ impl Attempt {
 
 /// A scalar ranking accepted solutions `(x, lambda)` for [`Selection::LowestMeasure`].
 type Measure<'a> = Box<dyn FnMut(&[f64], f64) -> f64 + 'a>;
-
-/// Whether a solve's outcome joins the branch: it converged, it is not the problem's state of
-/// rest (unless `rest_accepted`), and the acceptance test (if any) takes the solution.
-pub(super) fn accepts(
-    (accept, rest_accepted): (&mut Option<Acceptance<'_>>, bool),
-    problem: &mut impl ContinuationProblem,
-    result: &Result<SolveInfo, SolveError>,
-    (x, lambda): (&[f64], f64),
-) -> bool {
-    if result.is_err() || (!rest_accepted && at_rest(problem, x)) {
-        return false;
-    }
-    accept.as_mut().is_none_or(|accept| accept(x, lambda))
-}
 
 impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     /// A driver visiting `values` in order from the guess `start`.
@@ -192,9 +176,8 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
             failures: 0,
             finished: None,
             done: false,
-            accept: None,
+            admission: Admission::default(),
             measure: None,
-            rest_accepted: false,
         })
     }
 
@@ -203,7 +186,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     /// and counts as a failure. The test may borrow from the caller (the system it measures
     /// energies with): it lives as long as the driver's lifetime `'a`.
     pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'a) -> Self {
-        self.accept = Some(Box::new(accept));
+        self.admission.test = Some(Box::new(accept));
         self
     }
 
@@ -215,7 +198,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     /// test decides (the backbones' energy floor) or who studies the approach to rest opts
     /// out here.
     pub fn with_rest_accepted(mut self) -> Self {
-        self.rest_accepted = true;
+        self.admission.rest = true;
         self
     }
 
@@ -272,6 +255,17 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
         self.values[step.saturating_sub(1)]
     }
 
+    /// Whether a solve's outcome joins the branch: it converged and the driver's
+    /// [`Admission`] takes the solution.
+    pub(super) fn admits(
+        &mut self,
+        result: &Result<SolveInfo, SolveError>,
+        x: &[f64],
+        lambda: f64,
+    ) -> bool {
+        result.is_ok() && self.admission.admits(&mut self.problem, x, lambda)
+    }
+
     /// Solves at `lambda` from `x` with the driver's own problem; returns the solver's result
     /// and whether the acceptance test (if any) took the solution.
     pub(super) fn attempt(
@@ -281,12 +275,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     ) -> (Result<SolveInfo, SolveError>, bool) {
         self.problem.set_parameter(lambda);
         let result = self.solver.solve(&mut self.problem, x);
-        let accepted = accepts(
-            (&mut self.accept, self.rest_accepted),
-            &mut self.problem,
-            &result,
-            (x, lambda),
-        );
+        let accepted = self.admits(&result, x, lambda);
         (result, accepted)
     }
 

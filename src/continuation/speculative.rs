@@ -9,7 +9,7 @@
 //! first attempt joins the branch.
 
 use super::driver::{next_point, run_with};
-use super::sequential::{accepts, Attempt};
+use super::sequential::Attempt;
 use super::{Branch, ContinuationProblem, Observer, Point, Sequential, Step};
 use crate::error::{ContinuationError, SolveError};
 use crate::solve::{NonlinearSolver, SolveInfo, SolveMonitor};
@@ -277,12 +277,7 @@ where
             d.problem.set_parameter(lambda);
             d.solver.solve_monitored(&mut d.problem, &mut x, &mut watch)
         };
-        let accepted = accepts(
-            (&mut d.accept, d.rest_accepted),
-            &mut d.problem,
-            &result,
-            (&x, lambda),
-        );
+        let accepted = d.admits(&result, &x, lambda);
         let first = Attempt {
             x,
             result,
@@ -313,12 +308,7 @@ where
         let chosen = match speculated {
             // The worker ran the first retry: judge it as `step` would have, then go deeper.
             Some((y, result)) => {
-                let accepted = accepts(
-                    (&mut d.accept, d.rest_accepted),
-                    &mut d.problem,
-                    &result,
-                    (&y, lambda),
-                );
+                let accepted = d.admits(&result, &y, lambda);
                 let retried = Attempt {
                     x: y,
                     result,

@@ -36,13 +36,13 @@ mod options;
 pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
 
 use super::augmented;
-use super::driver::{next_point, run_with, Acceptance};
+use super::driver::{next_point, run_with, Admission};
 use super::{
     Branch, ContinuationProblem, EndReason, Event, Observer, Point, RejectReason, Rejection, Step,
 };
 use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::solve::{at_rest, NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
+use crate::solve::{NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
 use bordered::{BorderScratch, Bordered, Metric};
 use branching::Bracket;
 
@@ -65,10 +65,8 @@ pub struct Arclength<'a, P, S> {
     done: bool,
     /// Rejected steps so far.
     rejections: usize,
-    accept: Option<Acceptance<'a>>,
-    /// Whether a point at the problem's state of rest may join the branch
-    /// ([`Arclength::with_rest_accepted`]).
-    rest_accepted: bool,
+    /// What joins the branch: the acceptance test and the state of rest.
+    admission: Admission<'a>,
     border: BorderScratch,
     /// The sign of `det [J, F_lambda; t^T W]` at the current point (`None` when not watched
     /// or exactly singular).
@@ -141,8 +139,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
             finished: None,
             done: false,
             rejections: 0,
-            accept: None,
-            rest_accepted: false,
+            admission: Admission::default(),
             border: BorderScratch::default(),
             orientation: None,
             bracket: None,
@@ -163,7 +160,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
     /// [`Sequential::with_rest_accepted`](crate::continuation::Sequential::with_rest_accepted)
     /// says.
     pub fn with_rest_accepted(mut self) -> Self {
-        self.rest_accepted = true;
+        self.admission.rest = true;
         self
     }
 
@@ -171,7 +168,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
     /// failing corrected point is rejected like a solver failure. The test may borrow from
     /// the caller (the system it measures energies with) for the driver's lifetime `'a`.
     pub fn with_acceptance(mut self, accept: impl FnMut(&[f64], f64) -> bool + 'a) -> Self {
-        self.accept = Some(Box::new(accept));
+        self.admission.test = Some(Box::new(accept));
         self
     }
 
@@ -244,10 +241,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
     /// ([`Arclength::with_acceptance`]; `true` without a test). The problem is not moved to
     /// `lambda`.
     pub fn accepts(&mut self, x: &[f64], lambda: f64) -> bool {
-        if !self.rest_accepted && at_rest(&mut self.problem, x) {
-            return false;
-        }
-        self.accept.as_mut().is_none_or(|accept| accept(x, lambda))
+        self.admission.admits(&mut self.problem, x, lambda)
     }
 
     /// Continues the branch from another solution `x` at `lambda` (one found by
