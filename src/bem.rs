@@ -22,6 +22,15 @@ pub fn sinc(z: f64) -> f64 {
     }
 }
 
+/// [`sinc`] of `z` given `sin z` already computed (with its cosine, by `sin_cos`).
+pub(crate) fn sinc_given_sine(z: f64, sin_z: f64) -> f64 {
+    if z.abs() < 1e-2 {
+        sinc(z)
+    } else {
+        sin_z / z
+    }
+}
+
 /// Derivative of [`sinc`]: `(z cos z - sin z) / z^2`, accurate near `z = 0`.
 pub fn sinc_derivative(z: f64) -> f64 {
     if z.abs() < 1e-2 {

@@ -202,7 +202,8 @@ impl Way {
             solver,
             ..Request::new(1)
         };
-        // Auto judges its grid by the points that pass the time-domain check.
+        // Auto's points carry the time-domain check (it annotates them; Auto's judge is the
+        // same without it).
         if self == Self::Auto {
             request.check = Some(TimeDomainCheck::for_system(system));
         }
@@ -280,6 +281,52 @@ fn every_assembly_gives_a_branch_or_a_typed_reason() {
     assert!(outcomes
         .iter()
         .any(|o| matches!(o, Outcome::Run { converged, .. } if *converged > 0)));
+}
+
+/// Asking [`Method::Auto`] for the time-domain check annotates its answer and does not
+/// change it: on the held assemblies of the sequence at `m = 8`, the same points (period,
+/// energy, convergence), the same choice of runs, and the check's outcome on each converged
+/// point of the checked request.
+#[test]
+fn asking_for_the_check_does_not_change_the_answer() {
+    let settings = HarmonicBalanceSettings {
+        harmonics: 8,
+        ..HarmonicBalanceSettings::default()
+    };
+    let mut compared = 0;
+    for seed in 0..12 {
+        let drawn = draw(seed);
+        if drifting_bars(&drawn.system).is_some() {
+            continue;
+        }
+        let plain = Request::new(1).settings(settings);
+        let checked = plain
+            .clone()
+            .checked(TimeDomainCheck::for_system(&drawn.system));
+        let (Ok(a), Ok(b)) = (
+            compute(&drawn.system, &plain),
+            compute(&drawn.system, &checked),
+        ) else {
+            continue;
+        };
+        let d = &drawn.description;
+        assert_eq!(a.points.len(), b.points.len(), "{d}");
+        assert_eq!((a.auto, a.selection), (b.auto, b.selection), "{d}");
+        for (p, q) in a.points.iter().zip(&b.points) {
+            assert_eq!(
+                (p.period, p.energy, p.converged),
+                (q.period, q.energy, q.converged)
+            );
+            assert!(p.check.is_none(), "{d}: the plain request checks nothing");
+            assert_eq!(
+                q.check.is_some(),
+                q.converged && q.character.is_some(),
+                "{d}"
+            );
+        }
+        compared += 1;
+    }
+    assert!(compared >= 4, "{compared} assemblies compared");
 }
 
 /// The energy backbone refuses the drifting assemblies of the sequence as the others do,

@@ -162,8 +162,8 @@ fn judged_run(
     })
 }
 
-/// Whether a period grid of `steps` steps with `good` good points (converged, and not
-/// refuted by a time-domain check where one was asked) that ended with `end` falls short of
+/// Whether a period grid of `steps` steps with `good` good points ([`QuietRun::good`]) that
+/// ended with `end` falls short of
 /// a backbone: it stalled, or fewer than half its steps are good (its branch left the grid's
 /// range, or the grid walks the truncated system's resonances).
 fn grid_fell_short(good: usize, steps: usize, end: &EndReason) -> bool {

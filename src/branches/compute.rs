@@ -25,8 +25,9 @@ use std::ops::ControlFlow;
 ///   pseudo-arclength from the grid's first period walks the branch back and follows it
 ///   through its folds ([`ArclengthBackboneOptions::over_grid`](crate::branches::ArclengthBackboneOptions::over_grid)).
 /// - A period grid is judged before its points are shown: where it stalls or fewer than
-///   half its steps are good (converged and, when the request asks for a time-domain check,
-///   verified), as where its branch saturates at a period inside the grid or it walks the
+///   half its steps are good (its converged points, scaled by the share of a sample of
+///   [`JUDGE_SAMPLES`](crate::branches::JUDGE_SAMPLES) of them that passes the time-domain
+///   check: [`crate::branches::judge`]), as where its branch saturates at a period inside the grid or it walks the
 ///   truncated system's resonances, pseudo-arclength over the grid's range is run too, and
 ///   the run with more good points is returned ([`AutoChoice::GridFellShort`](crate::branches::AutoChoice::GridFellShort) when it is
 ///   arclength; the other run's points are not returned).
@@ -51,7 +52,7 @@ use std::ops::ControlFlow;
 ///   under harmonic selection of band
 ///   [`RESONANCE_BAND`](crate::system::RESONANCE_BAND), on two threads when the request
 ///   allows a second core ([`Request::speculation`]). The run whose converged skeleton
-///   points (verified, where the request asks for the check) cover more periods of the grid
+///   points cover more periods of the grid
 ///   is returned, a tie keeping the selected equations ([`ModeBranches::selection`]): the
 ///   selection removes the truncation's internal resonances, so that the skeleton converges
 ///   in `m` (`docs/theory.md`, "Harmonic selection"), but on assemblies with dense natural
@@ -59,10 +60,11 @@ use std::ops::ControlFlow;
 ///   the equations the points solve.
 ///
 /// The choice is [`ModeBranches::auto`]. `Auto`'s points reach an observer
-/// ([`compute_observed`]) once its runs are judged. Where the request asks for the
-/// time-domain check, the runs are judged with it, so that the answer can differ from the
-/// same request without it (on chains with a floating bar the check is what tells a start
-/// whose points are motions of the bars).
+/// ([`compute_observed`]) once its runs are judged. The judge is the same whether the
+/// request asks for the time-domain check or not, so the check only annotates the points
+/// returned (it runs on the run kept, and labels the points that fail it
+/// [`Label::Unverified`](crate::modal::Label::Unverified)); on chains with a floating bar
+/// the judge's sample is what tells a start whose points are motions of the bars.
 ///
 /// # Errors
 /// Only when no point was computed: invalid settings or options, no linear mode `i`, an

@@ -87,13 +87,14 @@ pub(crate) fn lifted_run(
     let solver = request.solver.unwrap_or_default();
     let points = lifted_points(points, &mut problem, &solver, (e_g, floor));
     let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
-    let mut annotator = Annotator::new(problem, request, quiet);
+    let mut annotator = Annotator::unchecked(problem, request, quiet);
     for point in points {
         // A quiet observer never stops the run.
         let _ = annotator.point(point);
     }
     let (points, problem) = annotator.into_parts();
-    (QuietRun::new(points, e_g, end, rejected), problem)
+    let run = QuietRun::new(points, (e_g, end, rejected), &problem);
+    (run, problem)
 }
 
 /// Each converged point of `points` (a run on `problem`'s system at fewer harmonics), lifted

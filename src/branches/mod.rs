@@ -14,6 +14,7 @@ mod escape;
 mod full_basis;
 mod groups;
 mod guesses;
+mod judge;
 mod level;
 mod lift;
 mod parameter;
@@ -45,6 +46,7 @@ pub use full_basis::{
     symmetry_instant, to_full_basis, with_harmonics, FullBasisBranch, FullBasisPoint,
 };
 pub use groups::{group_by_label, PointGroup};
+pub use judge::{JUDGE_CELLS_PER_TRAVEL, JUDGE_SAMPLES};
 pub use level::EnergyLevel;
 pub use lift::lift;
 pub use parameter::{parameter_branch, ParameterSteps};

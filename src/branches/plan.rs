@@ -6,6 +6,7 @@ use crate::branches::backbone::{
     ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PointSink,
 };
 use crate::branches::energy_backbone::{energy_backbone_with, EnergyBackboneOptions};
+use crate::branches::judge::Sampled;
 use crate::branches::point::BackbonePoint;
 use crate::branches::request::{Method, Request};
 use crate::branches::result::Annotator;
@@ -37,21 +38,20 @@ pub(crate) struct QuietRun {
     pub e_g: f64,
     pub end: EndReason,
     pub rejected: usize,
-    /// Converged points not labelled
-    /// [`Label::Unverified`](crate::modal::Label::Unverified) whose check, if asked, was not
-    /// prevented from running ([`BackbonePoint::is_good`]).
+    /// Converged points, scaled by the share of the judge's sample that passed
+    /// ([`crate::branches::judge`]).
     pub good: usize,
 }
 
 impl QuietRun {
-    /// The run of annotated `points`, its good points counted.
+    /// The run of `points` annotated on `problem`, judged.
     pub(crate) fn new(
         points: Vec<BackbonePoint>,
-        e_g: f64,
-        end: EndReason,
-        rejected: usize,
+        (e_g, end, rejected): (f64, EndReason, usize),
+        problem: &NonsmoothSystem,
     ) -> Self {
-        let good = points.iter().filter(|p| p.is_good()).count();
+        let good =
+            Sampled::of_run(&points, problem).scale(points.iter().filter(|p| p.is_good()).count());
         Self {
             points,
             e_g,
@@ -62,8 +62,8 @@ impl QuietRun {
     }
 }
 
-/// Runs `plan` with `solver`, keeping the points annotated on `problem` to be judged; gives
-/// the problem back.
+/// Runs `plan` with `solver`, keeping the points annotated on `problem` (without the
+/// time-domain check) to be judged; gives the problem back.
 pub(crate) fn quiet_run(
     system: &BarSystem,
     request: &Request,
@@ -71,10 +71,11 @@ pub(crate) fn quiet_run(
     problem: NonsmoothSystem,
 ) -> Result<(QuietRun, NonsmoothSystem), Error> {
     let quiet = |_: &BackbonePoint| ControlFlow::Continue(());
-    let mut annotator = Annotator::new(problem, request, quiet);
+    let mut annotator = Annotator::unchecked(problem, request, quiet);
     let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
     let (points, problem) = annotator.into_parts();
-    Ok((QuietRun::new(points, e_g, end, rejected), problem))
+    let run = QuietRun::new(points, (e_g, end, rejected), &problem);
+    Ok((run, problem))
 }
 
 /// Runs `plan` with `solver`, handing every point to `annotator`; returns `E_g`, the end

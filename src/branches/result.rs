@@ -3,6 +3,7 @@
 
 use crate::branches::backbone::BackboneObserver;
 use crate::branches::continuity::{BranchTail, Sample};
+use crate::branches::judge::check_point;
 use crate::branches::point::{BackbonePoint, CheckOutcome};
 use crate::branches::request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
@@ -13,7 +14,6 @@ use crate::modal::{character, label, nearest_mode, ContactState, Label};
 use crate::solution::Solution;
 use crate::stability::{floquet, hill, Floquet, HillOptions, StabilityOptions, Verdict};
 use crate::system::{HarmonicBalanceSettings, NonsmoothSystem};
-use crate::verify::{periodicity_check, VerifyError};
 use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
@@ -120,6 +120,8 @@ pub(crate) struct Annotator<O, B: Basis = CosineBasis> {
     /// The last points of the mode's own branch, which the next one must continue
     /// ([`crate::branches::continuity`]).
     tail: BranchTail,
+    /// Whether the last point of the mode's own content was off the branch.
+    off_branch: bool,
 }
 
 impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
@@ -139,6 +141,17 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             natural: Vec::new(),
             natural_up_to: 0.0,
             tail: BranchTail::default(),
+            off_branch: false,
+        }
+    }
+
+    /// The annotator of a candidate run of [`Method::Auto`], judged before it is shown: as
+    /// [`Annotator::new`] without the time-domain check, which the request's own annotator
+    /// adds to the points of the run kept ([`Annotator::replay`]).
+    pub(crate) fn unchecked(problem: NonsmoothSystem<B>, request: &Request, observer: O) -> Self {
+        Self {
+            check: None,
+            ..Self::new(problem, request, observer)
         }
     }
 
@@ -167,13 +180,14 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
 
     /// Shows points annotated by another annotator of the same request to the observer and
     /// keeps them, up to the one at which it stops the run; returns `end`, or
-    /// [`EndReason::StoppedByObserver`] if it stopped. The multipliers and Hill exponents this
-    /// request asks are added to converged points that the other run left without them (the
-    /// runs are judged with the time-domain check, so their points have it).
+    /// [`EndReason::StoppedByObserver`] if it stopped. The time-domain check, multipliers and
+    /// Hill exponents this request asks are added to converged points that the other run
+    /// left without them.
     pub(crate) fn replay(&mut self, points: Vec<BackbonePoint>, end: EndReason) -> EndReason {
         for mut point in points {
             self.converged += usize::from(point.converged);
             if point.converged && point.character.is_some() {
+                self.check(&mut point);
                 self.assess(&mut point);
             }
             let flow = self.observer.point(&point);
@@ -210,45 +224,45 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         if self.extend_natural_frequencies(described.named_frequencies(omega)) {
             described.name_modes(omega, &self.natural);
         }
-        self.check(point);
-        let verified = point.check.as_ref().and_then(CheckOutcome::verified);
         let natural = &self.natural;
-        let content = label(&described, self.order, omega, natural, verified).ok();
+        let content = label(&described, self.order, omega, natural, None).ok();
         point.character = Some(described);
         point.label = content.map(|l| self.on_branch(l, point));
+        self.split_at_excursion(point);
+        self.check(point);
         self.assess(point);
     }
 
-    /// The time-domain check the request asks of a converged point; the report goes to
-    /// [`BackbonePoint::time_domain`].
+    /// A new branch index, with [`Event::LeftBranch`], at the first point of an excursion off
+    /// the mode's own branch, and another, with [`Event::Rejoined`], at the first point back
+    /// on it: the branch index then changes wherever the run leaves the curve it followed.
+    fn split_at_excursion(&mut self, point: &mut BackbonePoint) {
+        let event = match (&point.label, self.off_branch) {
+            (Some(Label::OffBranch { ratio }), false) => Event::LeftBranch { ratio: *ratio },
+            (Some(Label::Skeleton | Label::Subharmonic { .. }), true) => Event::Rejoined,
+            _ => return,
+        };
+        self.off_branch = !self.off_branch;
+        self.branch += 1;
+        point.branch = self.branch;
+        point.events.push(event);
+    }
+
+    /// The time-domain check the request asks of a converged point, where it has none yet;
+    /// the report goes to [`BackbonePoint::time_domain`], and a point that fails it is
+    /// labelled [`Label::Unverified`] (after the branch's continuity was judged from its
+    /// content, so that the labels of the other points do not depend on the check).
     fn check(&mut self, point: &mut BackbonePoint) {
-        let Some(check) = self.check else {
+        let (Some(check), None) = (self.check, &point.check) else {
             return;
         };
-        let (system, basis) = (self.problem.system(), self.problem.basis());
-        let options = &check.options;
-        let steps = point.period / options.dt * options.periods as f64;
-        point.check = Some(if steps > check.max_steps {
-            CheckOutcome::OverBudget {
-                steps,
-                max_steps: check.max_steps,
-            }
-        } else {
-            match periodicity_check(system, basis, &point.x, point.omega, options) {
-                Ok(r) if r.displacement_defect <= check.max_displacement_defect => {
-                    point.time_domain = Some(r);
-                    CheckOutcome::Passed
-                }
-                Ok(r) => {
-                    point.time_domain = Some(r);
-                    CheckOutcome::Failed
-                }
-                Err(VerifyError::NoTimeDomainForm { condition }) => {
-                    CheckOutcome::Unchecked { condition }
-                }
-                Err(e) => CheckOutcome::NotRun(e),
-            }
-        });
+        let problem = (self.problem.system(), self.problem.basis());
+        let (outcome, report) = check_point(&check, problem, point);
+        if outcome == CheckOutcome::Failed {
+            point.label = Some(Label::Unverified);
+        }
+        point.time_domain = report;
+        point.check = Some(outcome);
     }
 
     /// `label` where the point continues the mode's own branch, [`Label::OffBranch`] where

@@ -9,11 +9,12 @@
 //! Harmonic selection ([`RESONANCE_BAND`]) removes them, so that the skeleton converges in
 //! `m` on a bar with an obstacle; on assemblies whose natural frequencies are dense it can
 //! drop harmonics the motion needs (`docs/assemblies.md`). Neither run is better on every
-//! system, so `Auto` runs both and keeps the one with more grid periods covered by good
-//! points of the mode's own branch: points labelled as internal resonances, unverified points
+//! system, so `Auto` runs both and keeps the one with more grid periods covered by converged
+//! points of the mode's own branch: points labelled as internal resonances or off the branch
 //! and failed steps do not count, and an arclength run that visits one period many times
-//! counts it once. It is a proxy (a spike of the truncation whose harmonic 1 dominates counts
-//! as skeleton), which on both exact families keeps the more accurate run at every `m`.
+//! counts it once. It is a proxy, which on both exact families keeps the more accurate run
+//! at every `m`. The time-domain check does not enter it, asked or not: both runs follow the
+//! same branch, and the check does not grade their accuracy ([`crate::branches::judge`]).
 
 use crate::branches::auto::{judged_auto, AutoRun};
 use crate::branches::backbone::{BackboneOptions, PeriodGrid};

@@ -213,11 +213,25 @@ pub enum Event {
         /// Where the largest multiplier of the point before sat.
         crossing: Crossing,
     },
+    /// The point's harmonic content reads as the branch's own, but it does not continue the
+    /// branch its run followed so far: it lies `ratio` times the predicted step from the
+    /// secant through the branch's last two points
+    /// ([`JUMP_RATIO`](crate::branches::JUMP_RATIO)). The point opens a new branch index;
+    /// reported by [`compute`](crate::branches::compute) on the first point of each
+    /// excursion.
+    LeftBranch {
+        /// Distance to the branch's secant prediction over the predicted step.
+        ratio: f64,
+    },
+    /// The run came back to the branch it left at the last
+    /// [`Event::LeftBranch`]: this point continues that branch again, under a new branch
+    /// index.
+    Rejoined,
 }
 
 impl Event {
     /// A short label for tables: `fold`, `jump`, `branch-point`, `grazing+`, `grazing-`,
-    /// `stability-lost`, `stability-gained`.
+    /// `stability-lost`, `stability-gained`, `left-branch`, `rejoined`.
     pub fn label(&self) -> &'static str {
         match self {
             Event::Fold { .. } => "fold",
@@ -227,6 +241,8 @@ impl Event {
             Event::Grazing { contact: false, .. } => "grazing-",
             Event::StabilityLost { .. } => "stability-lost",
             Event::StabilityGained { .. } => "stability-gained",
+            Event::LeftBranch { .. } => "left-branch",
+            Event::Rejoined => "rejoined",
         }
     }
 }

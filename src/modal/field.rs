@@ -1,6 +1,6 @@
 //! Displacement, velocity and strain fields of a harmonic-balance solution anywhere in a bar.
 
-use crate::bem::sinc;
+use crate::bem::sinc_given_sine;
 use crate::fourier::Basis;
 use crate::system::{BarSystem, Layout};
 
@@ -76,7 +76,7 @@ impl<'a, B: Basis> FieldEvaluator<'a, B> {
             let k = b.wavenumber(self.basis.harmonic(i) as f64 * self.omega);
             let (a, bb) = layout.pair(self.x, i, bar);
             let (s, c) = (k * position).sin_cos();
-            let u = a * c + bb * position * sinc(k * position);
+            let u = a * c + bb * position * sinc_given_sine(k * position, s);
             let ux = -a * k * s + bb * c;
             v.displacement += phi[i] * u;
             v.strain += phi[i] * ux;

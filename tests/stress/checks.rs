@@ -35,7 +35,7 @@ impl Checks {
         for e in events {
             match e {
                 Event::Fold { parameter } => self.finite(what, [parameter]),
-                Event::Jump { ratio } => self.finite(what, [ratio]),
+                Event::Jump { ratio } | Event::LeftBranch { ratio } => self.finite(what, [ratio]),
                 _ => {}
             }
         }
