@@ -7,7 +7,7 @@ use nonsmooth_modes::bc::{BoundaryCondition, LinearRows, Quantity, Term};
 use nonsmooth_modes::error::{Error, SettingsError, StabilityError};
 use nonsmooth_modes::modal::{branch_seed, open_mode};
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
-use nonsmooth_modes::stability::{hill, HillOptions, Verdict};
+use nonsmooth_modes::stability::{hill, HillOptions, HillUnresolved, Verdict, HILL_RESIDUAL};
 use nonsmooth_modes::system::{AssemblyBuilder, HarmonicBalanceSettings, NonsmoothSystem};
 
 fn settings(harmonics: usize) -> HarmonicBalanceSettings {
@@ -33,6 +33,33 @@ fn a_motion_without_contact_is_stable_with_its_trivial_exponent() {
     assert!(h.residual < 1e-12, "{}", h.residual);
     assert!(h.trivial_distance.is_some_and(|d| d < 1e-8), "{h:?}");
     assert!(h.time_shift_residual < 1e-12, "{}", h.time_shift_residual);
+    assert_eq!(h.unresolved, None);
+}
+
+/// The same motion with its unknowns perturbed no longer solves the equations: no verdict,
+/// and the reason gives the residual against the bound.
+#[test]
+fn a_point_that_misses_the_equations_says_so() {
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let omega = open_mode(&system, 1).unwrap().omega;
+    let mut problem = NonsmoothSystem::new(&system, settings(10)).unwrap();
+    let seed = branch_seed(&mut problem, 1, 1, omega).unwrap();
+    let x: Vec<f64> = (seed.iter().enumerate())
+        .map(|(i, v)| 0.5 * v + if i == 3 { 1e-3 } else { 0.0 })
+        .collect();
+    let h = hill(&system, settings(10), &x, omega, &HillOptions::default()).unwrap();
+    assert_eq!(h.verdict, Verdict::Unresolved, "{h:?}");
+    match h.unresolved {
+        Some(HillUnresolved::Residual { residual, bound }) => {
+            assert!(
+                residual > bound && bound == HILL_RESIDUAL,
+                "{residual} {bound}"
+            );
+            assert_eq!(residual, h.residual);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(h.unresolved.unwrap().to_string().contains("misses"));
 }
 
 /// A condition whose rows depend on the frequency (an end mass, `-M omega^2 u`) cannot be

@@ -44,7 +44,7 @@ pub const VERIFY_COLUMNS: &str =
 pub const STABILITY_COLUMNS: &str = ",stable,max_multiplier,stability_reason";
 
 /// The columns of `--hill`.
-pub const HILL_COLUMNS: &str = ",hill_stable,hill_max_multiplier";
+pub const HILL_COLUMNS: &str = ",hill_stable,hill_max_multiplier,hill_reason";
 
 fn events(events: &[Event]) -> String {
     events
@@ -231,33 +231,55 @@ pub fn verification_cells(p: &BackbonePoint) -> String {
 /// `UnresolvedReason`, or the error where the multipliers could not be computed (with a
 /// message on stderr). All empty for a point without multipliers.
 pub fn stability_cells(p: &BackbonePoint) -> String {
-    match &p.stability {
-        Some(Ok(f)) => {
-            let reason = f.unresolved.map(|r| csv_text(&r.to_string()));
-            format!(
-                "{},{}",
-                verdict_cells(f.verdict, f.max_multiplier),
-                reason.unwrap_or_default()
+    let outcome = p.stability.as_ref().map(|o| {
+        o.as_ref().map(|f| {
+            (
+                f.verdict,
+                f.max_multiplier,
+                f.unresolved.map(|r| r.to_string()),
             )
-        }
+        })
+    });
+    outcome_cells(p.step, "multipliers", outcome)
+}
+
+/// `,hill_stable,hill_max_multiplier,hill_reason` of a point, as [`stability_cells`] for
+/// `HillSpectrum`.
+pub fn hill_cells(p: &BackbonePoint) -> String {
+    let outcome = p.hill.as_ref().map(|o| {
+        o.as_ref().map(|h| {
+            (
+                h.verdict,
+                h.max_multiplier,
+                h.unresolved.map(|r| r.to_string()),
+            )
+        })
+    });
+    outcome_cells(p.step, "Hill exponents", outcome)
+}
+
+/// A verdict, the largest multiplier and why there is no verdict.
+type Assessed = (Verdict, f64, Option<String>);
+
+/// `,verdict,max_multiplier,reason` of a stability outcome (verdict, largest multiplier and
+/// why there is no verdict), or of the error that prevented it (said on stderr too), or
+/// empty cells where none was asked.
+fn outcome_cells<E: std::fmt::Display>(
+    step: usize,
+    what: &str,
+    outcome: Option<Result<Assessed, E>>,
+) -> String {
+    match outcome {
+        Some(Ok((verdict, max_multiplier, reason))) => format!(
+            "{},{}",
+            verdict_cells(verdict, max_multiplier),
+            reason.map(|r| csv_text(&r)).unwrap_or_default()
+        ),
         Some(Err(e)) => {
-            eprintln!("backbone: no multipliers for step {}: {e}", p.step);
+            eprintln!("backbone: no {what} for step {step}: {e}");
             format!(",,,{}", csv_text(&e.to_string()))
         }
         None => ",,,".to_string(),
-    }
-}
-
-/// `,hill_stable,hill_max_multiplier` of a point, as the first two of [`stability_cells`]
-/// for `HillSpectrum`.
-pub fn hill_cells(p: &BackbonePoint) -> String {
-    match &p.hill {
-        Some(Ok(h)) => verdict_cells(h.verdict, h.max_multiplier),
-        Some(Err(e)) => {
-            eprintln!("backbone: no Hill exponents for step {}: {e}", p.step);
-            ",,".to_string()
-        }
-        None => ",,".to_string(),
     }
 }
 

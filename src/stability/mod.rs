@@ -140,7 +140,8 @@ mod shooting;
 pub use crate::error::StabilityError;
 pub use floquet::{Crossing, Floquet, Multiplier, UnresolvedReason, Verdict};
 pub use hill::{
-    hill, Exponent, HillOptions, HillSpectrum, HILL_RESIDUAL, MAX_HILL_DIMENSION, MIN_ALIGNMENT,
+    hill, Exponent, HillOptions, HillSpectrum, HillUnresolved, HILL_RESIDUAL, MAX_HILL_DIMENSION,
+    MIN_ALIGNMENT,
 };
 
 use crate::bar::shortest_travel_time;

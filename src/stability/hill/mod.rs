@@ -188,6 +188,8 @@ pub struct HillSpectrum {
     /// exponent moves by the perturbation itself). The pair is left out of the verdict;
     /// `None` when no such exponent was found, and the verdict is then unresolved.
     pub trivial_distance: Option<f64>,
+    /// Why there is no verdict (`None` where there is one).
+    pub unresolved: Option<HillUnresolved>,
     /// `|H(0) x'| / (|H(0)|_F |x'|)` with `x'` the time derivative of the point: how nearly
     /// the time shift is an exponent 0 of the truncated system (exactly only for shifts by
     /// whole samples of the laws).
@@ -203,6 +205,49 @@ pub struct HillSpectrum {
     pub refined: usize,
     /// Rows of `H`.
     pub dimension: usize,
+}
+
+/// Why Hill's method gives a point no verdict ([`HillSpectrum::unresolved`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub enum HillUnresolved {
+    /// The point does not solve the full harmonic-balance system (no selection, no kink
+    /// blend): its residual `max |F(x)|` over the largest gap is above the bound
+    /// [`HILL_RESIDUAL`], so the exponents are those of another system.
+    Residual {
+        /// The point's residual.
+        residual: f64,
+        /// The bound.
+        bound: f64,
+    },
+    /// No exponent near 0 has an eigenvector aligned with the time shift to
+    /// [`MIN_ALIGNMENT`]: the trivial pair, which the verdict leaves out, was not found.
+    TrivialMissing {
+        /// The best alignment found (0 where no exponent lies near 0).
+        best_alignment: f64,
+        /// The alignment needed.
+        needed: f64,
+    },
+}
+
+/// One sentence without commas (a CSV cell).
+impl std::fmt::Display for HillUnresolved {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Residual { residual, bound } => write!(
+                f,
+                "the point misses the full harmonic-balance system by {residual:.3e} (bound {bound:.1e})"
+            ),
+            Self::TrivialMissing {
+                best_alignment,
+                needed,
+            } => write!(
+                f,
+                "no exponent near 0 follows the time shift (best alignment {best_alignment:.3} of {needed})"
+            ),
+        }
+    }
 }
 
 /// The Hill exponents of the harmonic-balance point `x` of `system` at fundamental
@@ -267,15 +312,28 @@ pub fn hill(
         .map(|v| v / largest.max(f64::MIN_POSITIVE))
         .collect();
     let dx = shift_of(&unit, m, unit.len() / (2 * m + 1));
-    let trivial = (found.near_zero.iter())
+    let best = (found.near_zero.iter())
         .map(|(e, v)| (e, alignment(v, &dx)))
-        .filter(|(_, a)| *a >= MIN_ALIGNMENT)
         .max_by(|a, b| a.1.total_cmp(&b.1));
+    let trivial = best.filter(|(_, a)| *a >= MIN_ALIGNMENT);
     let trivial_distance = trivial.map(|(e, _)| {
         let away = |z: c64| ((z * period).exp() - 1.0).norm();
         away(*e).max(away(-e))
     });
-    let resolved = residual <= HILL_RESIDUAL && trivial.is_some();
+    let unresolved = if residual.is_nan() || residual > HILL_RESIDUAL {
+        Some(HillUnresolved::Residual {
+            residual,
+            bound: HILL_RESIDUAL,
+        })
+    } else if trivial.is_none() {
+        Some(HillUnresolved::TrivialMissing {
+            best_alignment: best.map_or(0.0, |(_, a)| a),
+            needed: MIN_ALIGNMENT,
+        })
+    } else {
+        None
+    };
+    let resolved = unresolved.is_none();
     let is_trivial = |e: &c64| {
         trivial.is_some_and(|(t, _)| {
             let near = |z: c64| (e - z).norm() <= 1e-6 * omega;
@@ -310,6 +368,7 @@ pub fn hill(
         max_multiplier: largest,
         verdict,
         trivial_distance,
+        unresolved,
         time_shift_residual: time_shift_residual(&matrix, &dx),
         residual,
         search_modulus: options.max_modulus,
