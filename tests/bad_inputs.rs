@@ -9,7 +9,7 @@ use nonsmooth_modes::branches::{
     EnergyBackboneOptions, EnergyGrid, Method, ModeBranches, ParameterSteps, PeriodGrid, Request,
 };
 use nonsmooth_modes::continuation::{
-    linspace, ArclengthOptions, ContinuationProblem, Sequential, SequentialOptions,
+    geomspace, linspace, ArclengthOptions, ContinuationProblem, Sequential, SequentialOptions,
 };
 use nonsmooth_modes::forced::{
     forced_response, Damping, Excitation, Forcing, ResponseMethod, ResponseRequest,
@@ -825,23 +825,49 @@ fn assert_bad_grid(result: Result<ModeBranches, Error>, grid: PeriodGrid, defect
 
 #[test]
 fn bad_continuation_ranges() {
-    let invalid = |r: Result<Vec<f64>, ContinuationError>, what: &str, value: f64| match r {
-        Err(ContinuationError::InvalidOption { what: w, value: v }) => {
-            assert_eq!(w, what);
-            assert!(same(v, value), "{what}: {v} vs {value}");
+    let invalid = |r: Result<Vec<f64>, ContinuationError>,
+                   what: &str,
+                   given: (f64, f64, usize),
+                   defect: RangeDefect| match r {
+        Err(ContinuationError::Range(range)) => {
+            assert_range(&range, what, (given.0, given.1, Some(given.2)), defect)
         }
         other => panic!("{what}: {other:?}"),
     };
     for steps in [0, 1] {
+        let given = (3.9, 3.1, steps);
         invalid(
             linspace(3.9, 3.1, steps),
-            "steps (at least 2)",
-            steps as f64,
+            "grid",
+            given,
+            RangeDefect::SinglePoint,
+        );
+        invalid(
+            geomspace(3.9, 3.1, steps),
+            "geometric grid",
+            given,
+            RangeDefect::SinglePoint,
         );
     }
     for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        invalid(linspace(v, 3.1, 10), "range end", v);
-        invalid(linspace(3.9, v, 10), "range end", v);
+        let not_finite = RangeDefect::NotFinite;
+        invalid(linspace(v, 3.1, 10), "grid", (v, 3.1, 10), not_finite);
+        invalid(linspace(3.9, v, 10), "grid", (3.9, v, 10), not_finite);
+        invalid(
+            geomspace(v, 3.1, 10),
+            "geometric grid",
+            (v, 3.1, 10),
+            not_finite,
+        );
+    }
+    for v in [0.0, -1.0] {
+        let given = (v, 3.1, 10);
+        invalid(
+            geomspace(v, 3.1, 10),
+            "geometric grid",
+            given,
+            RangeDefect::NotPositive,
+        );
     }
     let values = linspace(3.9, 3.1, 5).unwrap();
     assert_eq!(values.len(), 5);
@@ -870,6 +896,16 @@ fn bad_continuation_ranges() {
             value: 0.0
         }
     );
+    // Several values, all equal, would compute one point again and again.
+    match new(vec![0.0; n], vec![1.6; 4]).unwrap_err() {
+        ContinuationError::Range(range) => assert_range(
+            &range,
+            "parameter values",
+            (1.6, 1.6, Some(4)),
+            RangeDefect::Empty,
+        ),
+        other => panic!("{other:?}"),
+    }
     match new(vec![0.0; n], vec![1.0, f64::NAN]).unwrap_err() {
         ContinuationError::InvalidOption { what, value } => {
             assert_eq!(what, "parameter value");

@@ -4,7 +4,7 @@ use super::driver::{next_point, run_with, Admission};
 use super::{
     Branch, ContinuationProblem, EndReason, Observer, Point, RejectReason, Rejection, Step,
 };
-use crate::error::{ContinuationError, SolveError};
+use crate::error::{BadRange, ContinuationError, RangeDefect, SolveError};
 use crate::solve::{failed_point, NonlinearSolver, SolveInfo};
 use std::collections::VecDeque;
 
@@ -129,8 +129,9 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
     ///
     /// # Errors
     /// [`ContinuationError::InvalidOption`] for an empty or non-finite list, or one whose
-    /// step between two successive values overflows; [`ContinuationError::Dimension`] for a
-    /// wrong-sized start.
+    /// step between two successive values overflows; [`ContinuationError::Range`]
+    /// ([`RangeDefect::Empty`]) for several values all equal; [`ContinuationError::Dimension`]
+    /// for a wrong-sized start.
     pub fn new(
         problem: P,
         solver: S,
@@ -157,6 +158,12 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Sequential<'a, P, S> {
                 what: "parameter value (its step from the previous one overflows)",
                 value: w[1],
             });
+        }
+        // Several values, all equal: every step would compute the same point again.
+        let last = values[values.len() - 1];
+        if values.len() >= 2 && values.iter().all(|&v| v == values[0]) {
+            let given = (values[0], last, values.len());
+            return Err(bad_grid("parameter values", given, RangeDefect::Empty));
         }
         if start.len() != problem.dimension() {
             return Err(ContinuationError::Dimension {
@@ -491,24 +498,24 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Iterator for Sequential<'_, P, 
 /// `end - start` overflows).
 ///
 /// # Errors
-/// [`ContinuationError::InvalidOption`] for non-finite ends or fewer than 2 steps;
+/// [`ContinuationError::Range`] for non-finite ends or fewer than 2 steps, quoting them;
 /// [`ContinuationError::TooLarge`] if the `steps` values do not fit in the memory budget
 /// [`MEMORY_BUDGET_BYTES`](crate::fourier::MEMORY_BUDGET_BYTES) (the error carries the bytes
 /// they would need).
 pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
-    for v in [start, end] {
-        if !v.is_finite() {
-            return Err(ContinuationError::InvalidOption {
-                what: "range end",
-                value: v,
-            });
-        }
+    if !(start.is_finite() && end.is_finite()) {
+        return Err(bad_grid(
+            "grid",
+            (start, end, steps),
+            RangeDefect::NotFinite,
+        ));
     }
     if steps < 2 {
-        return Err(ContinuationError::InvalidOption {
-            what: "steps (at least 2)",
-            value: steps as f64,
-        });
+        return Err(bad_grid(
+            "grid",
+            (start, end, steps),
+            RangeDefect::SinglePoint,
+        ));
     }
     crate::fourier::check_memory("the values of a grid", steps as f64)?;
     let last = (steps - 1) as f64;
@@ -528,20 +535,41 @@ pub fn linspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, Continua
         .collect())
 }
 
+/// The grid `what` of `steps` values from `start` to `end`, refused for `defect`.
+fn bad_grid(
+    what: &'static str,
+    (start, end, steps): (f64, f64, usize),
+    defect: RangeDefect,
+) -> ContinuationError {
+    BadRange {
+        what,
+        start,
+        end,
+        steps: Some(steps),
+        defect,
+    }
+    .into()
+}
+
 /// `steps` values from `start` to `end` (both included, exactly) in geometric progression:
 /// equispaced in `ln`, for parameters such as energies that span decades.
 ///
 /// # Errors
-/// [`ContinuationError::InvalidOption`] for an end that is not positive and finite, or
-/// fewer than 2 steps.
+/// [`ContinuationError::Range`] for an end that is not positive and finite, or fewer than 2
+/// steps, quoting them.
 pub fn geomspace(start: f64, end: f64, steps: usize) -> Result<Vec<f64>, ContinuationError> {
-    for v in [start, end] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(ContinuationError::InvalidOption {
-                what: "range end (positive)",
-                value: v,
-            });
-        }
+    let given = (start, end, steps);
+    let defect = if !(start.is_finite() && end.is_finite()) {
+        Some(RangeDefect::NotFinite)
+    } else if !(start > 0.0 && end > 0.0) {
+        Some(RangeDefect::NotPositive)
+    } else if steps < 2 {
+        Some(RangeDefect::SinglePoint)
+    } else {
+        None
+    };
+    if let Some(defect) = defect {
+        return Err(bad_grid("geometric grid", given, defect));
     }
     let mut values: Vec<f64> = linspace(start.ln(), end.ln(), steps)?
         .into_iter()
