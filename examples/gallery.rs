@@ -12,7 +12,8 @@
 //!   checked, as a black line; and the largest multiplier modulus of every point with a
 //!   verdict. CSV
 //!   columns `period,omega_normalized,energy_normalized,verdict,max_multiplier,
-//!   energy_correction` (`verdict`: 1 stable, -1 unstable, 0 unresolved).
+//!   energy_correction` (`verdict`: 1 stable, -1 unstable, 0 unresolved, whose
+//!   `max_multiplier` is NaN).
 //!
 //! - `not_even_clamped.svg` and `.csv`: a periodic motion of the clamped bar that is not
 //!   even in time, which the paper's cosine basis cannot hold. At `T = 3.089` (a period of
@@ -131,7 +132,11 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
             Some(false) => -1.0,
             None => 0.0,
         }),
-        column(&|p| floquet(p).map_or(f64::NAN, |f| f.max_modulus)),
+        // Without a verdict the largest modulus describes no motion: NaN.
+        column(&|p| {
+            let judged = floquet(p).filter(|f| f.verdict.stable().is_some());
+            judged.map_or(f64::NAN, |f| f.max_modulus)
+        }),
         column(&|p| floquet(p).map_or(f64::NAN, |f| f.energy_correction)),
     ];
     let refs: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
