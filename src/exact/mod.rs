@@ -1,0 +1,404 @@
+//! Exact nonsmooth modes: branches of periodic orbits of the exact one-period map of the
+//! time-domain integrator, continued in the period, with a Floquet verdict at every point.
+//!
+//! # Why
+//!
+//! Harmonic balance truncates: its strain jumps carry a Gibbs oscillation, so its points are
+//! only near periodic orbits of the exact map, and correcting each one on its own
+//! ([`stability`](crate::stability)) converges where the truncation happens to be mild. An
+//! exact branch corrects **one** harmonic-balance point (the seed) and then continues the
+//! exact orbit itself: each point starts from the previous exact orbit, so the corrector
+//! starts within the step's change of the motion, not within the truncation's error.
+//!
+//! # The map and its grid
+//!
+//! The map is [`stability`](crate::stability)'s `P_T: X(0) -> X(T)` in the same coordinates
+//! (cell means of `c u_x` and `u_t`, free end displacements), at an instant where every
+//! contact is open. The whole branch uses **one grid** ([`ExactOptions::stability`]'s
+//! `cells_per_travel` is a minimum): the cell count is the smallest from that minimum to
+//! twice it that makes every requested period a whole number of steps, so that the
+//! coordinates never change along the branch (the monodromy of one point is the corrector's
+//! matrix at the next) and no period ends with a fractional step (which would project the
+//! waves onto the cells and blur the multipliers). Where no count makes them whole, the
+//! periods are rounded to whole steps ([`ExactPoint::requested_period`] keeps the grid's);
+//! the clamped bar's grid `3.95 -> 3.05` is whole at 200 cells, the free–free bar's
+//! `1.975 -> 1.525` at 400.
+//!
+//! # Predictor and corrector
+//!
+//! The period is the continuation parameter; the energy is measured on the orbit found. The
+//! predictor is the secant through the last two orbits in `(X, T)` (the previous orbit alone
+//! after a seed or a gap). The corrector takes minimum-norm steps `(M - I) d = X - P_T(X)`
+//! over the singular values above `1e-4` of the largest, with `M` the **previous orbit's
+//! monodromy**, factored once (a chord method): each step costs one march instead of the
+//! `2 n` of a fresh matrix. Where a step does not halve the defect, `M` is recomputed at the
+//! current state (at most [`ExactOptions::refreshes`] times per point). The minimum-norm step
+//! is orthogonal to the singular directions of `M - I`: the time shift (so no phase condition
+//! is needed) and the waves that free flight carries back onto themselves over the period,
+//! which would change the motion rather than correct it. A point counts when its defect
+//! `|P(X) - X| / |X|` is at most [`RESOLVED_DEFECT`](crate::stability::RESOLVED_DEFECT).
+//!
+//! The section drifts along the orbit from point to point (the steps have no phase
+//! condition); where its smallest gap falls below a quarter of the law's gap, the state is
+//! moved to the widest-open instant of its orbit again before its monodromy is computed.
+//!
+//! # Events: another family, a lost branch
+//!
+//! A corrected orbit whose energy leaves the secant's prediction by more than the predicted
+//! change plus [`ExactOptions::max_energy_jump`] (without a secant, by more than
+//! [`ExactOptions::first_step_jump`]) has jumped onto another family of periodic orbits (they
+//! meet at branch points, and at a fixed period the map has several near one another): it is
+//! corrected once more from the previous orbit with a fresh matrix, and if it still jumps,
+//! or the correction fails, the branch is **lost** at that period. It is then reseeded from
+//! the harmonic-balance point at that period (a new [`BackbonePoint::branch`] index and an
+//! [`Event::Jump`] on its first point); where that fails too the period is skipped with its
+//! reason ([`ExactBranch::skipped`]), and after [`ExactOptions::max_lost`] consecutive skipped
+//! periods the walk ends ([`ExactEnd::Lost`]), keeping its points. The seed is the first grid
+//! period whose harmonic-balance point corrects to an orbit within the seed bounds of
+//! [`StabilityOptions`] (energy and displacement); the walk goes forward from it, then back
+//! to the grid's first period.
+//!
+//! # The verdict
+//!
+//! One monodromy per point, at the corrected orbit: its eigenvalues give the verdict exactly
+//! as [`floquet_of_state`](crate::stability::floquet_of_state) does (trivial pair, other steps
+//! where it is missed, tolerance), and its factored `M - I` is the next point's corrector.
+//! Where the integrator merged wave pieces over the period (incommensurate travel times,
+//! chattering), the energy removed is reported ([`ExactPoint::removed_energy`]) and the point
+//! gets a verdict only below [`ExactOptions::max_removed_energy`]
+//! ([`UnresolvedReason::Merged`](crate::stability::UnresolvedReason::Merged) beyond).
+//!
+//! # Cost
+//!
+//! Per point: one monodromy (`2 n` marches of a period, parallel with the `parallel`
+//! feature), its eigenvalues and one singular value decomposition, a few single marches for
+//! the chord steps, and a fresh monodromy where the chord stalls. The seed costs a shooting
+//! correction (several monodromies).
+
+mod corrector;
+mod grid;
+mod walk;
+
+use crate::branches::{
+    compute, BackboneOptions, BackbonePoint, Method, ModeBranches, PeriodGrid, Request,
+};
+use crate::continuation::linspace;
+use crate::error::{Error, SettingsError};
+use crate::stability::{StabilityError, StabilityOptions, UnresolvedReason, MAX_MARCH_STEPS};
+use crate::system::BarSystem;
+use crate::verify::{Model, State};
+use walk::{Seed, Walker};
+
+/// Options of [`exact_branch`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactOptions {
+    /// The grid (`cells_per_travel`, a minimum here), differences, tolerance and spring
+    /// update of the map, and the seed's correction: `corrections` fresh monodromies at most,
+    /// within `max_energy_correction` and `max_displacement_correction` of the
+    /// harmonic-balance point.
+    pub stability: StabilityOptions,
+    /// Corrector steps per point, chord and fresh (default 12).
+    pub iterations: usize,
+    /// Fresh monodromies per continued point where the chord stalls (default 2).
+    pub refreshes: usize,
+    /// How far, relative to the previous energy, an orbit's energy may leave the secant's
+    /// prediction beyond the predicted change (default `0.02`).
+    pub max_energy_jump: f64,
+    /// How far, relative, the energy may move in a step without a secant (default `0.25`).
+    pub first_step_jump: f64,
+    /// Harmonic-balance points tried for the seed (default 8).
+    pub seed_attempts: usize,
+    /// Consecutive periods skipped before the walk ends (default 3).
+    pub max_lost: usize,
+    /// The largest energy the integrator's merges may remove over one period, relative to
+    /// the motion's, for a verdict (default `1e-6`: the merges then move the state by about
+    /// `sqrt(1e-6) = 1e-3` of its norm, the verdict's tolerance).
+    pub max_removed_energy: f64,
+}
+
+impl Default for ExactOptions {
+    fn default() -> Self {
+        Self {
+            stability: StabilityOptions::default(),
+            iterations: 12,
+            refreshes: 2,
+            max_energy_jump: 0.02,
+            first_step_jump: 0.25,
+            seed_attempts: 8,
+            max_lost: 3,
+            max_removed_energy: 1e-6,
+        }
+    }
+}
+
+impl ExactOptions {
+    fn check(&self) -> Result<(), StabilityError> {
+        self.stability.check()?;
+        let checks = [
+            ("max_energy_jump", self.max_energy_jump),
+            ("first_step_jump", self.first_step_jump),
+            ("max_removed_energy", self.max_removed_energy),
+        ];
+        for (what, value) in checks {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(StabilityError::InvalidOption {
+                    what,
+                    expected: "finite and non-negative",
+                    value,
+                });
+            }
+        }
+        let counts = [
+            ("iterations", self.iterations),
+            ("seed_attempts", self.seed_attempts),
+            ("max_lost", self.max_lost),
+        ];
+        for (what, value) in counts {
+            if value == 0 {
+                return Err(StabilityError::InvalidOption {
+                    what,
+                    expected: "at least 1",
+                    value: 0.0,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One point of an exact branch: a [`BackbonePoint`] (its `x` is empty: the motion is no
+/// harmonic-balance solution; its `time_domain` is the orbit's own periodicity report, its
+/// `stability` the verdict of its monodromy, its `label` that of the harmonic-balance point
+/// its segment was seeded from) and what only an exact point has.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ExactPoint {
+    /// The point; its `period` is the map's, a whole number of grid steps.
+    pub point: BackbonePoint,
+    /// The period of the requested grid it stands for.
+    pub requested_period: f64,
+    /// `(E - E_hb) / E_hb` against the converged harmonic-balance point at the same grid
+    /// period (`None` where there is none).
+    pub harmonic_balance_distance: Option<f64>,
+    /// Energy the integrator's merges removed over one period, relative to the motion's.
+    pub removed_energy: f64,
+    /// Contact intervals per period of each unilateral condition (model order).
+    pub contacts: Vec<usize>,
+    /// Whether the point was corrected from a harmonic-balance point (a seed or a reseed)
+    /// rather than continued.
+    pub seeded: bool,
+}
+
+/// Why a period has no exact point, or why a seed failed.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum LossReason {
+    /// No converged harmonic-balance point at the period to seed from.
+    NoHarmonicBalancePoint,
+    /// The correction did not reach a periodic orbit near the start (its reason, with the
+    /// numbers).
+    Correction(UnresolvedReason),
+    /// The orbit found jumped: its energy left the prediction by `change` (relative to the
+    /// previous energy), more than `allowed`.
+    Jump {
+        /// `|E - E_predicted| / E_previous`.
+        change: f64,
+        /// The bound at that step.
+        allowed: f64,
+    },
+    /// The map could not be marched or its matrices decomposed.
+    Error(
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] StabilityError,
+    ),
+}
+
+impl std::fmt::Display for LossReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NoHarmonicBalancePoint => f.write_str("no converged harmonic-balance point"),
+            Self::Correction(reason) => write!(f, "{reason}"),
+            Self::Jump { change, allowed } => write!(
+                f,
+                "the orbit found left the prediction by {:.2} % of the energy (allowed {:.2} %)",
+                100.0 * change,
+                100.0 * allowed
+            ),
+            Self::Error(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// A requested period without an exact point.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Skipped {
+    /// The map's period.
+    pub period: f64,
+    /// Why, after the reseed failed.
+    pub reason: LossReason,
+}
+
+/// Why an exact branch ended.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum ExactEnd {
+    /// Every period of the grid was visited (some may be [`ExactBranch::skipped`]).
+    Completed,
+    /// No harmonic-balance point corrected to a seed: `attempts` were tried, the last
+    /// failing for `last`.
+    NoSeed {
+        /// Points tried.
+        attempts: usize,
+        /// Why the last one failed.
+        last: LossReason,
+    },
+    /// The branch was lost at `period` and could not be reseeded at it or the periods after
+    /// it (`attempts` in a row): the walk in that direction stopped there.
+    Lost {
+        /// The last period tried.
+        period: f64,
+        /// Consecutive periods skipped.
+        attempts: usize,
+        /// Why the last one was skipped.
+        last: LossReason,
+    },
+}
+
+/// An exact branch: its points in grid order, the periods it skipped and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ExactBranch {
+    /// The first grazing energy `E_g` the energies are normalised by.
+    pub grazing_energy: f64,
+    /// The time step of the branch's grid.
+    pub dt: f64,
+    /// Rows of each monodromy matrix.
+    pub dimension: usize,
+    /// The points, in the order of the grid.
+    pub points: Vec<ExactPoint>,
+    /// The periods without a point, and why.
+    pub skipped: Vec<Skipped>,
+    /// Why the walk ended.
+    pub end: ExactEnd,
+}
+
+/// The period grid of `request`: its method's, or the system's default for the mode
+/// ([`BackboneOptions::for_mode`]) where the method carries none (arclength, energy).
+fn period_grid(system: &BarSystem, request: &Request) -> Result<PeriodGrid, Error> {
+    Ok(match request.method {
+        Method::Auto(Some(o)) | Method::PeriodGrid(o) | Method::GenuineSubharmonic(o) => o.grid,
+        _ => BackboneOptions::for_mode(system, request.mode, request.subharmonic)?.grid,
+    })
+}
+
+/// The exact branch of `request`'s mode over its period grid: the harmonic-balance run of
+/// `request` ([`compute`], without its stability and Hill exponents), then
+/// [`exact_branch_from`] it.
+///
+/// # Errors
+/// A bad grid ([`SettingsError::Range`]) or options ([`StabilityError::InvalidOption`])
+/// before anything is computed; those of [`compute`]; those of [`exact_branch_from`].
+pub fn exact_branch(
+    system: &BarSystem,
+    request: &Request,
+    options: &ExactOptions,
+) -> Result<ExactBranch, Error> {
+    let grid = period_grid(system, request)?;
+    grid.validate().map_err(SettingsError::from)?;
+    options.check()?;
+    let harmonic_balance = Request {
+        stability: None,
+        hill: None,
+        ..request.clone()
+    };
+    exact_branch_from(&compute(system, &harmonic_balance)?, &grid, options)
+}
+
+/// The exact branch over `grid`, seeded by the converged points of the harmonic-balance run
+/// `run` (the point nearest each grid period, within half a step). See the
+/// [module docs](self).
+///
+/// # Errors
+/// [`SettingsError::Range`] for a bad grid; [`StabilityError::InvalidOption`] for bad
+/// options; [`StabilityError::TooLarge`] and [`StabilityError::TooCostly`] for a grid whose
+/// matrices or marches exceed the limits of [`stability`](crate::stability);
+/// [`VerifyError`](crate::verify::VerifyError) for a system the integrator cannot march.
+/// A seed or a point that fails is no error: the branch says why
+/// ([`ExactBranch::end`], [`ExactBranch::skipped`]).
+pub fn exact_branch_from(
+    run: &ModeBranches,
+    grid: &PeriodGrid,
+    options: &ExactOptions,
+) -> Result<ExactBranch, Error> {
+    grid.validate().map_err(SettingsError::from)?;
+    options.check()?;
+    let requested = linspace(grid.start, grid.end, grid.steps)?;
+    let problem = run.problem();
+    let (system, basis) = (problem.system(), problem.basis());
+    let model = Model::from_system(system)?;
+    let branch = grid::branch_grid(&model, &requested, options.stability.cells_per_travel)?;
+    let dt = branch.grid.dt();
+    let coordinates = crate::stability::coordinates::Coordinates::new(&model, &branch.grid);
+    crate::stability::check_dimension(&coordinates, options.stability.cells_per_travel)?;
+    let longest = branch.periods.iter().fold(0.0f64, |m, t| m.max(*t));
+    let steps = 2.0
+        * coordinates.len() as f64
+        * (longest / dt).ceil()
+        * (2.0 + options.refreshes.max(options.stability.corrections) as f64);
+    if steps.is_nan() || steps > MAX_MARCH_STEPS {
+        return Err(StabilityError::TooCostly {
+            steps,
+            dimension: coordinates.len(),
+            corrections: options.refreshes.max(options.stability.corrections),
+            limit: MAX_MARCH_STEPS,
+        }
+        .into());
+    }
+    let half_step = 0.5 * (grid.end - grid.start).abs() / (grid.steps - 1) as f64;
+    let harmonic_balance: Vec<Option<&BackbonePoint>> = requested
+        .iter()
+        .map(|t| {
+            run.points
+                .iter()
+                .filter(|p| p.converged && (p.period - t).abs() <= half_step)
+                .min_by(|a, b| (a.period - t).abs().total_cmp(&(b.period - t).abs()))
+        })
+        .collect();
+    let seeds = |j: usize| -> Option<Result<Seed, StabilityError>> {
+        let p = harmonic_balance[j]?;
+        Some(
+            State::from_harmonic_balance(system, basis, &p.x, p.omega, 0.0, dt)
+                .map(|state| Seed {
+                    state,
+                    label: p.label.clone(),
+                })
+                .map_err(StabilityError::from),
+        )
+    };
+    // Any state of the grid: the map takes its model and grid.
+    let template = coordinates.to_state(&model, &branch.grid, &vec![0.0; coordinates.len()])?;
+    let walker = Walker {
+        coordinates: &coordinates,
+        template: &template,
+        periods: &branch.periods,
+        requested: &requested,
+        harmonic_balance: &harmonic_balance
+            .iter()
+            .map(|p| p.map(|p| p.energy))
+            .collect::<Vec<_>>(),
+        seeds: &seeds,
+        options,
+        grazing_energy: run.grazing_energy,
+    };
+    let (points, skipped, end) = walker.walk();
+    Ok(ExactBranch {
+        grazing_energy: run.grazing_energy,
+        dt,
+        dimension: coordinates.len(),
+        points,
+        skipped,
+        end,
+    })
+}
