@@ -44,9 +44,10 @@
 //!
 //! # Events: another family, a lost branch
 //!
-//! A corrected orbit whose energy leaves the secant's prediction by more than the predicted
-//! change plus [`ExactOptions::max_energy_jump`] (without a secant, by more than
-//! [`ExactOptions::first_step_jump`]) has jumped onto another family of periodic orbits (they
+//! A corrected orbit whose energy leaves the predicted energy (the secant's; without a
+//! secant, the previous energy times harmonic balance's ratio between the two periods) by more
+//! than the predicted change plus [`ExactOptions::max_energy_jump`] (by more than
+//! [`ExactOptions::first_step_jump`] where nothing predicts a change) has jumped onto another family of periodic orbits (they
 //! meet at branch points, and at a fixed period the map has several near one another): it is
 //! corrected once more from the previous orbit with a fresh matrix, and if it still jumps,
 //! or the correction fails, the branch is **lost** at that period. It is then reseeded from
@@ -77,6 +78,7 @@
 
 mod corrector;
 mod grid;
+mod point;
 mod walk;
 
 use crate::branches::{

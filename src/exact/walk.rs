@@ -3,23 +3,17 @@
 
 use super::corrector::{correct, Limits, Outcome};
 use super::{ExactEnd, ExactOptions, ExactPoint, LossReason, Skipped};
-use crate::branches::{BackbonePoint, CheckOutcome, PointStatus};
 use crate::continuation::Event;
-use crate::fourier::frequency_of_period;
 use crate::modal::Label;
 use crate::solve::norm;
 use crate::stability::coordinates::Coordinates;
 use crate::stability::monodromy::PeriodMap;
 use crate::stability::shooting::{Corrected, PseudoInverse};
 use crate::stability::{
-    correction_failure, judge, open_section, Floquet, StabilityError, UnresolvedReason, Verdict,
+    correction_failure, open_section, Floquet, StabilityError, UnresolvedReason, Verdict,
     RESOLVED_DEFECT,
 };
-use crate::verify::{march, periodicity_of_state, MarchOptions, PeriodicityOptions, State};
-
-/// A state whose smallest gap, relative to its law's, is below this is moved to the
-/// widest-open instant of its orbit.
-const MIN_OPEN_GAP: f64 = 0.25;
+use crate::verify::State;
 
 /// A harmonic-balance point's state at `t = 0` on the branch's grid, and its label.
 pub(crate) struct Seed {
@@ -29,12 +23,14 @@ pub(crate) struct Seed {
 
 /// An exact orbit: its section state, period, energy, label and factored monodromy.
 #[derive(Clone)]
-struct Orbit {
-    x: Vec<f64>,
-    period: f64,
-    energy: f64,
-    label: Option<Label>,
-    jacobian: PseudoInverse,
+pub(super) struct Orbit {
+    /// Its index in the grid.
+    pub index: usize,
+    pub x: Vec<f64>,
+    pub period: f64,
+    pub energy: f64,
+    pub label: Option<Label>,
+    pub jacobian: PseudoInverse,
 }
 
 /// What a walk needs: the coordinates and grid, the periods (the map's and the requested
@@ -51,7 +47,7 @@ pub(crate) struct Walker<'a> {
 }
 
 impl Walker<'_> {
-    fn map(&self, period: f64) -> PeriodMap<'_> {
+    pub(super) fn map(&self, period: f64) -> PeriodMap<'_> {
         PeriodMap {
             coordinates: self.coordinates,
             template: self.template,
@@ -60,23 +56,65 @@ impl Walker<'_> {
         }
     }
 
-    fn energy(&self, x: &[f64]) -> Result<f64, StabilityError> {
+    pub(super) fn energy(&self, x: &[f64]) -> Result<f64, StabilityError> {
         Ok(self.coordinates.energy(self.template, x)?)
     }
 
-    /// The seed, the walk forward from it, then back to the grid's first period.
+    /// Segments until the grid is covered: a seed at the first period from `next` whose
+    /// harmonic-balance point corrects, the walk back from it to `next`, then forward until
+    /// the branch is lost for good; the next segment starts after the period where it was.
     pub(crate) fn walk(&self) -> (Vec<ExactPoint>, Vec<Skipped>, ExactEnd) {
         let n = self.periods.len();
+        let (mut points, mut skipped) = (Vec::new(), Vec::new());
+        let (mut next, mut branch) = (0, 0);
+        let mut end = ExactEnd::Completed;
+        while next < n {
+            let (found, attempts, last) = self.find_seed(next);
+            let Some((s, orbit, mut point)) = found else {
+                end = match points.is_empty() {
+                    true => ExactEnd::NoSeed { attempts, last },
+                    false => ExactEnd::Lost {
+                        period: self.periods[next],
+                        attempts,
+                        last,
+                    },
+                };
+                break;
+            };
+            point.point.branch = branch;
+            points.push(point);
+            let back = (next..s).rev();
+            self.walk_from(orbit.clone(), back, &mut branch, &mut points, &mut skipped);
+            match self.walk_from(orbit, s + 1..n, &mut branch, &mut points, &mut skipped) {
+                None => break,
+                Some((j, last)) => {
+                    (next, branch) = (j + 1, branch + 1);
+                    let attempts = self.options.max_lost;
+                    let period = self.periods[j];
+                    end = ExactEnd::Lost {
+                        period,
+                        attempts,
+                        last,
+                    };
+                }
+            }
+        }
+        points.sort_by_key(|p| p.point.step);
+        stability_events(&mut points);
+        (points, skipped, end)
+    }
+
+    /// The first period from `from` whose harmonic-balance point corrects to a seed, within
+    /// [`ExactOptions::seed_attempts`] failures: its index, orbit and point, with the failures
+    /// counted and the last one's reason.
+    #[allow(clippy::type_complexity)]
+    fn find_seed(&self, from: usize) -> (Option<(usize, Orbit, ExactPoint)>, usize, LossReason) {
         let mut attempts = 0;
         let mut last = LossReason::NoHarmonicBalancePoint;
-        let mut seeded = None;
-        for j in 0..n {
+        for j in from..self.periods.len() {
             match self.seed(j) {
-                Ok(found) => {
-                    seeded = Some((j, found));
-                    break;
-                }
-                Err(LossReason::NoHarmonicBalancePoint) => continue,
+                Ok((orbit, point)) => return (Some((j, orbit, point)), attempts, last),
+                Err(LossReason::NoHarmonicBalancePoint) => {}
                 Err(reason) => {
                     attempts += 1;
                     last = reason;
@@ -86,28 +124,11 @@ impl Walker<'_> {
                 }
             }
         }
-        let Some((s, (orbit, point))) = seeded else {
-            let end = ExactEnd::NoSeed { attempts, last };
-            return (Vec::new(), Vec::new(), end);
-        };
-        let mut points = vec![point];
-        let mut skipped = Vec::new();
-        let mut branch = 0;
-        let forward = self.walk_from(
-            orbit.clone(),
-            s + 1..n,
-            &mut branch,
-            &mut points,
-            &mut skipped,
-        );
-        let backward = self.walk_from(orbit, (0..s).rev(), &mut branch, &mut points, &mut skipped);
-        points.sort_by_key(|p| p.point.step);
-        stability_events(&mut points);
-        let end = forward.or(backward).unwrap_or(ExactEnd::Completed);
-        (points, skipped, end)
+        (None, attempts, last)
     }
 
-    /// Continues from `orbit` over `indices`; `Some` end where the branch was lost for good.
+    /// Continues from `orbit` over `indices`, reseeding where the branch is lost; the index
+    /// and reason where it was lost [`ExactOptions::max_lost`] times in a row.
     fn walk_from(
         &self,
         orbit: Orbit,
@@ -115,7 +136,7 @@ impl Walker<'_> {
         branch: &mut usize,
         points: &mut Vec<ExactPoint>,
         skipped: &mut Vec<Skipped>,
-    ) -> Option<ExactEnd> {
+    ) -> Option<(usize, LossReason)> {
         let (mut last, mut before): (Orbit, Option<Orbit>) = (orbit, None);
         let mut lost = 0;
         for j in indices {
@@ -144,11 +165,7 @@ impl Walker<'_> {
                     skipped.push(Skipped { period, reason });
                     lost += 1;
                     if lost >= self.options.max_lost {
-                        return Some(ExactEnd::Lost {
-                            period,
-                            attempts: lost,
-                            last: seed_failure,
-                        });
+                        return Some((j, seed_failure));
                     }
                 }
             }
@@ -166,8 +183,9 @@ impl Walker<'_> {
             open_section(&seed.state, period, stability.spring).map_err(LossReason::Error)?;
         let mut base = Vec::new();
         self.coordinates.of_snapshot(&section.snapshot(), &mut base);
+        // Chord steps as along the branch, fresh matrices only where they stall.
         let limits = Limits {
-            iterations: stability.corrections,
+            iterations: stability.corrections + self.options.iterations,
             refreshes: stability.corrections,
             relative_step: stability.relative_step,
             tolerance: crate::stability::PERIODIC_DEFECT,
@@ -204,13 +222,16 @@ impl Walker<'_> {
                     .collect();
                 (x, last.energy + s * (last.energy - b.energy))
             }
-            None => (last.x.clone(), last.energy),
+            // Without a secant, harmonic balance's change of energy, where it has both points.
+            None => match (self.harmonic_balance[j], self.harmonic_balance[last.index]) {
+                (Some(e), Some(e_last)) => (last.x.clone(), last.energy * e / e_last),
+                _ => (last.x.clone(), last.energy),
+            },
         };
-        let allowed = match before {
-            Some(_) => {
-                (predicted_energy - last.energy).abs() / last.energy + self.options.max_energy_jump
-            }
-            None => self.options.first_step_jump,
+        let predicted_change = (predicted_energy - last.energy).abs() / last.energy;
+        let allowed = match (before, predicted_change > 0.0) {
+            (None, false) => self.options.first_step_jump,
+            _ => predicted_change + self.options.max_energy_jump,
         };
         let limits = Limits {
             iterations: self.options.iterations,
@@ -257,7 +278,7 @@ impl Walker<'_> {
     }
 
     /// The correction `outcome` from `start` (of energy `energy`), as [`Corrected`].
-    fn corrected(
+    pub(super) fn corrected(
         &self,
         outcome: &Outcome,
         start: &[f64],
@@ -275,124 +296,6 @@ impl Walker<'_> {
             iterations: outcome.iterations,
         })
     }
-
-    /// The point of the periodic orbit `outcome` at grid period `j`, corrected from `start`:
-    /// its section moved to an open instant where needed, its monodromy, verdict, periodicity
-    /// report and contacts. `context`: its label, the previous period, whether it is a seed.
-    fn finish(
-        &self,
-        j: usize,
-        mut outcome: Outcome,
-        start: (&[f64], f64),
-        context: (Option<Label>, Option<f64>, bool),
-    ) -> Result<(Orbit, ExactPoint), StabilityError> {
-        let period = self.periods[j];
-        let stability = &self.options.stability;
-        let (model, grid) = (self.template.model(), self.template.grid());
-        let mut state = self.coordinates.to_state(model, grid, &outcome.x)?;
-        if open_gap(&state) < MIN_OPEN_GAP {
-            state = open_section(&state, period, stability.spring)?;
-            self.coordinates
-                .of_snapshot(&state.snapshot(), &mut outcome.x);
-        }
-        let map = self.map(period);
-        let monodromy = map.monodromy(&outcome.x, stability.relative_step)?;
-        let options = PeriodicityOptions {
-            dt: grid.dt(),
-            adjust_grid: false,
-            spring: stability.spring,
-            periods: 1,
-        };
-        let report = periodicity_of_state(&state, period, &options)?;
-        let removed = report.projected_energy;
-        let failure =
-            (removed > self.options.max_removed_energy).then_some(UnresolvedReason::Merged {
-                removed,
-                bound: self.options.max_removed_energy,
-            });
-        let corrected = self.corrected(&outcome, start.0, start.1)?;
-        let floquet = judge(&map, &corrected, &monodromy, failure, stability)?;
-        let energy = self.energy(&outcome.x)?;
-        let (label, previous, seeded) = context;
-        let status = PointStatus::Converged.with_energy(energy, energy / self.grazing_energy);
-        let point = BackbonePoint {
-            step: j,
-            period,
-            omega: frequency_of_period(period),
-            energy,
-            energy_normalized: energy / self.grazing_energy,
-            converged: status == PointStatus::Converged,
-            status,
-            residual_norm: outcome.defect,
-            iterations: outcome.iterations,
-            x: Vec::new(),
-            step_size: previous.map_or(0.0, |t| period - t),
-            events: Vec::new(),
-            branch: 0,
-            time_domain: Some(report),
-            check: Some(CheckOutcome::Passed),
-            character: None,
-            label: label.clone(),
-            stability: Some(Ok(floquet)),
-            hill: None,
-        };
-        let exact = ExactPoint {
-            point,
-            requested_period: self.requested[j],
-            harmonic_balance_distance: self.harmonic_balance[j].map(|e| (energy - e) / e),
-            removed_energy: removed,
-            contacts: contacts(&state, period, stability.spring)?,
-            seeded,
-        };
-        let orbit = Orbit {
-            x: outcome.x,
-            period,
-            energy,
-            label,
-            jacobian: PseudoInverse::of_monodromy(&monodromy)?,
-        };
-        Ok((orbit, exact))
-    }
-}
-
-/// The smallest gap of `state`'s unilateral conditions relative to their laws' gaps (`inf`
-/// without any).
-fn open_gap(state: &State) -> f64 {
-    (0..state.model().conditions().len())
-        .filter_map(|i| {
-            let law = crate::stability::law_gap(state.model(), i).abs();
-            state.gap(i).map(|g| g / law.max(f64::MIN_POSITIVE))
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// Contact intervals per period of each unilateral condition: the runs of steps with a
-/// positive contact force, counted around the period.
-fn contacts(
-    state: &State,
-    period: f64,
-    spring: crate::verify::SpringUpdate,
-) -> Result<Vec<usize>, StabilityError> {
-    let options = MarchOptions {
-        spring,
-        snapshot_every: 0,
-    };
-    let trajectory = march(state, period, &options)?;
-    Ok(trajectory
-        .contacts
-        .iter()
-        .map(|h| {
-            let pressed: Vec<bool> = h.force.iter().map(|f| *f > 0.0).collect();
-            let starts = (0..pressed.len())
-                .filter(|&k| pressed[k] && !pressed[(k + pressed.len() - 1) % pressed.len()])
-                .count();
-            if starts == 0 && pressed.iter().all(|p| *p) && !pressed.is_empty() {
-                1
-            } else {
-                starts
-            }
-        })
-        .collect())
 }
 
 /// Adds [`Event::StabilityLost`] and [`Event::StabilityGained`] where the verdict changes

@@ -1,12 +1,13 @@
 //! The verdict of a corrected state from its monodromy: shared by [`floquet_of_state`] and
 //! the exact branches of [`crate::exact`], which correct their states themselves.
 //!
+//! [`STEP_FACTORS`]: super::STEP_FACTORS
+//!
 //! [`floquet_of_state`]: super::floquet_of_state
 
 use super::floquet::{self, MapShape, Multiplier, TrivialPair};
 use super::monodromy::{Monodromy, PeriodMap};
 use super::shooting::Corrected;
-use super::STEP_FACTORS;
 use super::{Floquet, StabilityError, StabilityOptions, UnresolvedReason, RESOLVED_DEFECT};
 
 /// Why the correction `corrected` does not count, in the order of the checks: its state is
@@ -46,13 +47,15 @@ pub(crate) fn correction_failure(
 /// The multipliers and verdict of the state `corrected` of `map`, from `monodromy` (at the
 /// corrected state where `failure` is `None`, at the point's own state otherwise), without
 /// the `spurious` exact multipliers 1 of the coordinates. Where the trivial pair is missed,
-/// the differences are retried with the steps of [`STEP_FACTORS`] and the best pair kept.
+/// the differences are retried with the steps `retries` (relative to the options' step; the
+/// shooting correction's are [`STEP_FACTORS`]) and the best pair kept.
 pub(crate) fn judge(
     map: &PeriodMap,
     corrected: &Corrected,
     monodromy: &Monodromy,
     failure: Option<UnresolvedReason>,
     options: &StabilityOptions,
+    retries: &[f64],
 ) -> Result<Floquet, StabilityError> {
     let spurious = map.coordinates.spurious_unit_multipliers();
     let periodic = failure.is_none();
@@ -73,7 +76,7 @@ pub(crate) fn judge(
     // miss it, a step that adds or removes a near-grazing impact made them inaccurate: a
     // ten times larger step steps over it, a ten times smaller one stays within the piece.
     if periodic {
-        for factor in STEP_FACTORS {
+        for factor in retries {
             if pair.found(options.tolerance) {
                 break;
             }

@@ -361,7 +361,14 @@ pub fn floquet_of_state(
         Some(at_corrected) if failure.is_none() => at_corrected,
         _ => at_base,
     };
-    judge(&map, &corrected, &monodromy, failure, options)
+    judge(
+        &map,
+        &corrected,
+        &monodromy,
+        failure,
+        options,
+        &STEP_FACTORS,
+    )
 }
 
 /// [`StabilityError::TooLarge`] for more than [`MAX_DIMENSION`] coordinates.
