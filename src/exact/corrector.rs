@@ -21,6 +21,8 @@ pub(crate) struct Limits {
     pub relative_step: f64,
     /// The defect `|P(x) - x| / |x|` at which the correction stops.
     pub tolerance: f64,
+    /// The largest norm of a step (a trust radius): a longer one is shortened to it.
+    pub max_step: f64,
 }
 
 /// Where a correction ended.
@@ -40,7 +42,9 @@ pub(crate) struct Outcome {
 /// Corrects `x0` towards `P(x) = x` by minimum-norm steps `(M - I) d = x - P(x)`, with `M`
 /// the monodromy factored in `jacobian` (the previous orbit's, or `None`). Where a step does
 /// not contract the defect by [`CONTRACTION`], `M` is recomputed at the current state (at
-/// most `limits.refreshes` times); `jacobian` holds the last matrix used.
+/// most `limits.refreshes` times); `jacobian` holds the last matrix used. Steps longer than
+/// `limits.max_step` are shortened: near a point the map has other periodic orbits, and a
+/// long step from a prediction in another piece of the map lands on one of them.
 pub(crate) fn correct(
     map: &PeriodMap,
     x0: &[f64],
@@ -68,7 +72,11 @@ pub(crate) fn correct(
             break;
         };
         let rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-        let d = inverse.solve(&rhs);
+        let mut d = inverse.solve(&rhs);
+        let length = norm(&d);
+        if length > limits.max_step {
+            d.iter_mut().for_each(|v| *v *= limits.max_step / length);
+        }
         iterations += 1;
         match line_step(map, &x, &d, defect, &mut trial_r)? {
             Some((next, next_defect)) => {

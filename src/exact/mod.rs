@@ -99,7 +99,7 @@ pub struct ExactOptions {
     /// within `max_energy_correction` and `max_displacement_correction` of the
     /// harmonic-balance point.
     pub stability: StabilityOptions,
-    /// Corrector steps per point, chord and fresh (default 12).
+    /// Corrector steps per point, chord and fresh (default 20).
     pub iterations: usize,
     /// Fresh monodromies per continued point where the chord stalls (default 2).
     pub refreshes: usize,
@@ -122,7 +122,7 @@ impl Default for ExactOptions {
     fn default() -> Self {
         Self {
             stability: StabilityOptions::default(),
-            iterations: 12,
+            iterations: 20,
             refreshes: 2,
             max_energy_jump: 0.02,
             first_step_jump: 0.25,

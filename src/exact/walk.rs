@@ -15,6 +15,9 @@ use crate::stability::{
 };
 use crate::verify::State;
 
+/// The smallest trust radius of a continued point's corrector, relative to the state.
+const TRUST: f64 = 1e-2;
+
 /// A harmonic-balance point's state at `t = 0` on the branch's grid, and its label.
 pub(crate) struct Seed {
     pub state: State,
@@ -189,6 +192,7 @@ impl Walker<'_> {
             refreshes: stability.corrections,
             relative_step: stability.relative_step,
             tolerance: crate::stability::PERIODIC_DEFECT,
+            max_step: f64::INFINITY,
         };
         let map = self.map(period);
         let outcome = correct(&map, &base, &mut None, &limits).map_err(LossReason::Error)?;
@@ -233,11 +237,14 @@ impl Walker<'_> {
             (None, false) => self.options.first_step_jump,
             _ => predicted_change + self.options.max_energy_jump,
         };
+        // The trust radius: twice the predictor's step, and at least a hundredth of the state.
+        let moved: Vec<f64> = prediction.iter().zip(&last.x).map(|(a, b)| a - b).collect();
         let limits = Limits {
             iterations: self.options.iterations,
             refreshes: self.options.refreshes,
             relative_step: self.options.stability.relative_step,
             tolerance: crate::stability::PERIODIC_DEFECT,
+            max_step: (2.0 * norm(&moved)).max(TRUST * norm(&last.x)),
         };
         let map = self.map(period);
         let attempt = |start: &[f64], mut jacobian: Option<PseudoInverse>| {
