@@ -31,8 +31,11 @@ fn exact(c: &mut Criterion) {
         grid,
         ..BackboneOptions::for_mode(&system, 1, 1).expect("options")
     };
-    let run = compute(&system, &Request::new(1).method(Method::PeriodGrid(options)))
-        .expect("harmonic balance");
+    let run = compute(
+        &system,
+        &Request::new(1).method(Method::PeriodGrid(options)),
+    )
+    .expect("harmonic balance");
     for cells in [50usize, 100, 200] {
         let exact = ExactOptions {
             stability: StabilityOptions {

@@ -74,15 +74,23 @@ fn share_within(branch: &ExactBranch, steps: usize, family: impl Fn(f64) -> f64)
 fn clamped_branch_follows_the_exact_family() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
     let steps = 31;
-    let branch = exact_branch(&system, &request(&system, 3.95, 3.80, steps), &options(200.0))
-        .unwrap();
+    let branch = exact_branch(
+        &system,
+        &request(&system, 3.95, 3.80, steps),
+        &options(200.0),
+    )
+    .unwrap();
     let share = share_within(&branch, steps, |t| {
         ClampedFirstMode::new(1e-3, t).energy_normalized()
     });
     assert!(share >= 0.9, "{share}: {:?}", branch.skipped);
     assert!(branch.points.iter().all(|p| p.contacts == vec![1]));
     let resolved = verdicts(&branch).iter().filter(|v| v.1.is_some()).count();
-    assert!(resolved * 2 >= branch.points.len(), "{:?}", verdicts(&branch));
+    assert!(
+        resolved * 2 >= branch.points.len(),
+        "{:?}",
+        verdicts(&branch)
+    );
 }
 
 /// The free–free bar between two walls: its first family is the clamped bar's at half
@@ -97,8 +105,12 @@ fn free_free_branch_follows_the_exact_family() {
     );
     let system = Assembly::from_path(path).unwrap().into_system();
     let steps = 31;
-    let branch = exact_branch(&system, &request(&system, 1.975, 1.825, steps), &options(200.0))
-        .unwrap();
+    let branch = exact_branch(
+        &system,
+        &request(&system, 1.975, 1.825, steps),
+        &options(200.0),
+    )
+    .unwrap();
     let share = share_within(&branch, steps, |t| {
         8.0 / (PI * PI * (2.0 * t - 3.0).powi(2))
     });
@@ -120,7 +132,11 @@ fn gap_scales_out() {
     assert_eq!(verdicts(&a), verdicts(&b));
     for (p, q) in a.points.iter().zip(&b.points) {
         let ratio = q.point.energy / p.point.energy;
-        assert!((ratio - 4.0).abs() < 1e-6, "T = {}: {ratio}", p.point.period);
+        assert!(
+            (ratio - 4.0).abs() < 1e-6,
+            "T = {}: {ratio}",
+            p.point.period
+        );
     }
 }
 

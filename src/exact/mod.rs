@@ -52,7 +52,7 @@
 //! corrected once more from the previous orbit with a fresh matrix, and if it still jumps,
 //! or the correction fails, the branch is **lost** at that period. It is then reseeded from
 //! the harmonic-balance point at that period (a new [`BackbonePoint::branch`] index and an
-//! [`Event::Jump`] on its first point); where that fails too the period is skipped with its
+//! [`Event::Jump`](crate::continuation::Event::Jump) on its first point); where that fails too the period is skipped with its
 //! reason ([`ExactBranch::skipped`]), and after [`ExactOptions::max_lost`] consecutive skipped
 //! periods the walk ends ([`ExactEnd::Lost`]), keeping its points. The seed is the first grid
 //! period whose harmonic-balance point corrects to an orbit within the seed bounds of
@@ -67,7 +67,7 @@
 //! Where the integrator merged wave pieces over the period (incommensurate travel times,
 //! chattering), the energy removed is reported ([`ExactPoint::removed_energy`]) and the point
 //! gets a verdict only below [`ExactOptions::max_removed_energy`]
-//! ([`UnresolvedReason::Merged`](crate::stability::UnresolvedReason::Merged) beyond).
+//! ([`UnresolvedReason::Merged`] beyond).
 //!
 //! # Cost
 //!

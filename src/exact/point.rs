@@ -128,7 +128,7 @@ impl Walker<'_> {
             seeded,
         };
         let orbit = Orbit {
-            index: j,
+            index: Some(j),
             x: outcome.x,
             period,
             energy,

@@ -27,8 +27,8 @@ pub(crate) struct Seed {
 /// An exact orbit: its section state, period, energy, label and factored monodromy.
 #[derive(Clone)]
 pub(super) struct Orbit {
-    /// Its index in the grid.
-    pub index: usize,
+    /// Its index in the grid (`None` for an orbit half-way between two).
+    pub index: Option<usize>,
     pub x: Vec<f64>,
     pub period: f64,
     pub energy: f64,
@@ -208,6 +208,8 @@ impl Walker<'_> {
     }
 
     /// The orbit of grid period `j` continued from `last` (and `before`, for the secant).
+    /// Where the correction fails over more than one step of the grid, the step is halved:
+    /// an orbit at the whole number of steps half-way, not reported, then on from it.
     fn continue_to(
         &self,
         j: usize,
@@ -215,6 +217,57 @@ impl Walker<'_> {
         before: Option<&Orbit>,
     ) -> Result<(Orbit, ExactPoint), LossReason> {
         let period = self.periods[j];
+        let ratio = match (last.index, self.harmonic_balance[j]) {
+            (Some(i), Some(e)) => self.harmonic_balance[i].map(|e_last| e / e_last),
+            _ => None,
+        };
+        let (outcome, prediction, predicted) = match self.correct_to(period, ratio, last, before) {
+            Ok(found) => found,
+            Err(reason) => {
+                let dt = self.template.grid().dt();
+                let steps = ((period - last.period) / dt).round();
+                if steps.abs() < 2.0 {
+                    return Err(reason);
+                }
+                let mid = last.period + (steps / 2.0).trunc() * dt;
+                let half = ratio.map(f64::sqrt);
+                let (outcome, _, _) = self
+                    .correct_to(mid, half, last, before)
+                    .map_err(|_| reason)?;
+                let halfway = self.orbit(mid, outcome, last).map_err(LossReason::Error)?;
+                return self.continue_to(j, &halfway, Some(last));
+            }
+        };
+        let context = (last.label.clone(), Some(last.period), false);
+        self.finish(j, outcome, (&prediction, predicted), context)
+            .map_err(LossReason::Error)
+    }
+
+    /// The unreported orbit `outcome` at `period` half-way from `last`, with its monodromy.
+    fn orbit(&self, period: f64, outcome: Outcome, last: &Orbit) -> Result<Orbit, StabilityError> {
+        let step = self.options.stability.relative_step;
+        let monodromy = self.map(period).monodromy(&outcome.x, step)?;
+        Ok(Orbit {
+            index: None,
+            energy: self.energy(&outcome.x)?,
+            x: outcome.x,
+            period,
+            label: last.label.clone(),
+            jacobian: PseudoInverse::of_monodromy(&monodromy)?,
+        })
+    }
+
+    /// The periodic orbit at `period` from `last` (and `before`, for the secant), with the
+    /// prediction and its energy; `ratio`, harmonic balance's ratio of energies, predicts the
+    /// energy without a secant.
+    #[allow(clippy::type_complexity)]
+    fn correct_to(
+        &self,
+        period: f64,
+        ratio: Option<f64>,
+        last: &Orbit,
+        before: Option<&Orbit>,
+    ) -> Result<(Outcome, Vec<f64>, f64), LossReason> {
         let (prediction, predicted_energy) = match before {
             Some(b) => {
                 let s = (period - last.period) / (last.period - b.period);
@@ -226,11 +279,7 @@ impl Walker<'_> {
                     .collect();
                 (x, last.energy + s * (last.energy - b.energy))
             }
-            // Without a secant, harmonic balance's change of energy, where it has both points.
-            None => match (self.harmonic_balance[j], self.harmonic_balance[last.index]) {
-                (Some(e), Some(e_last)) => (last.x.clone(), last.energy * e / e_last),
-                _ => (last.x.clone(), last.energy),
-            },
+            None => (last.x.clone(), last.energy * ratio.unwrap_or(1.0)),
         };
         let predicted_change = (predicted_energy - last.energy).abs() / last.energy;
         let allowed = match (before, predicted_change > 0.0) {
@@ -279,9 +328,7 @@ impl Walker<'_> {
             // Once more from the previous orbit, with a matrix of the new period.
             Err(_) => judge_attempt(attempt(&last.x, None).map_err(LossReason::Error)?)?,
         };
-        let context = (last.label.clone(), Some(last.period), false);
-        self.finish(j, outcome, (&prediction, predicted_energy), context)
-            .map_err(LossReason::Error)
+        Ok((outcome, prediction, predicted_energy))
     }
 
     /// The correction `outcome` from `start` (of energy `energy`), as [`Corrected`].
