@@ -2,8 +2,8 @@
 //! report and contacts.
 
 use super::corrector::Outcome;
+use super::types::ExactPoint;
 use super::walk::{Orbit, Walker};
-use super::ExactPoint;
 use crate::branches::{BackbonePoint, CheckOutcome, PointStatus};
 use crate::fourier::frequency_of_period;
 use crate::modal::Label;

@@ -2,7 +2,7 @@
 //! verdict.
 
 use super::corrector::{correct, Limits, Outcome};
-use super::{ExactEnd, ExactOptions, ExactPoint, LossReason, Skipped};
+use super::types::{ExactEnd, ExactOptions, ExactPoint, LossReason, Skipped};
 use crate::continuation::Event;
 use crate::modal::Label;
 use crate::solve::norm;
