@@ -45,29 +45,35 @@
 //! # Events: another family, a lost branch
 //!
 //! A corrected orbit whose energy leaves the predicted energy (the secant's; without a
-//! secant, the previous energy times harmonic balance's ratio between the two periods) by more
-//! than the predicted change plus [`ExactOptions::max_energy_jump`] (by more than
-//! [`ExactOptions::first_step_jump`] where nothing predicts a change) has jumped onto another family of periodic orbits (they
-//! meet at branch points, and at a fixed period the map has several near one another): it is
-//! corrected once more from the previous orbit with a fresh matrix, and if it still jumps,
-//! or the correction fails, the branch is **lost** at that period. It is then reseeded from
-//! the harmonic-balance point at that period (a new [`BackbonePoint::branch`] index and an
-//! [`Event::Jump`](crate::continuation::Event::Jump) on its first point); where that fails too the period is skipped with its
-//! reason ([`ExactBranch::skipped`]), and after [`ExactOptions::max_lost`] consecutive skipped
-//! periods the walk ends ([`ExactEnd::Lost`]), keeping its points. The seed is the first grid
-//! period whose harmonic-balance point corrects to an orbit within the seed bounds of
-//! [`StabilityOptions`] (energy and displacement); the walk goes forward from it, then back
-//! to the grid's first period.
+//! secant, the previous energy times harmonic balance's ratio between the two periods) by
+//! more than the predicted change plus [`ExactOptions::max_energy_jump`] (by more than
+//! [`ExactOptions::first_step_jump`] where nothing predicts a change) has jumped onto another
+//! family of periodic orbits (they meet at branch points, and at a fixed period the map has
+//! several near one another): it is corrected once more from the previous orbit with a fresh
+//! matrix. If it still jumps, or the correction fails, a step over more than one step of the
+//! grid is **halved** (an orbit at the whole number of steps half-way, not reported, then on
+//! from it). Otherwise the branch is **lost** at that period and reseeded from the
+//! harmonic-balance point there (a new [`BackbonePoint::branch`] index and an
+//! [`Event::Jump`](crate::continuation::Event::Jump) on its first point); where that fails
+//! too, the period is skipped with its reason ([`ExactBranch::skipped`]).
+//!
+//! The walk goes in segments: a seed at the first period whose harmonic-balance point
+//! corrects to an orbit within the seed bounds of
+//! [`StabilityOptions`](crate::stability::StabilityOptions) (energy and displacement,
+//! [`ExactOptions::seed_attempts`] tries), the walk back from it to the segment's first
+//! period, then forward until [`ExactOptions::max_lost`] periods in a row are skipped; the
+//! next segment is sought after them. [`ExactBranch::end`] says why the last one ended
+//! ([`ExactEnd::Lost`], [`ExactEnd::NoSeed`]); every point found is kept.
 //!
 //! # The verdict
 //!
 //! One monodromy per point, at the corrected orbit: its eigenvalues give the verdict exactly
-//! as [`floquet_of_state`](crate::stability::floquet_of_state) does (trivial pair, other steps
-//! where it is missed, tolerance), and its factored `M - I` is the next point's corrector.
+//! as [`floquet_of_state`](crate::stability::floquet_of_state) does (trivial pair,
+//! tolerance; no other differences' steps: each costs a monodromy), and its factored `M - I` is the next point's corrector.
 //! Where the integrator merged wave pieces over the period (incommensurate travel times,
 //! chattering), the energy removed is reported ([`ExactPoint::removed_energy`]) and the point
 //! gets a verdict only below [`ExactOptions::max_removed_energy`]
-//! ([`UnresolvedReason::Merged`] beyond).
+//! ([`UnresolvedReason::Merged`](crate::stability::UnresolvedReason::Merged) beyond).
 //!
 //! # Cost
 //!
