@@ -121,6 +121,8 @@ pub enum LossReason {
         /// The bound at that step.
         allowed: f64,
     },
+    /// The walk back from a segment's seed was lost before it reached this period.
+    Unreached,
     /// The map could not be marched or its matrices decomposed.
     Error(
         #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] StabilityError,
@@ -138,6 +140,7 @@ impl std::fmt::Display for LossReason {
                 100.0 * change,
                 100.0 * allowed
             ),
+            Self::Unreached => f.write_str("the walk back from the next seed was lost before it"),
             Self::Error(e) => write!(f, "{e}"),
         }
     }
@@ -158,7 +161,8 @@ pub struct Skipped {
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub enum ExactEnd {
-    /// Every period of the grid was visited (some may be [`ExactBranch::skipped`]).
+    /// The last segment reached the grid's last period (periods may be
+    /// [`ExactBranch::skipped`], with their reasons).
     Completed,
     /// No harmonic-balance point corrected to a seed: `attempts` were tried, the last
     /// failing for `last`.

@@ -87,9 +87,19 @@ impl Walker<'_> {
             point.point.branch = branch;
             points.push(point);
             let back = (next..s).rev();
-            self.walk_from(orbit.clone(), back, &mut branch, &mut points, &mut skipped);
+            let lost = self.walk_from(orbit.clone(), back, &mut branch, &mut points, &mut skipped);
+            if let Some((j, _)) = lost {
+                // The periods the walk back did not reach are said, not dropped.
+                skipped.extend((next..j).map(|i| Skipped {
+                    period: self.periods[i],
+                    reason: LossReason::Unreached,
+                }));
+            }
             match self.walk_from(orbit, s + 1..n, &mut branch, &mut points, &mut skipped) {
-                None => break,
+                None => {
+                    end = ExactEnd::Completed;
+                    break;
+                }
                 Some((j, last)) => {
                     (next, branch) = (j + 1, branch + 1);
                     let attempts = self.options.max_lost;
@@ -103,6 +113,7 @@ impl Walker<'_> {
             }
         }
         points.sort_by_key(|p| p.point.step);
+        skipped.sort_by(|a, b| a.period.total_cmp(&b.period));
         stability_events(&mut points);
         (points, skipped, end)
     }
