@@ -39,13 +39,14 @@
 //! | [`verify::periodicity_check`] | exact time-domain march of a point: periodicity defect |
 //! | [`mod@reference`] | the paper's systems and exact solutions |
 //! | [`io`] | CSV, and JSON with the `serde` feature; with it, assemblies from TOML/JSON files |
+//! | [`exact`] | exact nonsmooth modes: branches of the integrator's one-period map, continued in the period, with a Floquet verdict at every point |
 //! | [`sweep::backbones`] | many requests at once; in parallel with the `parallel` feature (rayon), results identical to the serial run |
 //!
 //! ## Features
 //!
 //! | feature | adds |
 //! |---|---|
-//! | `parallel` | [`sweep::backbones`] on rayon's thread pool |
+//! | `parallel` | [`sweep::backbones`] on rayon's thread pool, and the columns of every monodromy matrix ([`stability`], [`exact`]) |
 //! | `serde` (default) | `Serialize` on points, branches and diagnostics; `io::to_json`; assemblies read from and written to TOML or JSON files (`io::assembly`); `default-features = false` leaves it out |
 //! | `plot` | the `plot` module: SVG figures |
 //! | `proptest` | the `strategies` module: proptest strategies |
@@ -78,6 +79,7 @@ mod check;
 pub mod continuation;
 mod end;
 pub mod error;
+pub mod exact;
 pub mod forced;
 pub mod fourier;
 pub mod io;

@@ -15,7 +15,8 @@ pub const USAGE: &str = "usage: backbone [--system ds|rs|two-bar] [--gap G] [--r
   [--method sequential|arclength]
   [--ds DS] [--ds-min A] [--ds-max B] [--max-steps N] [--omega-range LO:HI] [--switch-at N[:SIDE]]
   [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio] [--parameter-range LO:HI]
-  [--energy-range LO:HI] [--progress] [--verify] [--stability] [--hill] [--basis cosine|full]";
+  [--energy-range LO:HI] [--progress] [--verify] [--stability] [--hill] [--basis cosine|full]
+  [--exact] [--cells-per-travel N]";
 
 /// Largest `--steps` and `--max-steps`.
 pub const MAX_POINTS: usize = 1_000_000;
@@ -90,6 +91,10 @@ pub struct Args {
     pub stability: bool,
     /// `--hill`: the Hill exponents of every converged point.
     pub hill: bool,
+    /// `--exact`: the exact branch of the one-period map, seeded by the harmonic-balance run.
+    pub exact: bool,
+    /// `--cells-per-travel`: the exact map's grid (a minimum; default 200).
+    pub cells_per_travel: f64,
 }
 
 fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
@@ -161,6 +166,8 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         stability: false,
         hill: false,
         full_basis: false,
+        exact: false,
+        cells_per_travel: 200.0,
     };
     let mut assembly = None;
     let mut system_given = false;
@@ -262,6 +269,8 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("verify") => a.verify = true,
             Long("stability") => a.stability = true,
             Long("hill") => a.hill = true,
+            Long("exact") => a.exact = true,
+            Long("cells-per-travel") => a.cells_per_travel = parser.value()?.parse()?,
             Long("basis") => {
                 a.full_basis = match parser.value()?.string()?.as_str() {
                     "cosine" => false,
@@ -299,6 +308,19 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
              arclength) for --subharmonic 1"
                 .into(),
         );
+    }
+    if a.exact && (a.parameter != Parameter::Omega || a.full_basis || a.hill) {
+        return Err(
+            "--exact continues in the period (--parameter omega) in the cosine basis, without --hill"
+                .into(),
+        );
+    }
+    if !(a.cells_per_travel.is_finite() && (1.0..=1000.0).contains(&a.cells_per_travel)) {
+        return Err(format!(
+            "--cells-per-travel must lie in [1, 1000], got {}",
+            a.cells_per_travel
+        )
+        .into());
     }
     if a.parameter == Parameter::Energy && a.arclength == Some(true) {
         return Err("--parameter energy is sequential: it takes no --method arclength".into());

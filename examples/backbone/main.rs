@@ -12,7 +12,7 @@
 //!     [--method sequential|arclength] [--ds DS --ds-min A --ds-max B --max-steps N]
 //!     [--omega-range LO:HI] [--switch-at N[:SIDE]] [--parameter omega|energy|gap|robin-stiffness|stiffness-ratio]
 //!     [--parameter-range LO:HI] [--energy-range LO:HI] [--progress] [--verify] [--stability]
-//!     [--hill] [--basis cosine|full]
+//!     [--hill] [--basis cosine|full] [--exact [--cells-per-travel N]]
 //! ```
 //!
 //! The system: `--system ds|rs|two-bar` are shorthands for the paper's three systems
@@ -74,6 +74,18 @@
 //! error where the multipliers could not be computed (commas written as semicolons).
 //! Changes of verdict along a branch appear in `event` as `stability-lost` and
 //! `stability-gained`. Period and energy runs only; empty cells for `--parameter` runs.
+//!
+//! `--exact` runs the harmonic-balance branch of the flags (its rows not written), then the
+//! exact branch seeded by it over the same period grid (`exact::exact_branch_from`: periodic
+//! orbits of the integrator's one-period map, continued in the period) and writes one row per
+//! exact point, in the same columns with the stability columns always present: `iterations`
+//! and `residual_norm` are the corrector's steps and the orbit's periodicity defect, `label`
+//! that of the harmonic-balance point the segment was seeded from, `branch` one more after
+//! each reseed, `contacts_per_period` counted on the orbit, `dominant_harmonic` empty.
+//! `--cells-per-travel N` (default 200, at most 1000) is the map's smallest grid; the grid
+//! used may be finer, so that every period is a whole number of steps. Stderr says how many
+//! points, verdicts and seconds, why the walk ended and why each skipped period has no
+//! point. With `--parameter omega` only, in the cosine basis, without `--hill`.
 //!
 //! `--hill` adds, after those, `hill_stable,hill_max_multiplier`: the verdict and largest
 //! multiplier of Hill's method on the truncated harmonic-balance equations (`stability::hill`,

@@ -4,6 +4,7 @@
 
 use nonsmooth_modes::branches::{BackbonePoint, PointStatus};
 use nonsmooth_modes::continuation::Event;
+use nonsmooth_modes::exact::ExactPoint;
 use nonsmooth_modes::modal::{contact_intervals, subharmonic_share};
 use nonsmooth_modes::reference::ClampedFirstMode;
 use nonsmooth_modes::stability::Verdict;
@@ -76,7 +77,12 @@ impl Sink<'_> {
     /// `,contacts_per_period` and, for `K > 1`, `,subharmonic_share` of a point (empty cells
     /// where they cannot be computed, e.g. the unknowns of a failed step are not finite, and
     /// an empty share for a point collapsed to rest).
-    fn signature(&self, problem: &mut NonsmoothSystem, p: &BackbonePoint) -> String {
+    fn signature(
+        &self,
+        problem: &mut NonsmoothSystem,
+        p: &BackbonePoint,
+        counted: Option<usize>,
+    ) -> String {
         let cell = |value: Result<String, nonsmooth_modes::SettingsError>, what: &str| {
             value.unwrap_or_else(|e| {
                 eprintln!("backbone: {what} of step {} not computed: {e}", p.step);
@@ -84,9 +90,12 @@ impl Sink<'_> {
             })
         };
         // A converged point carries its contact count; the others are counted here.
-        let contacts = match &p.character {
-            Some(c) => Ok(c.contacts.iter().sum::<usize>()),
-            None => contact_intervals(problem, &p.x, p.omega).map(|c| c.iter().sum::<usize>()),
+        let contacts = match (counted, &p.character) {
+            (Some(c), _) => Ok(c),
+            (None, Some(c)) => Ok(c.contacts.iter().sum::<usize>()),
+            (None, None) => {
+                contact_intervals(problem, &p.x, p.omega).map(|c| c.iter().sum::<usize>())
+            }
         };
         let mut cells = format!(
             ",{}",
@@ -152,6 +161,23 @@ impl Sink<'_> {
         p: &BackbonePoint,
         parameter: f64,
     ) -> ControlFlow<()> {
+        self.row_counted(problem, p, parameter, None)
+    }
+
+    /// Writes the row of a point of an exact branch, whose contacts were counted on its
+    /// orbit (it has no harmonic-balance unknowns to count them on).
+    pub fn exact_row(&mut self, problem: &mut NonsmoothSystem, e: &ExactPoint) -> ControlFlow<()> {
+        self.row_counted(problem, &e.point, f64::NAN, Some(e.contacts.iter().sum()))
+    }
+
+    /// [`Sink::row`], with the contacts per period `counted` where they are known.
+    fn row_counted(
+        &mut self,
+        problem: &mut NonsmoothSystem,
+        p: &BackbonePoint,
+        parameter: f64,
+        counted: Option<usize>,
+    ) -> ControlFlow<()> {
         self.total += 1;
         self.converged += usize::from(p.converged);
         let exact = self
@@ -164,7 +190,7 @@ impl Sink<'_> {
             );
         }
         let verification = self.verification(p);
-        let signature = self.signature(problem, p);
+        let signature = self.signature(problem, p, counted);
         let line = format!(
             "{},{:.10},{:.10},{:.10e},{:.10e},{},{},{},{:.3e},{},{:.6e},{},{}{}{}{}{}",
             p.step,

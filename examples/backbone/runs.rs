@@ -11,6 +11,7 @@ use nonsmooth_modes::branches::{
     PeriodGrid, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
+use nonsmooth_modes::exact::{exact_branch_from, ExactOptions};
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton, Solver};
 use nonsmooth_modes::stability::{HillOptions, StabilityOptions};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
@@ -30,7 +31,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
     writeln!(
         out,
         "{}",
-        header(a.verify, a.subharmonic, a.stability, a.hill)
+        header(a.verify, a.subharmonic, a.stability || a.exact, a.hill)
     )?;
     let mut sink = Sink {
         out,
@@ -43,10 +44,12 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         error: None,
         progress: a.progress,
         subharmonic: a.subharmonic,
-        stability: a.stability,
+        stability: a.stability || a.exact,
         hill: a.hill,
     };
-    if a.parameter != Parameter::Omega && a.parameter != Parameter::Energy {
+    if a.exact {
+        run_exact(a, &system, &request(a, &system, (t0, t1))?, &mut sink)?;
+    } else if a.parameter != Parameter::Omega && a.parameter != Parameter::Energy {
         run_parameter(a, t0, &mut sink)?;
     } else {
         let request = request(a, &system, (t0, t1))?;
@@ -114,6 +117,67 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         return Err(e.into());
     }
     Ok((sink.total, sink.converged))
+}
+
+/// `--exact`: the harmonic-balance run of `request` (its rows not written), then the exact
+/// branch seeded by it over the same period grid, one row per exact point.
+fn run_exact(
+    a: &Args,
+    system: &BarSystem,
+    request: &Request,
+    sink: &mut Sink<'_>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let grid = match request.method {
+        Method::Auto(Some(o)) | Method::PeriodGrid(o) | Method::GenuineSubharmonic(o) => o.grid,
+        _ => BackboneOptions::for_mode(system, a.mode, a.subharmonic)?.grid,
+    };
+    let harmonic_balance = Request {
+        stability: None,
+        ..request.clone()
+    };
+    let options = ExactOptions {
+        stability: StabilityOptions {
+            cells_per_travel: a.cells_per_travel,
+            ..StabilityOptions::default()
+        },
+        ..ExactOptions::default()
+    };
+    let start = std::time::Instant::now();
+    let run = compute(system, &harmonic_balance)?;
+    let branch = exact_branch_from(&run, &grid, &options)?;
+    let mut problem = NonsmoothSystem::new(system, a.settings)?;
+    for p in &branch.points {
+        if sink.exact_row(&mut problem, p).is_break() {
+            break;
+        }
+    }
+    let count = |stable: Option<bool>| {
+        branch
+            .points
+            .iter()
+            .filter(|p| matches!(&p.point.stability, Some(Ok(f)) if f.verdict.stable() == stable))
+            .count()
+    };
+    eprintln!(
+        "backbone: exact branch of {} points ({} stable, {} unstable, {} unresolved) on a grid \
+         of dt = {:.6e} ({} coordinates) in {:.1} s; {} periods skipped; ended: {:?}",
+        branch.points.len(),
+        count(Some(true)),
+        count(Some(false)),
+        count(None),
+        branch.dt,
+        branch.dimension,
+        start.elapsed().as_secs_f64(),
+        branch.skipped.len(),
+        branch.end
+    );
+    for s in &branch.skipped {
+        eprintln!(
+            "backbone: no exact point at T = {:.6}: {}",
+            s.period, s.reason
+        );
+    }
+    Ok(())
 }
 
 /// The request of the flags: the method of `--method` and `--parameter energy`, or the

@@ -433,6 +433,15 @@ pub enum UnresolvedReason {
         /// [`StabilityOptions::tolerance`](super::StabilityOptions::tolerance).
         tolerance: f64,
     },
+    /// The integrator merged wave pieces over the period (incommensurate travel times,
+    /// chattering) and removed more energy than the bound: the map is blurred by about the
+    /// square root of that share of the state, more than a verdict at the tolerance allows.
+    Merged {
+        /// The energy removed over one period, relative to the motion's.
+        removed: f64,
+        /// The bound ([`ExactOptions::max_removed_energy`](crate::exact::ExactOptions::max_removed_energy)).
+        bound: f64,
+    },
 }
 
 impl std::fmt::Display for UnresolvedReason {
@@ -479,6 +488,11 @@ impl std::fmt::Display for UnresolvedReason {
                 f,
                 "the trivial multiplier pair lies {distance:.1e} from 1 and is a perturbation \
                  of {perturbation:.1e} from the double multiplier 1 (tolerance {tolerance:.1e})"
+            ),
+            UnresolvedReason::Merged { removed, bound } => write!(
+                f,
+                "the integrator's merges removed {removed:.1e} of the energy over the period \
+                 (bound {bound:.1e})"
             ),
         }
     }
@@ -669,6 +683,13 @@ mod tests {
                     tolerance: 1e-3,
                 },
                 &["1.4e-2", "1.1e-2", "1.0e-3"][..],
+            ),
+            (
+                UnresolvedReason::Merged {
+                    removed: 3e-5,
+                    bound: 1e-6,
+                },
+                &["3.0e-5", "1.0e-6"][..],
             ),
         ];
         for (reason, numbers) in cases {

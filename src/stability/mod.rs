@@ -131,11 +131,12 @@
 //! [`MAX_MARCH_STEPS`] time steps ([`StabilityError::TooCostly`]). The clamped bar at 200
 //! cells takes about 0.2 s per monodromy (`cargo bench --bench stability`).
 
-mod coordinates;
+pub(crate) mod coordinates;
 mod floquet;
 pub mod hill;
-mod monodromy;
-mod shooting;
+mod judge;
+pub(crate) mod monodromy;
+pub(crate) mod shooting;
 
 pub use crate::error::StabilityError;
 pub use floquet::{Crossing, Floquet, Multiplier, UnresolvedReason, Verdict};
@@ -152,9 +153,8 @@ use crate::verify::{
     SpringUpdate, State, VerifyError,
 };
 use coordinates::Coordinates;
-use floquet::{MapShape, TrivialPair};
-use monodromy::{Monodromy, PeriodMap};
-use shooting::Corrected;
+pub(crate) use judge::{correction_failure, judge};
+use monodromy::PeriodMap;
 
 /// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
 /// `8 n^2` bytes (200 MiB).
@@ -170,7 +170,7 @@ pub const PERIODIC_DEFECT: f64 = 1e-11;
 
 /// The other steps of the differences, relative to [`StabilityOptions::relative_step`], tried
 /// in turn when the trivial pair is not found within the tolerance.
-const STEP_FACTORS: [f64; 2] = [10.0, 0.1];
+pub(crate) const STEP_FACTORS: [f64; 2] = [10.0, 0.1];
 
 /// The largest periodicity defect of a corrected state whose multipliers count
 /// ([`Verdict::Unresolved`] beyond).
@@ -226,7 +226,7 @@ impl Default for StabilityOptions {
 }
 
 impl StabilityOptions {
-    fn check(&self) -> Result<(), StabilityError> {
+    pub(crate) fn check(&self) -> Result<(), StabilityError> {
         let checks = [
             (
                 "cells_per_travel",
@@ -278,7 +278,7 @@ impl StabilityOptions {
     /// of steps: a period that ends between two steps ends with a fractional step, whose
     /// projection onto the cells blurs the map (on the clamped bar, no period of
     /// `785.5` steps gets a verdict where one of `786` does).
-    fn grid(&self, model: &Model, period: f64) -> Result<(Grid, f64), StabilityError> {
+    pub(crate) fn grid(&self, model: &Model, period: f64) -> Result<(Grid, f64), StabilityError> {
         let travel = shortest_travel_time(model.bars());
         let first = self.cells_per_travel.ceil() as usize;
         let candidate = |k: usize| -> Result<(Grid, f64, f64), StabilityError> {
@@ -358,90 +358,25 @@ pub fn floquet_of_state(
     let failure = correction_failure(&corrected, options);
     // A point whose correction failed keeps the multipliers of its own state: those of a
     // partial correction depend on the path the iterations took.
-    let spurious = coordinates.spurious_unit_multipliers();
-    let periodic = failure.is_none();
-    let assess = |monodromy: &Monodromy| -> Result<(Vec<Multiplier>, TrivialPair), StabilityError> {
-        let mut multipliers = floquet::eigenvalues(monodromy)?;
-        floquet::remove_nearest_one(&mut multipliers, spurious);
-        let pair = floquet::trivial_pair(
-            monodromy,
-            &multipliers,
-            spurious,
-            options.tolerance,
-            periodic,
-        )?;
-        Ok((multipliers, pair))
+    let monodromy = match at_corrected {
+        Some(at_corrected) if failure.is_none() => at_corrected,
+        _ => at_base,
     };
-    let (mut multipliers, mut pair) = match at_corrected {
-        Some(at_corrected) if periodic => assess(&at_corrected)?,
-        _ => assess(&at_base)?,
-    };
-    // The differences must reproduce the known multiplier 1 of the time shift. Where they
-    // miss it, a step that adds or removes a near-grazing impact made them inaccurate: a
-    // ten times larger step steps over it, a ten times smaller one stays within the piece.
-    if periodic {
-        for factor in STEP_FACTORS {
-            if pair.found(options.tolerance) {
-                break;
-            }
-            let other = map.monodromy(&corrected.x, factor * options.relative_step)?;
-            let other = assess(&other)?;
-            if other.1.miss() < pair.miss() {
-                (multipliers, pair) = other;
-            }
-        }
-    }
-    let shape = MapShape {
-        dimension: coordinates.len(),
-        dt: initial.grid().dt(),
-        period,
-    };
-    Ok(floquet::verdict(
-        multipliers,
-        options.tolerance,
-        pair,
-        failure,
+    judge(
+        &map,
         &corrected,
-        shape,
-    ))
-}
-
-/// Why the correction `corrected` does not count, in the order of the checks: its state is
-/// not periodic (defect above [`RESOLVED_DEFECT`]), or the periodic orbit it reached has
-/// another energy or displacement than the point's (beyond
-/// [`StabilityOptions::max_energy_correction`] and
-/// [`StabilityOptions::max_displacement_correction`]). `None` when it counts.
-fn correction_failure(
-    corrected: &Corrected,
-    options: &StabilityOptions,
-) -> Option<UnresolvedReason> {
-    let periodic = corrected.defect <= RESOLVED_DEFECT;
-    let energy_kept = corrected.energy_change.abs() <= options.max_energy_correction;
-    let displacement_kept = corrected.displacement_shift <= options.max_displacement_correction;
-    if !periodic {
-        Some(UnresolvedReason::NotPeriodic {
-            defect: corrected.defect,
-            bound: RESOLVED_DEFECT,
-            iterations: corrected.iterations,
-            corrections: options.corrections,
-        })
-    } else if !energy_kept {
-        Some(UnresolvedReason::EnergyMoved {
-            change: corrected.energy_change,
-            bound: options.max_energy_correction,
-        })
-    } else if !displacement_kept {
-        Some(UnresolvedReason::DisplacementMoved {
-            change: corrected.displacement_shift,
-            bound: options.max_displacement_correction,
-        })
-    } else {
-        None
-    }
+        &monodromy,
+        failure,
+        options,
+        &STEP_FACTORS,
+    )
 }
 
 /// [`StabilityError::TooLarge`] for more than [`MAX_DIMENSION`] coordinates.
-fn check_dimension(coordinates: &Coordinates, cells_per_travel: f64) -> Result<(), StabilityError> {
+pub(crate) fn check_dimension(
+    coordinates: &Coordinates,
+    cells_per_travel: f64,
+) -> Result<(), StabilityError> {
     if coordinates.len() > MAX_DIMENSION {
         return Err(StabilityError::TooLarge {
             dimension: coordinates.len(),
@@ -456,7 +391,7 @@ fn check_dimension(coordinates: &Coordinates, cells_per_travel: f64) -> Result<(
 /// gap (relative to the law's own gap) is largest: there every contact is open, so the
 /// one-period map is differentiable. At an instant of closed contact the state sits on the
 /// constraint `g = 0` and its perturbations that penetrate are not motions.
-fn open_section(
+pub(crate) fn open_section(
     initial: &State,
     period: f64,
     spring: SpringUpdate,
@@ -505,7 +440,7 @@ fn open_instant(initial: &State, period: f64, spring: SpringUpdate) -> Result<f6
 }
 
 /// The gap `g0` of condition `index` (0 for a linear condition).
-fn law_gap(model: &Model, index: usize) -> f64 {
+pub(crate) fn law_gap(model: &Model, index: usize) -> f64 {
     match model.conditions()[index] {
         Condition::Obstacle { gap, .. }
         | Condition::CompliantObstacle { gap, .. }

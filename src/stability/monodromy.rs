@@ -83,18 +83,35 @@ impl PeriodMap<'_> {
         }
         let step = relative_step * scale;
         let n = base.len();
-        let mut matrix = Mat::<f64>::zeros(n, n);
-        let mut scratch = [Vec::new(), Vec::new(), Vec::new()];
-        for j in 0..n {
-            self.column(base, j, step, &mut scratch)?;
-            if let Some(value) = scratch[1].iter().find(|v| !v.is_finite()) {
-                return Err(StabilityError::NonFinite {
+        let column = |scratch: &mut [Vec<f64>; 3], j: usize| -> Result<Vec<f64>, StabilityError> {
+            self.column(base, j, step, scratch)?;
+            match scratch[1].iter().find(|v| !v.is_finite()) {
+                Some(value) => Err(StabilityError::NonFinite {
                     column: j,
                     value: *value,
-                });
+                }),
+                None => Ok(scratch[1].clone()),
             }
-            for (i, value) in scratch[1].iter().enumerate() {
-                matrix[(i, j)] = *value;
+        };
+        // The columns are independent marches: with the `parallel` feature they run on
+        // rayon's pool (the matrix is the same, bit for bit).
+        #[cfg(feature = "parallel")]
+        let columns: Vec<Result<Vec<f64>, StabilityError>> = {
+            use rayon::prelude::*;
+            (0..n)
+                .into_par_iter()
+                .map_init(|| [Vec::new(), Vec::new(), Vec::new()], column)
+                .collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let columns: Vec<Result<Vec<f64>, StabilityError>> = {
+            let mut scratch = [Vec::new(), Vec::new(), Vec::new()];
+            (0..n).map(|j| column(&mut scratch, j)).collect()
+        };
+        let mut matrix = Mat::<f64>::zeros(n, n);
+        for (j, values) in columns.into_iter().enumerate() {
+            for (i, value) in values?.into_iter().enumerate() {
+                matrix[(i, j)] = value;
             }
         }
         Ok(matrix)

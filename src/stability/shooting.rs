@@ -32,30 +32,94 @@ pub(crate) struct Corrected {
 }
 
 /// The minimum-norm solution of `a d = b` over the singular values of `a` above
-/// [`SINGULAR_CUTOFF`] of the largest.
-fn truncated_solve(a: &Mat<f64>, b: &[f64]) -> Result<Vec<f64>, StabilityError> {
-    let svd = a.thin_svd().map_err(|_| StabilityError::NoSingularValues {
-        dimension: a.nrows(),
-    })?;
-    let (u, s, v) = (svd.U(), svd.S(), svd.V());
-    let largest = (0..s.dim()).map(|k| s[k]).fold(0.0, f64::max);
-    let mut d = vec![0.0; a.ncols()];
-    for k in (0..s.dim()).filter(|&k| s[k] > SINGULAR_CUTOFF * largest) {
-        let c = (0..a.nrows()).map(|i| u[(i, k)] * b[i]).sum::<f64>() / s[k];
-        for (j, dj) in d.iter_mut().enumerate() {
-            *dj += c * v[(j, k)];
-        }
+/// [`SINGULAR_CUTOFF`] of the largest, with the decomposition kept: a chord corrector solves
+/// many right-hand sides with one matrix.
+#[derive(Debug, Clone)]
+pub(crate) struct PseudoInverse {
+    u: faer::Mat<f64>,
+    v: faer::Mat<f64>,
+    /// The inverted singular values (those above the cutoff).
+    s: Vec<f64>,
+}
+
+impl PseudoInverse {
+    /// The truncated pseudo-inverse of `a`.
+    pub(crate) fn new(a: &Mat<f64>) -> Result<Self, StabilityError> {
+        let svd = a.thin_svd().map_err(|_| StabilityError::NoSingularValues {
+            dimension: a.nrows(),
+        })?;
+        let (u, s, v) = (svd.U(), svd.S(), svd.V());
+        let largest = (0..s.dim()).map(|k| s[k]).fold(0.0, f64::max);
+        let kept: Vec<usize> = (0..s.dim())
+            .filter(|&k| s[k] > SINGULAR_CUTOFF * largest)
+            .collect();
+        Ok(Self {
+            u: Mat::from_fn(a.nrows(), kept.len(), |i, k| u[(i, kept[k])]),
+            v: Mat::from_fn(a.ncols(), kept.len(), |j, k| v[(j, kept[k])]),
+            s: kept.iter().map(|&k| s[k]).collect(),
+        })
     }
-    Ok(d)
+
+    /// `M - I` of a monodromy, pseudo-inverted.
+    pub(crate) fn of_monodromy(monodromy: &Monodromy) -> Result<Self, StabilityError> {
+        let n = monodromy.nrows();
+        let identity = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
+        Self::new(&Mat::<f64>::from_fn(n, n, |i, j| {
+            monodromy[(i, j)] - identity(i, j)
+        }))
+    }
+
+    /// The minimum-norm `d` of `a d = b` over the kept singular values.
+    pub(crate) fn solve(&self, b: &[f64]) -> Vec<f64> {
+        let mut d = vec![0.0; self.v.nrows()];
+        for (k, s) in self.s.iter().enumerate() {
+            let c = (0..self.u.nrows())
+                .map(|i| self.u[(i, k)] * b[i])
+                .sum::<f64>()
+                / s;
+            for (j, dj) in d.iter_mut().enumerate() {
+                *dj += c * self.v[(j, k)];
+            }
+        }
+        d
+    }
 }
 
 /// `|P(x) - x|` and the residual `P(x) - x` itself.
-fn residual(map: &PeriodMap, x: &[f64], out: &mut Vec<f64>) -> Result<f64, StabilityError> {
+pub(crate) fn residual(
+    map: &PeriodMap,
+    x: &[f64],
+    out: &mut Vec<f64>,
+) -> Result<f64, StabilityError> {
     map.apply(x, out)?;
     for (r, a) in out.iter_mut().zip(x) {
         *r -= a;
     }
     Ok(norm(out))
+}
+
+/// The step `x + a d` of the first `a` in `1, 1/2, 1/4, 1/8` whose relative defect
+/// `|P - I| / |x|` is below `defect`, with that defect (its residual in `r`); `None` when
+/// none is.
+pub(crate) fn line_step(
+    map: &PeriodMap,
+    x: &[f64],
+    d: &[f64],
+    defect: f64,
+    r: &mut Vec<f64>,
+) -> Result<Option<(Vec<f64>, f64)>, StabilityError> {
+    let mut a = 1.0;
+    for _ in 0..4 {
+        let trial: Vec<f64> = x.iter().zip(d).map(|(x, d)| x + a * d).collect();
+        if trial.iter().all(|v| v.is_finite()) {
+            let trial_defect = residual(map, &trial, r)? / norm(&trial);
+            if trial_defect < defect {
+                return Ok(Some((trial, trial_defect)));
+            }
+        }
+        a *= 0.5;
+    }
+    Ok(None)
 }
 
 impl PeriodMap<'_> {
@@ -97,27 +161,10 @@ impl PeriodMap<'_> {
             if best.defect <= tolerance {
                 break;
             }
-            let x = &best.x;
             let monodromy = latest.as_ref().unwrap_or(&at_base);
-            let n = monodromy.nrows();
-            let identity = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
-            let step_matrix = Mat::<f64>::from_fn(n, n, |i, j| monodromy[(i, j)] - identity(i, j));
             let rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-            let d = truncated_solve(&step_matrix, &rhs)?;
-            let mut accepted = None;
-            let mut a = 1.0;
-            for _ in 0..4 {
-                let trial: Vec<f64> = (0..n).map(|i| x[i] + a * d[i]).collect();
-                if trial.iter().all(|v| v.is_finite()) {
-                    let defect = residual(self, &trial, &mut trial_r)? / norm(&trial);
-                    if defect < best.defect {
-                        accepted = Some((trial, defect));
-                        break;
-                    }
-                }
-                a *= 0.5;
-            }
-            let Some((x, defect)) = accepted else {
+            let d = PseudoInverse::of_monodromy(monodromy)?.solve(&rhs);
+            let Some((x, defect)) = line_step(self, &best.x, &d, best.defect, &mut trial_r)? else {
                 break;
             };
             std::mem::swap(&mut r, &mut trial_r);

@@ -1,0 +1,203 @@
+//! What an exact branch is made of: its options, points, skipped periods and end.
+
+use crate::branches::BackbonePoint;
+use crate::stability::{StabilityError, StabilityOptions, UnresolvedReason};
+
+/// Options of [`exact_branch`](super::exact_branch).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactOptions {
+    /// The grid (`cells_per_travel`, a minimum here), differences, tolerance and spring
+    /// update of the map, and the seed's correction: `corrections` fresh monodromies at most,
+    /// within `max_energy_correction` and `max_displacement_correction` of the
+    /// harmonic-balance point.
+    pub stability: StabilityOptions,
+    /// Corrector steps per point, chord and fresh (default 20).
+    pub iterations: usize,
+    /// Fresh monodromies per continued point where the chord stalls (default 2).
+    pub refreshes: usize,
+    /// How far, relative to the previous energy, an orbit's energy may leave the secant's
+    /// prediction beyond the predicted change (default `0.02`).
+    pub max_energy_jump: f64,
+    /// How far, relative, the energy may move in a step without a secant (default `0.25`).
+    pub first_step_jump: f64,
+    /// Harmonic-balance points tried for the seed (default 8).
+    pub seed_attempts: usize,
+    /// Consecutive periods skipped before the walk ends (default 3).
+    pub max_lost: usize,
+    /// The largest energy the integrator's merges may remove over one period, relative to
+    /// the motion's, for a verdict (default `1e-6`: the merges then move the state by about
+    /// `sqrt(1e-6) = 1e-3` of its norm, the verdict's tolerance).
+    pub max_removed_energy: f64,
+}
+
+impl Default for ExactOptions {
+    fn default() -> Self {
+        Self {
+            stability: StabilityOptions::default(),
+            iterations: 20,
+            refreshes: 2,
+            max_energy_jump: 0.02,
+            first_step_jump: 0.25,
+            seed_attempts: 8,
+            max_lost: 3,
+            max_removed_energy: 1e-6,
+        }
+    }
+}
+
+impl ExactOptions {
+    pub(super) fn check(&self) -> Result<(), StabilityError> {
+        self.stability.check()?;
+        let checks = [
+            ("max_energy_jump", self.max_energy_jump),
+            ("first_step_jump", self.first_step_jump),
+            ("max_removed_energy", self.max_removed_energy),
+        ];
+        for (what, value) in checks {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(StabilityError::InvalidOption {
+                    what,
+                    expected: "finite and non-negative",
+                    value,
+                });
+            }
+        }
+        let counts = [
+            ("iterations", self.iterations),
+            ("seed_attempts", self.seed_attempts),
+            ("max_lost", self.max_lost),
+        ];
+        for (what, value) in counts {
+            if value == 0 {
+                return Err(StabilityError::InvalidOption {
+                    what,
+                    expected: "at least 1",
+                    value: 0.0,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One point of an exact branch: a [`BackbonePoint`] (its `x` is empty: the motion is no
+/// harmonic-balance solution; its `time_domain` is the orbit's own periodicity report, its
+/// `stability` the verdict of its monodromy, its `label` that of the harmonic-balance point
+/// its segment was seeded from) and what only an exact point has.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ExactPoint {
+    /// The point; its `period` is the map's, a whole number of grid steps.
+    pub point: BackbonePoint,
+    /// The period of the requested grid it stands for.
+    pub requested_period: f64,
+    /// `(E - E_hb) / E_hb` against the converged harmonic-balance point at the same grid
+    /// period (`None` where there is none).
+    pub harmonic_balance_distance: Option<f64>,
+    /// Energy the integrator's merges removed over one period, relative to the motion's.
+    pub removed_energy: f64,
+    /// Contact intervals per period of each unilateral condition (model order).
+    pub contacts: Vec<usize>,
+    /// Whether the point was corrected from a harmonic-balance point (a seed or a reseed)
+    /// rather than continued.
+    pub seeded: bool,
+}
+
+/// Why a period has no exact point, or why a seed failed.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum LossReason {
+    /// No converged harmonic-balance point at the period to seed from.
+    NoHarmonicBalancePoint,
+    /// The correction did not reach a periodic orbit near the start (its reason, with the
+    /// numbers).
+    Correction(UnresolvedReason),
+    /// The orbit found jumped: its energy left the prediction by `change` (relative to the
+    /// previous energy), more than `allowed`.
+    Jump {
+        /// `|E - E_predicted| / E_previous`.
+        change: f64,
+        /// The bound at that step.
+        allowed: f64,
+    },
+    /// The walk back from a segment's seed was lost before it reached this period.
+    Unreached,
+    /// The map could not be marched or its matrices decomposed.
+    Error(
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] StabilityError,
+    ),
+}
+
+impl std::fmt::Display for LossReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NoHarmonicBalancePoint => f.write_str("no converged harmonic-balance point"),
+            Self::Correction(reason) => write!(f, "{reason}"),
+            Self::Jump { change, allowed } => write!(
+                f,
+                "the orbit found left the prediction by {:.2} % of the energy (allowed {:.2} %)",
+                100.0 * change,
+                100.0 * allowed
+            ),
+            Self::Unreached => f.write_str("the walk back from the next seed was lost before it"),
+            Self::Error(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// A requested period without an exact point.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Skipped {
+    /// The map's period.
+    pub period: f64,
+    /// Why, after the reseed failed.
+    pub reason: LossReason,
+}
+
+/// Why an exact branch ended.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
+pub enum ExactEnd {
+    /// The last segment reached the grid's last period (periods may be
+    /// [`ExactBranch::skipped`], with their reasons).
+    Completed,
+    /// No harmonic-balance point corrected to a seed: `attempts` were tried, the last
+    /// failing for `last`.
+    NoSeed {
+        /// Points tried.
+        attempts: usize,
+        /// Why the last one failed.
+        last: LossReason,
+    },
+    /// The branch was lost at `period` and could not be reseeded at it or the periods after
+    /// it (`attempts` in a row): the walk in that direction stopped there.
+    Lost {
+        /// The last period tried.
+        period: f64,
+        /// Consecutive periods skipped.
+        attempts: usize,
+        /// Why the last one was skipped.
+        last: LossReason,
+    },
+}
+
+/// An exact branch: its points in grid order, the periods it skipped and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ExactBranch {
+    /// The first grazing energy `E_g` the energies are normalised by.
+    pub grazing_energy: f64,
+    /// The time step of the branch's grid.
+    pub dt: f64,
+    /// Rows of each monodromy matrix.
+    pub dimension: usize,
+    /// The points, in the order of the grid.
+    pub points: Vec<ExactPoint>,
+    /// The periods without a point, and why.
+    pub skipped: Vec<Skipped>,
+    /// Why the walk ended.
+    pub end: ExactEnd,
+}
