@@ -27,7 +27,7 @@ use std::ops::ControlFlow;
 /// - A period grid is judged before its points are shown: where it stalls or fewer than
 ///   half its steps are good (its converged points, scaled by the share of a sample of
 ///   [`JUDGE_SAMPLES`](crate::branches::JUDGE_SAMPLES) of them that passes the time-domain
-///   check: [`crate::branches::judge`]), as where its branch saturates at a period inside the grid or it walks the
+///   check), as where its branch saturates at a period inside the grid or it walks the
 ///   truncated system's resonances, pseudo-arclength over the grid's range is run too, and
 ///   the run with more good points is returned ([`AutoChoice::GridFellShort`](crate::branches::AutoChoice::GridFellShort) when it is
 ///   arclength; the other run's points are not returned).
