@@ -141,9 +141,8 @@ fn gap_scales_out() {
 }
 
 /// Verdicts on 200 and 400 cells per travel time agree on at least 95 % of the points
-/// resolved on both (slow: the 400-cell matrices cost eight times as much).
+/// resolved on both (about 30 s: the 400-cell matrices cost eight times as much).
 #[test]
-#[ignore = "slow: about a minute and a half in release"]
 fn verdicts_do_not_depend_on_the_grid() {
     let system = clamped_bar_with_obstacle(1e-3).unwrap();
     let request = request(&system, 3.60, 3.55, 11);
