@@ -133,6 +133,9 @@ const FLAGS: &[(&str, Value)] = &[
     ("stability", Value::Switch),
     ("hill", Value::Switch),
     ("basis", Value::Word(&["cosine", "full"])),
+    // The exact branch's grid: without `--exact` (not fuzzed: seconds per point) a usage
+    // error, its values checked all the same.
+    ("cells-per-travel", Value::Real(1.0, 1000.0)),
 ];
 
 /// Every other flag of the `frf` example with its cheap valid values (`--steps` and
@@ -737,6 +740,56 @@ fn gallery_refuses_bad_arguments() {
         assert!(stderr.contains(message), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
+}
+
+/// `backbone --exact` and its grid refuse what they cannot use with the usage code 2 and a
+/// message quoting it, before any march; none panics.
+#[test]
+fn exact_refuses_bad_arguments() {
+    let binary = example_binary("backbone", "examples/backbone");
+    let exact = ["--system", "ds", "--exact", "--steps", "3"];
+    let cases: [(&[&str], &str); 7] = [
+        (&["--cells-per-travel", "0"], "got 0"),
+        (&["--cells-per-travel", "nan"], "got NaN"),
+        (&["--cells-per-travel", "1e9"], "got 1000000000"),
+        (&["--cells-per-travel", "garbage"], "garbage"),
+        (
+            &["--parameter", "energy"],
+            "--exact continues in the period",
+        ),
+        (&["--hill"], "without --hill"),
+        (
+            &["--period-start", "3.5", "--period-end", "3.5"],
+            "from 3.5 to 3.5",
+        ),
+    ];
+    for (extra, message) in cases {
+        let output = Command::new(&binary)
+            .args(exact.iter().chain(extra))
+            .args(["--out", "/dev/null"])
+            .output()
+            .expect("spawn the backbone example");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{extra:?}: {stderr}");
+        assert!(stderr.contains(message), "{extra:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{extra:?}: {stderr}");
+    }
+    // The grid of --exact without --exact is a usage error too, not silently ignored.
+    let output = Command::new(&binary)
+        .args([
+            "--system",
+            "ds",
+            "--steps",
+            "3",
+            "--cells-per-travel",
+            "100",
+        ])
+        .args(["--out", "/dev/null"])
+        .output()
+        .expect("spawn the backbone example");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--cells-per-travel"), "{stderr}");
 }
 
 /// `backbone --stability` writes `stable,max_multiplier,stability_reason` last: a number and

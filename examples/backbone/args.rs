@@ -93,8 +93,9 @@ pub struct Args {
     pub hill: bool,
     /// `--exact`: the exact branch of the one-period map, seeded by the harmonic-balance run.
     pub exact: bool,
-    /// `--cells-per-travel`: the exact map's grid (a minimum; default 200).
-    pub cells_per_travel: f64,
+    /// `--cells-per-travel`: the exact map's grid (a minimum; `None`: the default of
+    /// `StabilityOptions`).
+    pub cells_per_travel: Option<f64>,
 }
 
 fn range(text: &str) -> Result<(f64, f64), lexopt::Error> {
@@ -167,7 +168,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
         hill: false,
         full_basis: false,
         exact: false,
-        cells_per_travel: 200.0,
+        cells_per_travel: None,
     };
     let mut assembly = None;
     let mut system_given = false;
@@ -270,7 +271,7 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("stability") => a.stability = true,
             Long("hill") => a.hill = true,
             Long("exact") => a.exact = true,
-            Long("cells-per-travel") => a.cells_per_travel = parser.value()?.parse()?,
+            Long("cells-per-travel") => a.cells_per_travel = Some(parser.value()?.parse()?),
             Long("basis") => {
                 a.full_basis = match parser.value()?.string()?.as_str() {
                     "cosine" => false,
@@ -315,12 +316,14 @@ pub fn parse() -> Result<Option<Args>, lexopt::Error> {
                 .into(),
         );
     }
-    if !(a.cells_per_travel.is_finite() && (1.0..=1000.0).contains(&a.cells_per_travel)) {
-        return Err(format!(
-            "--cells-per-travel must lie in [1, 1000], got {}",
-            a.cells_per_travel
-        )
-        .into());
+    match a.cells_per_travel {
+        Some(_) if !a.exact => {
+            return Err("--cells-per-travel sets the grid of --exact, which is not given".into())
+        }
+        Some(cells) if !(cells.is_finite() && (1.0..=1000.0).contains(&cells)) => {
+            return Err(format!("--cells-per-travel must lie in [1, 1000], got {cells}").into())
+        }
+        _ => {}
     }
     if a.parameter == Parameter::Energy && a.arclength == Some(true) {
         return Err("--parameter energy is sequential: it takes no --method arclength".into());

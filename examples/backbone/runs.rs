@@ -137,7 +137,8 @@ fn run_exact(
     };
     let options = ExactOptions {
         stability: StabilityOptions {
-            cells_per_travel: a.cells_per_travel,
+            cells_per_travel: (a.cells_per_travel)
+                .unwrap_or(StabilityOptions::default().cells_per_travel),
             ..StabilityOptions::default()
         },
         ..ExactOptions::default()
