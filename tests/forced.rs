@@ -434,3 +434,53 @@ fn a_force_whose_residual_overflows_when_squared_ends_the_dogleg() {
         Err(e) => assert!(!e.to_string().is_empty()),
     }
 }
+
+/// The reliability reproducers of the forced system's public calls: before a frequency is
+/// set, the open response is a typed error (it indexed rows not yet built); a gap history of
+/// a law the system does not have, or of a state of another size, is a typed error; the
+/// contact defect of a basis whose four-times-finer grid is over the memory budget is
+/// measured on the basis' own grid instead of panicking.
+#[test]
+fn the_forced_systems_calls_refuse_what_they_cannot_use() {
+    let (system, forcing) = clamped_base(1e-3, 0.02, 1e-6);
+    let mut problem = ForcedSystem::new(&system, settings(3), &forcing).unwrap();
+    match problem.open_response() {
+        Err(Error::Settings(nonsmooth_modes::SettingsError::NotFinite { what, value })) => {
+            assert!(
+                what.contains("forcing frequency") && value.is_nan(),
+                "{what}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    problem.set_parameter(1.2);
+    let x = problem.open_response().unwrap();
+    assert!(problem
+        .gap_history(&x, 0)
+        .unwrap()
+        .iter()
+        .all(|g| g.is_finite()));
+    match problem.gap_history(&x, 1) {
+        Err(nonsmooth_modes::SettingsError::IndexOutOfRange {
+            index: 1, count: 1, ..
+        }) => {}
+        other => panic!("{other:?}"),
+    }
+    match problem.gap_history(&x[1..], 0) {
+        Err(nonsmooth_modes::SettingsError::Length { got, expected, .. }) => {
+            assert_eq!((got + 1, expected), (x.len(), x.len()))
+        }
+        other => panic!("{other:?}"),
+    }
+    // One harmonic, 10^7 samples per harmonic: within the budget, its finer grid is not.
+    let huge = HarmonicBalanceSettings {
+        harmonics: 1,
+        samples_per_harmonic: 10_000_000,
+        ..Default::default()
+    };
+    let mut big = ForcedSystem::new(&system, huge, &forcing).expect("within the budget");
+    big.set_parameter(1.2);
+    let x = big.open_response().unwrap();
+    let defect = big.contact_defect(&x);
+    assert!(defect.is_finite() && defect >= 0.0, "{defect}");
+}

@@ -250,12 +250,30 @@ impl ForcedSystem {
     }
 
     /// The gap samples of law `l` over one period at `x` (the basis' `N` instants).
-    pub fn gap_history(&self, x: &[f64], l: usize) -> Vec<f64> {
+    ///
+    /// # Errors
+    /// [`SettingsError::IndexOutOfRange`] for a law `l` the system does not have;
+    /// [`SettingsError::Length`] for an `x` that is not a state of the system.
+    pub fn gap_history(&self, x: &[f64], l: usize) -> Result<Vec<f64>, SettingsError> {
+        let count = self.offsets.len();
+        if l >= count {
+            let (what, index) = ("unilateral law", l);
+            return Err(SettingsError::IndexOutOfRange { what, index, count });
+        }
+        let expected = self.dimension();
+        if x.len() != expected {
+            let (what, got) = ("forced state", x.len());
+            return Err(SettingsError::Length {
+                what,
+                got,
+                expected,
+            });
+        }
         let mut gap = vec![0.0; self.basis.samples()];
         self.basis
             .synthesize(&self.observable(x, l, true, false), &mut gap);
         gap.iter_mut().for_each(|v| *v += self.offsets[l].0);
-        gap
+        Ok(gap)
     }
 
     /// The Gram matrices `(G(w_gap), G(w_force))` of law `l` from the samples `s`.
@@ -304,9 +322,18 @@ impl ForcedSystem {
     /// cosine and sine are solved for (a constant rigid motion, singular here, stays zero).
     ///
     /// # Errors
+    /// [`SettingsError::NotFinite`] before a frequency is set
+    /// ([`ContinuationProblem::set_parameter`]);
     /// [`SolveError::SingularJacobian`](crate::SolveError::SingularJacobian) when the open
     /// system is singular at harmonic 1 (an undamped natural frequency).
     pub fn open_response(&self) -> Result<Vec<f64>, Error> {
+        if !self.omega.is_finite() {
+            return Err(SettingsError::NotFinite {
+                what: "forcing frequency (none set yet: set_parameter gives it)",
+                value: self.omega,
+            }
+            .into());
+        }
         let (u, m) = (self.unknowns, self.basis.harmonics());
         let rows = &self.rows[1];
         // Harmonic 1's equations: the linear rows, then every law's force held at zero, for
