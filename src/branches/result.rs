@@ -310,15 +310,7 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             return;
         }
         if let Some((branch, before)) = self.last_verdict {
-            let event = match (before, f.verdict) {
-                (Verdict::Stable, Verdict::Unstable(crossing)) => {
-                    Some(Event::StabilityLost { crossing })
-                }
-                (Verdict::Unstable(crossing), Verdict::Stable) => {
-                    Some(Event::StabilityGained { crossing })
-                }
-                _ => None,
-            };
+            let event = Event::of_verdicts(before, f.verdict);
             if let Some(event) = event.filter(|_| branch == point.branch) {
                 point.events.push(event);
             }

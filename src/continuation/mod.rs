@@ -42,6 +42,7 @@ use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::linalg::DenseMatrix;
 use crate::solve::{Problem, Structured};
 use crate::stability::Crossing;
+use crate::stability::Verdict;
 
 /// A family of square systems `F(x, lambda) = 0` in one scalar parameter: a [`Problem`] at
 /// its current parameter, plus the parameter and the derivative in it.
@@ -230,6 +231,21 @@ pub enum Event {
 }
 
 impl Event {
+    /// The event of a point whose verdict is `now` after a point of the same branch whose
+    /// verdict was `before`: [`Event::StabilityLost`] or [`Event::StabilityGained`], `None`
+    /// where stability did not change.
+    pub(crate) fn of_verdicts(before: Verdict, now: Verdict) -> Option<Self> {
+        match (before, now) {
+            (Verdict::Stable, Verdict::Unstable(crossing)) => {
+                Some(Event::StabilityLost { crossing })
+            }
+            (Verdict::Unstable(crossing), Verdict::Stable) => {
+                Some(Event::StabilityGained { crossing })
+            }
+            _ => None,
+        }
+    }
+
     /// A short label for tables: `fold`, `jump`, `branch-point`, `grazing+`, `grazing-`,
     /// `stability-lost`, `stability-gained`, `left-branch`, `rejoined`.
     pub fn label(&self) -> &'static str {

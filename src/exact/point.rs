@@ -11,7 +11,8 @@ use crate::stability::monodromy::Monodromy;
 use crate::stability::shooting::PseudoInverse;
 use crate::stability::{judge, law_gap, open_section, Floquet, StabilityError, UnresolvedReason};
 use crate::verify::{
-    march, periodicity_of_state, MarchOptions, PeriodicityOptions, SpringUpdate, State,
+    march, periodicity_of_state, MarchOptions, PeriodicityOptions, PeriodicityReport, SpringUpdate,
+    State,
 };
 
 /// A state whose smallest gap, relative to its law's, is below this is moved to the
@@ -24,6 +25,8 @@ struct Judged {
     state: State,
     monodromy: Monodromy,
     floquet: Floquet,
+    /// The orbit's march over one period (its removed energy decides `Merged`).
+    report: PeriodicityReport,
 }
 
 impl Walker<'_> {
@@ -42,7 +45,8 @@ impl Walker<'_> {
         let state = self.coordinates.to_state(model, grid, &outcome.x)?;
         let map = self.map(period);
         let monodromy = map.monodromy(&outcome.x, stability.relative_step)?;
-        let removed = periodicity_of_state(&state, period, &self.periodicity())?.projected_energy;
+        let report = periodicity_of_state(&state, period, &self.periodicity())?;
+        let removed = report.projected_energy;
         let failure =
             (removed > self.options.max_removed_energy).then_some(UnresolvedReason::Merged {
                 removed,
@@ -55,6 +59,7 @@ impl Walker<'_> {
             state,
             monodromy,
             floquet,
+            report,
         })
     }
 
@@ -92,8 +97,8 @@ impl Walker<'_> {
             state,
             monodromy,
             floquet,
+            report,
         } = self.judged(period, outcome, start)?;
-        let report = periodicity_of_state(&state, period, &self.periodicity())?;
         let energy = self.energy(&outcome.x)?;
         let (label, previous, seeded) = context;
         let normalized = energy / self.grazing_energy;

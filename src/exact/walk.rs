@@ -349,17 +349,11 @@ impl Walker<'_> {
         start: &[f64],
         energy: f64,
     ) -> Result<Corrected, StabilityError> {
-        let change: Vec<f64> = outcome.x.iter().zip(start).map(|(a, b)| a - b).collect();
-        let reached = self.energy(&outcome.x)?;
-        Ok(Corrected {
-            x: outcome.x.clone(),
-            initial_defect: outcome.initial_defect,
-            defect: outcome.defect,
-            energy_change: (reached - energy) / energy,
-            shift: norm(&change) / norm(start),
-            displacement_shift: self.coordinates.displacement_distance(&outcome.x, start),
-            iterations: outcome.iterations,
-        })
+        Corrected::measured(
+            (self.coordinates, self.template),
+            (outcome.x.clone(), start, energy),
+            (outcome.initial_defect, outcome.defect, outcome.iterations),
+        )
     }
 }
 
@@ -374,16 +368,9 @@ fn stability_events(points: &mut [ExactPoint]) {
     for p in points.iter_mut() {
         let Some(now) = verdict(p) else { continue };
         if let Some((branch, before)) = last {
-            if branch == p.point.branch {
-                match (before, now) {
-                    (Verdict::Stable, Verdict::Unstable(crossing)) => {
-                        p.point.events.push(Event::StabilityLost { crossing })
-                    }
-                    (Verdict::Unstable(crossing), Verdict::Stable) => {
-                        p.point.events.push(Event::StabilityGained { crossing })
-                    }
-                    _ => {}
-                }
+            let event = Event::of_verdicts(before, now);
+            if let Some(event) = event.filter(|_| branch == p.point.branch) {
+                p.point.events.push(event);
             }
         }
         last = Some((p.point.branch, now));

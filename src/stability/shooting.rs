@@ -1,8 +1,10 @@
 //! Correction of a state to a periodic orbit of the one-period map (shooting).
 
+use super::coordinates::Coordinates;
 use super::monodromy::{Monodromy, PeriodMap};
 use crate::error::StabilityError;
 use crate::solve::norm;
+use crate::verify::State;
 use faer::Mat;
 
 /// Singular values of the correction's matrix below this fraction of the largest are not
@@ -40,6 +42,28 @@ pub(crate) struct PseudoInverse {
     v: faer::Mat<f64>,
     /// The inverted singular values (those above the cutoff).
     s: Vec<f64>,
+}
+
+impl Corrected {
+    /// The state `x`, reached from `base` (of energy `base_energy`) in the `coordinates` of
+    /// `template`'s grid, with how far that moved it and its defects before and after.
+    pub(crate) fn measured(
+        (coordinates, template): (&Coordinates, &State),
+        (x, base, base_energy): (Vec<f64>, &[f64], f64),
+        (initial_defect, defect, iterations): (f64, f64, usize),
+    ) -> Result<Self, StabilityError> {
+        let change: Vec<f64> = x.iter().zip(base).map(|(a, b)| a - b).collect();
+        let reached = coordinates.energy(template, &x)?;
+        Ok(Self {
+            shift: norm(&change) / norm(base),
+            displacement_shift: coordinates.displacement_distance(&x, base),
+            energy_change: (reached - base_energy) / base_energy,
+            x,
+            initial_defect,
+            defect,
+            iterations,
+        })
+    }
 }
 
 impl PseudoInverse {
@@ -168,17 +192,12 @@ impl PeriodMap<'_> {
                 break;
             };
             std::mem::swap(&mut r, &mut trial_r);
-            let change: Vec<f64> = x.iter().zip(base).map(|(a, b)| a - b).collect();
             latest = Some(self.monodromy(&x, relative_step)?);
-            best = Corrected {
-                shift: norm(&change) / x0_norm,
-                displacement_shift: self.coordinates.displacement_distance(&x, base),
-                energy_change: (self.coordinates.energy(self.template, &x)? - energy) / energy,
-                x,
-                initial_defect,
-                defect,
-                iterations: iteration,
-            };
+            best = Corrected::measured(
+                (self.coordinates, self.template),
+                (x, base, energy),
+                (initial_defect, defect, iteration),
+            )?;
         }
         Ok((best, latest, at_base))
     }
