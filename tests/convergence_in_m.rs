@@ -14,10 +14,13 @@
 //! the runs here take `a_c = 4 EA / l`.
 
 use nonsmooth_modes::bar::Bar;
-use nonsmooth_modes::branches::{compute, BackboneOptions, Method, ModeBranches, Request};
+use nonsmooth_modes::branches::{
+    compute, compute_observed, BackboneOptions, Method, ModeBranches, Request,
+};
 use nonsmooth_modes::modal::Label;
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, RESONANCE_BAND};
 use std::f64::consts::PI;
+use std::ops::ControlFlow;
 
 /// A bar of length `l`, speed `c` and stiffness `ea`: clamped (`true`) or free on the left,
 /// facing a wall at gap `gap` on the right, and on the left too when free.
@@ -175,8 +178,10 @@ fn label_counts(run: &ModeBranches, clamped: bool, tau: f64) -> (usize, usize, u
 /// frequency at once, and dropping harmonic 4 with the others put seven points of the default
 /// `m = 20` backbone 20 to 23 % below the exact family, all labelled skeleton), and a point
 /// that does not continue its branch is [`Label::OffBranch`] (spikes of 20 to 50 % at
-/// `m = 40`). With the default request no skeleton point is more than 20 % off and at least
-/// 90 % of the points within 2 % are skeleton, on the unit bars and on generated ones.
+/// `m = 40`, and a one-point spike of 25 % whose energy sits in harmonics of small
+/// coefficients at `m = 80`). With the default request no skeleton point is more than 20 % off
+/// and at least 90 % of the points within 2 % are skeleton, on the unit bars and on generated
+/// ones.
 #[test]
 fn no_skeleton_point_is_far_from_the_exact_family() {
     let mut draw = draws(0x1abe1);
@@ -185,6 +190,8 @@ fn no_skeleton_point_is_far_from_the_exact_family() {
         (true, (1.0, 1.0, 1.0, 1e-3), 40),
         (false, (1.0, 1.0, 1.0, 1e-3), 20),
         (false, (1.0, 1.0, 1.0, 1e-3), 40),
+        (true, (1.0, 1.0, 1.0, 1e-3), 80),
+        (false, (1.0, 1.0, 1.0, 1e-3), 80),
     ];
     for clamped in [true, false] {
         cases.push((clamped, random_bar(&mut draw), 20));
@@ -201,4 +208,26 @@ fn no_skeleton_point_is_far_from_the_exact_family() {
             "m = {m}, {bar:?}: {near_skeleton} of {near} near points are skeleton"
         );
     }
+}
+
+/// A point held until the next one says whether it was a spike reaches the observer with the
+/// label the result gives it, in the run's order: on the clamped bar at `m = 80`, whose run
+/// has a one-point spike of 25 % (`T = 3.835`), the observer sees exactly the points returned.
+#[test]
+fn the_observer_sees_the_labels_the_result_gives() {
+    let system = system(true, (1.0, 1.0, 1.0, 1e-3));
+    let mut seen = Vec::new();
+    let observer = |p: &nonsmooth_modes::branches::BackbonePoint| {
+        seen.push((p.period, p.label.clone(), p.branch));
+        ControlFlow::Continue(())
+    };
+    let run = compute_observed(&system, &Request::new(1).harmonics(80), observer).expect("a run");
+    let returned: Vec<_> = (run.points.iter())
+        .map(|p| (p.period, p.label.clone(), p.branch))
+        .collect();
+    assert_eq!(seen, returned);
+    let spikes = (run.points.iter())
+        .filter(|p| p.events.iter().any(|e| e.label() == "left-branch"))
+        .count();
+    assert!(spikes > 0, "the run left its branch nowhere");
 }

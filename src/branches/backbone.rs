@@ -420,6 +420,13 @@ impl ArclengthBackboneOptions {
 /// Closures `FnMut(&BackbonePoint) -> ControlFlow<()>` observe the points only; implement
 /// the trait to see the rejections too (for instance to stop a run whose shrink factor is
 /// close to 1 after a budget of your own).
+///
+/// The runs of [`compute`](crate::branches::compute) show each point with the label and
+/// branch index the result gives it, in the run's order: a point whose energy leaves the
+/// branch's secant (a possible one-point spike, [`SPIKE_ENERGY`](crate::branches::SPIKE_ENERGY))
+/// is shown, with the failed steps after it, once the next converged point has said whether
+/// it came back: an observer that stops the run there stops it one point later, and the
+/// result ends at the point where it stopped.
 pub trait BackboneObserver {
     /// Called with every accepted point.
     fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()>;

@@ -33,7 +33,7 @@ pub use backbone::{
     MAX_CONSECUTIVE_FAILURES, TRIVIAL_ENERGY,
 };
 pub use compute::{compute, compute_observed};
-pub use continuity::JUMP_RATIO;
+pub use continuity::{JUMP_RATIO, SPIKE_ENERGY, SPIKE_SPREAD};
 pub use convergence::{convergence_study, ConvergenceEntry};
 pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use energy_backbone::{

@@ -7,15 +7,17 @@
 //! energy normalised by the grazing energy of the system at that parameter value.
 
 use crate::branches::backbone::TRIVIAL_ENERGY;
+use crate::branches::continuity::{Sample, Splitter};
 use crate::branches::point::{BackbonePoint, PointStatus};
 use crate::continuation::{
-    Arclength, ArclengthOptions, Branch, Point, Sequential, SequentialOptions, Step,
+    Arclength, ArclengthOptions, Branch, EndReason, Point, Sequential, SequentialOptions, Step,
 };
 use crate::error::{BadRange, ContinuationError, Error, RangeDefect};
 use crate::modal::energy::energy;
 use crate::modal::linear::grazing_energy;
+use crate::modal::Label;
 use crate::solve::NonlinearSolver;
-use crate::system::{HarmonicBalanceSettings, ParameterFamily, SystemFamily};
+use crate::system::{HarmonicBalanceSettings, NonsmoothSystem, ParameterFamily, SystemFamily};
 use std::ops::ControlFlow;
 
 /// How [`parameter_branch`] steps through the parameter.
@@ -48,6 +50,17 @@ pub enum ParameterSteps {
 /// `E_g` at its parameter) is the state of rest, not a point of the branch: it reaches the
 /// observer as [`PointStatus::CollapsedToRest`] with `converged == false`.
 ///
+/// Branches are continuous or split, as in [`compute`](crate::branches::compute)'s runs
+/// ([`JUMP_RATIO`](crate::branches::JUMP_RATIO),
+/// [`SPIKE_ENERGY`](crate::branches::SPIKE_ENERGY)): a converged point that does not continue
+/// the branch (its state far from the secant of the last two in the parameter, measured in
+/// the energy weights of the start's system, or a one-point spike of `E / E_g`) is labelled
+/// [`Label::OffBranch`] and opens a new [`BackbonePoint::branch`] index with
+/// [`Event::LeftBranch`](crate::continuation::Event::LeftBranch), and the first point back
+/// another with [`Event::Rejoined`](crate::continuation::Event::Rejoined); a jump of the
+/// driver opens one too. A point held as a possible spike reaches the observer once the next
+/// converged point has said whether it came back.
+///
 /// # Errors
 /// A family that rejects `value`, a system at `value` without grazing energy, invalid
 /// settings or options, or a start where the solver fails ([`ContinuationError::Start`],
@@ -75,7 +88,29 @@ where
     let floor = TRIVIAL_ENERGY;
     let problem = ParameterFamily::at(family.clone(), settings, omega, value)?;
     // Energies are normalised by `E_g`: a start without one is refused, as by `backbone`.
-    grazing_energy(&family.build(value)?)?;
+    let start = family.build(value)?;
+    grazing_energy(&start)?;
+    // The continuity test's norm: the energy weights of the start's system.
+    let (weights, per) = {
+        let description = NonsmoothSystem::new(&start, settings)?;
+        let description = description.description();
+        (description.state_weights(omega), description.unknowns)
+    };
+    let mut splitter = Splitter::<BackbonePoint, f64>::default();
+    let mut stopped = false;
+    // Shows the points released to the observer, up to the one at which it stops the run.
+    let mut show = |released: &mut dyn Iterator<Item = (BackbonePoint, f64)>| {
+        for (point, parameter) in released {
+            if !stopped && observer(parameter, &point).is_break() {
+                stopped = true;
+            }
+        }
+        if stopped {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    };
     // The point in the frame of the system at its parameter value; a value the family
     // rejects is skipped (it is not a point of the branch).
     let mut report = |p: &Point| {
@@ -89,11 +124,24 @@ where
             point.converged = false;
             point.status = PointStatus::CollapsedToRest;
         }
-        observer(p.parameter, &point)
+        splitter.enter(&mut point);
+        if point.converged {
+            let sample = Sample {
+                period: p.parameter,
+                energy: point.energy_normalized,
+                x: p.x.clone(),
+                held: Vec::new(),
+            };
+            if let Some(ratio) = splitter.judge(&mut point, sample, &weights, per) {
+                point.label = Some(Label::OffBranch { ratio });
+            }
+        }
+        splitter.push(point, p.parameter);
+        show(&mut splitter.release())
     };
     let mut see = |step: &Step| step.point().map_or(ControlFlow::Continue(()), &mut report);
     // The energy floor above decides what counts as rest, and says so in the status.
-    let branch = match steps {
+    let mut branch = match steps {
         ParameterSteps::Values(values, options) => {
             Sequential::new(problem, solver, x, values, options)?
                 .with_rest_accepted()
@@ -103,6 +151,10 @@ where
             .with_rest_accepted()
             .run(&mut see),
     };
+    // A point held until the run ended: an observer that stops there stops the run.
+    if show(&mut splitter.flush()).is_break() {
+        branch.end = EndReason::StoppedByObserver;
+    }
     Ok(branch)
 }
 

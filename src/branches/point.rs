@@ -1,6 +1,7 @@
 //! The points of a backbone and what a backbone run returns: every point it computed, each
 //! with its status, and the reason it ended. A run that stalls or is stopped keeps its points.
 
+use crate::branches::continuity::OnBranch;
 use crate::continuation::{EndReason, Event, Point};
 use crate::error::{ContinuationError, Error, SettingsError, SolveError};
 use crate::fourier::{frequency_of_period, period_of_frequency, Basis};
@@ -131,6 +132,29 @@ impl BackbonePoint {
             label: None,
             stability: None,
             hill: None,
+        }
+    }
+}
+
+/// A point whose label reads as its branch's own (skeleton, subharmonic, or none yet) becomes
+/// [`Label::OffBranch`] when it turns out a spike; a check that failed it keeps
+/// [`Label::Unverified`].
+impl OnBranch for BackbonePoint {
+    fn set_branch(&mut self, branch: usize) {
+        self.branch = branch;
+    }
+
+    fn push_event(&mut self, event: Event) {
+        self.events.push(event);
+    }
+
+    fn jumped(&self) -> bool {
+        self.events.iter().any(|e| matches!(e, Event::Jump { .. }))
+    }
+
+    fn left_branch(&mut self, ratio: f64) {
+        if self.label != Some(Label::Unverified) {
+            self.label = Some(Label::OffBranch { ratio });
         }
     }
 }

@@ -2,7 +2,7 @@
 //! index, its time-domain defect and its label on the way.
 
 use crate::branches::backbone::BackboneObserver;
-use crate::branches::continuity::{BranchTail, Sample};
+use crate::branches::continuity::{Sample, Splitter};
 use crate::branches::judge::check_point;
 use crate::branches::point::{BackbonePoint, CheckOutcome};
 use crate::branches::request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
@@ -112,16 +112,15 @@ pub(crate) struct Annotator<O, B: Basis = CosineBasis> {
     order: usize,
     observer: O,
     points: Vec<BackbonePoint>,
-    branch: usize,
+    /// Whether the observer stopped the run.
+    stopped: bool,
     converged: usize,
     /// Open-contact natural frequencies up to `natural_up_to` (computed as points need).
     natural: Vec<f64>,
     natural_up_to: f64,
-    /// The last points of the mode's own branch, which the next one must continue
-    /// ([`crate::branches::continuity`]).
-    tail: BranchTail,
-    /// Whether the last point of the mode's own content was off the branch.
-    off_branch: bool,
+    /// Branch indices, and whether the points of the mode's own content continue the branch
+    /// their run followed ([`crate::branches::continuity`]).
+    splitter: Splitter<BackbonePoint>,
 }
 
 impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
@@ -136,12 +135,11 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             order: request.subharmonic,
             observer,
             points: Vec::new(),
-            branch: 0,
+            stopped: false,
             converged: 0,
             natural: Vec::new(),
             natural_up_to: 0.0,
-            tail: BranchTail::default(),
-            off_branch: false,
+            splitter: Splitter::default(),
         }
     }
 
@@ -155,22 +153,43 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         }
     }
 
-    /// Annotates `point`, shows it to the observer and keeps it (moved in, not copied).
+    /// Annotates `point`, shows it to the observer and keeps it (moved in, not copied). A
+    /// point held as a possible spike is shown, with the points after it, once the next
+    /// converged point of the mode's own content has said whether it left the branch.
     pub(crate) fn point(&mut self, mut point: BackbonePoint) -> ControlFlow<()> {
-        // A jump (the stall escape, a corrector that lands far from its prediction, a switch
-        // onto a crossing branch) leaves the branch followed so far.
-        let jumped = point.events.iter().any(|e| matches!(e, Event::Jump { .. }));
-        if jumped && !self.points.is_empty() {
-            self.branch += 1;
-        }
-        point.branch = self.branch;
+        self.splitter.enter(&mut point);
         if point.converged {
             self.converged += 1;
             self.describe(&mut point);
         }
-        let flow = self.observer.point(&point);
-        self.points.push(point);
-        flow
+        self.splitter.push(point, ());
+        let released: Vec<_> = self.splitter.release().map(|(p, ())| p).collect();
+        self.show(released)
+    }
+
+    /// Shows `points` to the observer and keeps them, up to the one at which it stops the
+    /// run: the result holds the points the observer saw (a point computed after a held one
+    /// at which it stops is past where it asked to stop).
+    fn show(&mut self, points: impl IntoIterator<Item = BackbonePoint>) -> ControlFlow<()> {
+        for point in points {
+            if self.stopped {
+                break;
+            }
+            self.stopped = self.observer.point(&point).is_break();
+            self.points.push(point);
+        }
+        if self.stopped {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+
+    /// Shows the points still held (the run ended); returns whether the observer stopped the
+    /// run, then or before.
+    fn flush(&mut self) -> bool {
+        let held: Vec<_> = self.splitter.flush().map(|(p, ())| p).collect();
+        self.show(held).is_break()
     }
 
     /// Shows a rejected step to the observer.
@@ -190,17 +209,16 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
                 self.check(&mut point);
                 self.assess(&mut point);
             }
-            let flow = self.observer.point(&point);
-            self.points.push(point);
-            if flow.is_break() {
+            if self.show([point]).is_break() {
                 return EndReason::StoppedByObserver;
             }
         }
         end
     }
 
-    /// The points kept, in order.
-    pub(crate) fn into_points(self) -> Vec<BackbonePoint> {
+    /// The points kept, in order (a point still held is shown to the observer first).
+    pub(crate) fn into_points(mut self) -> Vec<BackbonePoint> {
+        self.flush();
         self.points
     }
 
@@ -217,6 +235,7 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
     fn describe(&mut self, point: &mut BackbonePoint) {
         let (x, omega) = (&point.x, point.omega);
         let Ok(mut described) = character(&mut self.problem, x, omega, &self.natural) else {
+            self.splitter.other();
             return;
         };
         // The natural frequencies are computed only as far as the points name modes: a
@@ -227,25 +246,15 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         let natural = &self.natural;
         let content = label(&described, self.order, omega, natural, None).ok();
         point.character = Some(described);
-        point.label = content.map(|l| self.on_branch(l, point));
-        self.split_at_excursion(point);
+        point.label = match content {
+            Some(content) => Some(self.on_branch(content, point)),
+            None => {
+                self.splitter.other();
+                None
+            }
+        };
         self.check(point);
         self.assess(point);
-    }
-
-    /// A new branch index, with [`Event::LeftBranch`], at the first point of an excursion off
-    /// the mode's own branch, and another, with [`Event::Rejoined`], at the first point back
-    /// on it: the branch index then changes wherever the run leaves the curve it followed.
-    fn split_at_excursion(&mut self, point: &mut BackbonePoint) {
-        let event = match (&point.label, self.off_branch) {
-            (Some(Label::OffBranch { ratio }), false) => Event::LeftBranch { ratio: *ratio },
-            (Some(Label::Skeleton | Label::Subharmonic { .. }), true) => Event::Rejoined,
-            _ => return,
-        };
-        self.off_branch = !self.off_branch;
-        self.branch += 1;
-        point.branch = self.branch;
-        point.events.push(event);
     }
 
     /// The time-domain check the request asks of a converged point, where it has none yet;
@@ -267,21 +276,24 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
 
     /// `label` where the point continues the mode's own branch, [`Label::OffBranch`] where
     /// its content reads as the branch's (skeleton, subharmonic) but it lies off the branch
-    /// followed so far ([`crate::branches::continuity`]).
-    fn on_branch(&mut self, label: Label, point: &BackbonePoint) -> Label {
+    /// followed so far ([`crate::branches::continuity`]); a point off the branch, and the
+    /// first point back, open new branch indices.
+    fn on_branch(&mut self, label: Label, point: &mut BackbonePoint) -> Label {
         if !matches!(label, Label::Skeleton | Label::Subharmonic { .. }) {
+            self.splitter.other();
             return label;
         }
         let weights = self.problem.description().state_weights(point.omega);
         let per = self.problem.description().unknowns;
         let sample = Sample {
             period: point.period,
+            energy: point.energy,
             x: point.x.clone(),
             held: self.problem.held_at(point.omega),
         };
-        match self.tail.continues(sample, &weights, per) {
-            Ok(()) => label,
-            Err(ratio) => Label::OffBranch { ratio },
+        match self.splitter.judge(point, sample, &weights, per) {
+            Some(ratio) => Label::OffBranch { ratio },
+            None => label,
         }
     }
 
@@ -357,18 +369,26 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
 
 impl<O: BackboneObserver> Annotator<O> {
     /// The points kept, in order, and the problem they were annotated on.
-    pub(crate) fn into_parts(self) -> (Vec<BackbonePoint>, NonsmoothSystem) {
+    pub(crate) fn into_parts(mut self) -> (Vec<BackbonePoint>, NonsmoothSystem) {
+        self.flush();
         (self.points, self.problem)
     }
 
     /// The result of the run.
     pub(crate) fn finish(
-        self,
+        mut self,
         (method, auto): (Method, Option<AutoChoice>),
         grazing_energy: f64,
         end: EndReason,
         rejected_steps: usize,
     ) -> ModeBranches {
+        // An observer that stops the run at a point shown only now (held until the run ended)
+        // stops it all the same: what came after is past where it asked to stop.
+        let end = if self.flush() {
+            EndReason::StoppedByObserver
+        } else {
+            end
+        };
         ModeBranches {
             problem: self.problem,
             method,

@@ -217,7 +217,9 @@ pub enum Event {
     /// The point's harmonic content reads as the branch's own, but it does not continue the
     /// branch its run followed so far: it lies `ratio` times the predicted step from the
     /// secant through the branch's last two points
-    /// ([`JUMP_RATIO`](crate::branches::JUMP_RATIO)). The point opens a new branch index;
+    /// ([`JUMP_RATIO`](crate::branches::JUMP_RATIO)), or its energy is off the chord of its
+    /// neighbours' as a one-point spike ([`SPIKE_ENERGY`](crate::branches::SPIKE_ENERGY),
+    /// `ratio` then that of its state). The point opens a new branch index;
     /// reported by [`compute`](crate::branches::compute) on the first point of each
     /// excursion.
     LeftBranch {

@@ -200,8 +200,10 @@ pub enum Label {
     /// The point's harmonic content reads as the branch's own (skeleton or subharmonic), but
     /// the point does not continue the branch its run followed: it lies `ratio` times the
     /// predicted step away from the branch's secant prediction, more than
-    /// [`JUMP_RATIO`](crate::branches::JUMP_RATIO) (a spike of a truncation resonance, or a
-    /// neighbouring solution the corrector jumped to). Given by the runs of
+    /// [`JUMP_RATIO`](crate::branches::JUMP_RATIO) (a neighbouring solution the corrector
+    /// jumped to), or it is a one-point spike whose energy is off its neighbours' chord
+    /// ([`SPIKE_ENERGY`](crate::branches::SPIKE_ENERGY); a truncation resonance just outside
+    /// the selection's band). Given by the runs of
     /// [`compute`](crate::branches::compute), never by [`label`].
     OffBranch {
         /// Distance to the branch's prediction over the predicted step.
