@@ -10,8 +10,10 @@
 //! - `labels`: the character and label of each converged point of the kept run, with the
 //!   open-contact natural frequencies the labels name;
 //! - `judge`: the time-domain march of the judge's 8 points of the kept run;
-//! - `selection_scan`: the open- and closed-contact natural frequencies the selection reads
-//!   (on a new system each time: a system keeps its scans).
+//! - `selection_scan`: the open- and closed-contact natural frequencies the selection reads.
+//!
+//! A system keeps its natural-frequency scans (`system::spectra`), so every iteration builds
+//! the system anew, as a process running the request once does.
 //!
 //! ```text
 //! cargo bench --bench default_request                 # everything
@@ -62,6 +64,11 @@ fn run(system: &BarSystem, request: &Request) -> ModeBranches {
     compute(system, request).expect("a backbone")
 }
 
+/// The clamped bar, built anew (with no scans kept).
+fn fresh() -> BarSystem {
+    clamped_bar_with_obstacle(GAP).expect("the clamped bar")
+}
+
 fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
     let mut group = c.benchmark_group(name);
     group
@@ -79,7 +86,7 @@ fn bench_whole(c: &mut Criterion) {
         for (name, threads) in [("two_threads", true), ("serial", false)] {
             let request = request(m, auto, threads);
             group.bench_with_input(BenchmarkId::new(name, m), &request, |b, r| {
-                b.iter(|| run(black_box(&system), r))
+                b.iter(|| run(&fresh(), black_box(r)))
             });
         }
     }
@@ -93,12 +100,12 @@ fn bench_runs(c: &mut Criterion) {
     for m in HARMONICS {
         let sequential = request(m, Method::PeriodGrid(options), false);
         group.bench_with_input(BenchmarkId::new("sequential", m), &sequential, |b, r| {
-            b.iter(|| run(black_box(&system), r))
+            b.iter(|| run(&fresh(), black_box(r)))
         });
         let selected =
             request(m, Method::Auto(Some(options)), false).resonance_band(RESONANCE_BAND);
         group.bench_with_input(BenchmarkId::new("selected", m), &selected, |b, r| {
-            b.iter(|| run(black_box(&system), r))
+            b.iter(|| run(&fresh(), black_box(r)))
         });
     }
     group.finish();
@@ -121,7 +128,7 @@ fn bench_parts(c: &mut Criterion) {
             b.iter(|| {
                 let mut problem = result.problem().clone();
                 // The labels' scan: open-contact modes a little beyond the points' fundamentals.
-                let open = natural_frequencies(&system, ContactState::Open, 2.0 * highest)
+                let open = natural_frequencies(&fresh(), ContactState::Open, 2.0 * highest)
                     .expect("a scan");
                 let natural: Vec<f64> = open.iter().map(|mode| mode.omega).collect();
                 for p in &points {
@@ -154,9 +161,9 @@ fn bench_parts(c: &mut Criterion) {
         let bound = 2.0 * (m as f64 + 1.0) * omega * (1.0 + RESONANCE_BAND / m as f64);
         group.bench_function(BenchmarkId::new("selection_scan", m), |b| {
             b.iter(|| {
-                let fresh = clamped_bar_with_obstacle(GAP).expect("the clamped bar");
+                let system = fresh();
                 for state in [ContactState::Open, ContactState::Closed] {
-                    black_box(natural_frequencies(&fresh, state, bound).ok());
+                    black_box(natural_frequencies(&system, state, bound).ok());
                 }
             })
         });
