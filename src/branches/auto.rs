@@ -10,7 +10,6 @@ use crate::branches::request::{AutoChoice, Method, Request};
 use crate::branches::start::{
     backbone_start, tethered_backbone_start, BackboneStart, MIN_COARSE_HARMONICS,
 };
-use crate::continuation::EndReason;
 use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
@@ -44,7 +43,7 @@ pub(crate) fn judged_auto(
     let direct = direct_run(system, request, grid, problem.clone());
     // Only a run that fell short, or a start that was not found, is worth a coarser run.
     let direct_good = match &direct {
-        Ok((run, ..)) if 2 * run.good < grid.grid.steps => run.good,
+        Ok((run, ..)) if run.falls_short_of(grid.grid.steps) => run.good(),
         Err(Error::Settings(SettingsError::StartNotFound { .. })) => 0,
         _ => return direct,
     };
@@ -71,12 +70,13 @@ pub(crate) fn judged_auto(
     let floor = grid.trivial_energy * run.e_g;
     let coarse = (&run.points[..], run.e_g, floor);
     let (lifted, problem) = lifted_run(coarse, (run.end, run.rejected), request, problem);
-    if lifted.good <= direct_good {
+    let lifted_good = lifted.good();
+    if lifted_good <= direct_good {
         return direct;
     }
     let choice = AutoChoice::Lifted {
         harmonics,
-        good: lifted.good,
+        good: lifted_good,
         direct_good,
     };
     Ok((lifted, method, Some(choice), problem))
@@ -105,13 +105,13 @@ fn direct_run(
         problem,
     );
     Ok(match (searched, tied) {
-        (Ok(a), Ok(b)) if b.0.good <= a.0.good => a,
+        (Ok(a), Ok(b)) if b.0.good() <= a.0.good() => a,
         (Ok(a), Err(_)) => a,
         (Err(e), Err(_)) => return Err(e),
         (searched, Ok((run, method, _, problem))) => {
-            let searched_good = searched.map_or(0, |a| a.0.good);
+            let searched_good = searched.map_or(0, |a| a.0.good());
             let choice = AutoChoice::Tethered {
-                good: run.good,
+                good: run.good(),
                 searched_good,
             };
             (run, method, Some(choice), problem)
@@ -141,7 +141,7 @@ fn judged_run(
         return Ok((grid, method, auto, problem));
     };
     let steps = options.grid.steps;
-    if !grid_fell_short(grid.good, steps, &grid.end) {
+    if !grid_fell_short(&grid, steps) {
         return Ok((grid, method, auto, problem));
     }
     let arclength = ArclengthBackboneOptions::over_grid(&options);
@@ -149,8 +149,8 @@ fn judged_run(
     let solver = request.solver_for(&other)?;
     let plan = Plan::Arclength(arclength, start);
     let (run, problem) = quiet_run(system, request, (plan, solver), problem)?;
-    Ok(if run.good > grid.good {
-        let good = grid.good;
+    let good = grid.good();
+    Ok(if run.good() > good {
         (
             run,
             other,
@@ -162,12 +162,12 @@ fn judged_run(
     })
 }
 
-/// Whether a period grid of `steps` steps with `good` good points ([`QuietRun::good`]) that
-/// ended with `end` falls short of
-/// a backbone: it stalled, or fewer than half its steps are good (its branch left the grid's
-/// range, or the grid walks the truncated system's resonances).
-fn grid_fell_short(good: usize, steps: usize, end: &EndReason) -> bool {
-    end.error().is_some() || 2 * good < steps
+/// Whether the run of a period grid of `steps` steps falls short of a backbone: it stalled,
+/// or fewer than half its steps are good ([`QuietRun::good`]: its branch left the grid's
+/// range, or the grid walks the truncated system's resonances). A stalled run needs no
+/// march of the judge's sample to tell.
+fn grid_fell_short(grid: &QuietRun, steps: usize) -> bool {
+    grid.end.error().is_some() || grid.falls_short_of(steps)
 }
 
 /// What [`Method::Auto`] runs at the request's harmonics: the plan, the method it stands

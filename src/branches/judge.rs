@@ -28,7 +28,7 @@
 use crate::bar::shortest_travel_time;
 use crate::branches::point::{BackbonePoint, CheckOutcome};
 use crate::branches::request::TimeDomainCheck;
-use crate::fourier::Basis;
+use crate::fourier::{Basis, CosineBasis};
 use crate::system::{BarSystem, NonsmoothSystem};
 use crate::verify::{periodicity_check, PeriodicityOptions, PeriodicityReport, VerifyError};
 
@@ -94,24 +94,6 @@ pub(crate) struct Sampled {
 }
 
 impl Sampled {
-    /// The judge's sample of `points` on `problem`: up to [`JUDGE_SAMPLES`] converged
-    /// points, the `k`-th of `s` at `(2k + 1) n / 2s` among the `n` converged, marched.
-    pub(crate) fn of_run(points: &[BackbonePoint], problem: &NonsmoothSystem) -> Self {
-        let converged: Vec<&BackbonePoint> = points.iter().filter(|p| p.converged).collect();
-        let (n, s) = (converged.len(), converged.len().min(JUDGE_SAMPLES));
-        let check = judge_check(problem.system());
-        let mut sampled = Self::default();
-        for k in 0..s {
-            let point = converged[(2 * k + 1) * n / (2 * s)];
-            match check_point(&check, (problem.system(), problem.basis()), point).0 {
-                CheckOutcome::Passed => sampled.passed += 1,
-                CheckOutcome::Failed => sampled.failed += 1,
-                _ => {}
-            }
-        }
-        sampled
-    }
-
     /// `count` scaled by the share of the sample that passed (`count` itself where nothing
     /// could be marched), rounded to the nearest integer.
     pub(crate) fn scale(&self, count: usize) -> usize {
@@ -120,6 +102,98 @@ impl Sampled {
             return count;
         }
         ((count * self.passed) as f64 / marched as f64).round() as usize
+    }
+}
+
+/// The judge of one run: its sample of up to [`JUDGE_SAMPLES`] converged points, the `k`-th
+/// of `s` at `(2k + 1) n / 2s` among the `n` converged, marched one at a time as far as a
+/// question needs.
+///
+/// # Why lazily
+/// Most questions `Auto` asks of a run are whether it falls short of half its grid's steps.
+/// Once the points marched decide that whatever the others give (the run's count scaled by
+/// the share that passed, with every remaining point failing, still reaches half the steps;
+/// or with every one passing, still does not), the rest of the sample is not marched: on the
+/// clamped bar four passing points of eight settle it. A question that needs the count
+/// itself marches the whole sample, so every answer is the one the whole sample gives.
+#[derive(Debug, Clone)]
+pub(crate) struct Judge {
+    system: BarSystem,
+    basis: CosineBasis,
+    /// Indices of the sample among the run's points, in marching order.
+    sample: Vec<usize>,
+    /// How many of the sample were marched, and with what outcome.
+    marched: usize,
+    sampled: Sampled,
+    /// The run's good points before scaling.
+    count: usize,
+}
+
+impl Judge {
+    /// The judge of the run of `points` on `problem`, nothing marched yet.
+    pub(crate) fn new(points: &[BackbonePoint], problem: &NonsmoothSystem) -> Self {
+        let converged: Vec<usize> = (0..points.len()).filter(|&i| points[i].converged).collect();
+        let (n, s) = (converged.len(), converged.len().min(JUDGE_SAMPLES));
+        Self {
+            system: problem.system().clone(),
+            basis: problem.basis().clone(),
+            sample: (0..s)
+                .map(|k| converged[(2 * k + 1) * n / (2 * s)])
+                .collect(),
+            marched: 0,
+            sampled: Sampled::default(),
+            count: points.iter().filter(|p| p.is_good()).count(),
+        }
+    }
+
+    /// Marches the next point of the sample; `false` when none is left.
+    fn march_next(&mut self, points: &[BackbonePoint]) -> bool {
+        let Some(&i) = self.sample.get(self.marched) else {
+            return false;
+        };
+        self.marched += 1;
+        let Some(point) = points.get(i) else {
+            return true;
+        };
+        let check = judge_check(&self.system);
+        match check_point(&check, (&self.system, &self.basis), point).0 {
+            CheckOutcome::Passed => self.sampled.passed += 1,
+            CheckOutcome::Failed => self.sampled.failed += 1,
+            _ => {}
+        }
+        true
+    }
+
+    /// The run's good points, scaled by the share of the whole sample that passed.
+    pub(crate) fn good(&mut self, points: &[BackbonePoint]) -> usize {
+        while self.march_next(points) {}
+        self.sampled.scale(self.count)
+    }
+
+    /// Whether the run's good points ([`Judge::good`]) are fewer than half of `steps`,
+    /// marching only as much of the sample as decides it.
+    pub(crate) fn falls_short(&mut self, points: &[BackbonePoint], steps: usize) -> bool {
+        loop {
+            let left = self.sample.len() - self.marched;
+            let Sampled { passed, failed } = self.sampled;
+            let least = Sampled {
+                passed,
+                failed: failed + left,
+            };
+            let most = Sampled {
+                passed: passed + left,
+                failed,
+            };
+            if 2 * least.scale(self.count) >= steps {
+                return false;
+            }
+            if 2 * most.scale(self.count) < steps {
+                return true;
+            }
+            if !self.march_next(points) {
+                return 2 * self.sampled.scale(self.count) < steps;
+            }
+        }
     }
 }
 
@@ -141,5 +215,41 @@ mod tests {
             failed: 3,
         };
         assert_eq!(all_failed.scale(181), 0);
+    }
+
+    /// The lazy judge answers whether a run falls short as the whole sample does, marching
+    /// only what decides it: on the clamped bar's run, whose sampled points pass or fail
+    /// whatever the order, the answer and the count match those of the full sample.
+    #[test]
+    fn falling_short_is_decided_as_the_whole_sample_decides_it() {
+        use crate::branches::backbone::BackboneOptions;
+        use crate::branches::compute::compute;
+        use crate::branches::request::{Method, Request};
+        use crate::reference::clamped_bar_with_obstacle;
+        let system = clamped_bar_with_obstacle(1e-3).unwrap();
+        let grid = BackboneOptions::for_mode(&system, 1, 1).unwrap();
+        let request = Request::new(1)
+            .harmonics(10)
+            .method(Method::PeriodGrid(grid));
+        let run = compute(&system, &request).unwrap();
+        let points = run.points.clone();
+        let mut whole = Judge::new(&points, run.problem());
+        let good = whole.good(&points);
+        for steps in [0, 1, good, 2 * good, 2 * good + 1, 2 * good + 2, 400] {
+            let mut lazy = Judge::new(&points, run.problem());
+            assert_eq!(
+                lazy.falls_short(&points, steps),
+                2 * good < steps,
+                "{steps}"
+            );
+            assert!(lazy.marched <= JUDGE_SAMPLES);
+            assert_eq!(lazy.good(&points), good);
+        }
+        // Half the steps reached with every sampled point passing: decided before the end.
+        if whole.sampled.failed == 0 && whole.sampled.passed == JUDGE_SAMPLES {
+            let mut lazy = Judge::new(&points, run.problem());
+            assert!(!lazy.falls_short(&points, good));
+            assert!(lazy.marched < JUDGE_SAMPLES);
+        }
     }
 }

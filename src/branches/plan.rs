@@ -6,7 +6,7 @@ use crate::branches::backbone::{
     ArclengthBackboneOptions, BackboneObserver, BackboneOptions, PointSink,
 };
 use crate::branches::energy_backbone::{energy_backbone_with, EnergyBackboneOptions};
-use crate::branches::judge::Sampled;
+use crate::branches::judge::Judge;
 use crate::branches::point::BackbonePoint;
 use crate::branches::request::{Method, Request};
 use crate::branches::result::Annotator;
@@ -16,6 +16,7 @@ use crate::continuation::{EndReason, Rejection};
 use crate::error::Error;
 use crate::solve::Solver;
 use crate::system::{BarSystem, NonsmoothSystem};
+use std::cell::RefCell;
 use std::ops::ControlFlow;
 
 /// What [`compute`](crate::branches::compute) runs: the driver, with its options built from the system and the
@@ -38,27 +39,38 @@ pub(crate) struct QuietRun {
     pub e_g: f64,
     pub end: EndReason,
     pub rejected: usize,
-    /// Converged points, scaled by the share of the judge's sample that passed
-    /// ([`crate::branches::judge`]).
-    pub good: usize,
+    /// The judge of the run's points ([`crate::branches::judge`]), marched as far as the
+    /// questions asked of the run need.
+    judge: RefCell<Judge>,
 }
 
 impl QuietRun {
-    /// The run of `points` annotated on `problem`, judged.
+    /// The run of `points` annotated on `problem`, to be judged.
     pub(crate) fn new(
         points: Vec<BackbonePoint>,
         (e_g, end, rejected): (f64, EndReason, usize),
         problem: &NonsmoothSystem,
     ) -> Self {
-        let good =
-            Sampled::of_run(&points, problem).scale(points.iter().filter(|p| p.is_good()).count());
+        let judge = RefCell::new(Judge::new(&points, problem));
         Self {
             points,
             e_g,
             end,
             rejected,
-            good,
+            judge,
         }
+    }
+
+    /// Converged points, scaled by the share of the judge's sample that passed
+    /// ([`crate::branches::judge`]).
+    pub(crate) fn good(&self) -> usize {
+        self.judge.borrow_mut().good(&self.points)
+    }
+
+    /// Whether [`QuietRun::good`] is below half of `steps`, from as few of the judge's
+    /// marches as decide it.
+    pub(crate) fn falls_short_of(&self, steps: usize) -> bool {
+        self.judge.borrow_mut().falls_short(&self.points, steps)
     }
 }
 

@@ -154,13 +154,16 @@ fn fold_for_half_length(x: &[f64], half: usize, sin: &[f64], real: &mut Vec<f64>
         return;
     }
     // x_k vanishes from k = len on, x_(M-k) up to k = M - len.
-    real.fill(0.0);
     let lead = x.len().min(half);
     for k in 0..lead {
         let (a, b) = (x[k], if half - k < x.len() { x[half - k] } else { 0.0 });
         real[k] = (a + b) - 2.0 * sin[k] * (a - b);
     }
-    for k in (half + 1 - x.len()).max(lead)..half {
+    // Only the samples between the two ends vanish (a short synthesis: most of them); the
+    // ends are written above and below.
+    let tail = (half + 1 - x.len()).max(lead).min(half);
+    real[lead..tail].fill(0.0);
+    for k in tail..half {
         real[k] = x[half - k] * (1.0 + 2.0 * sin[k]);
     }
 }

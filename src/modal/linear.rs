@@ -13,6 +13,7 @@ use crate::linalg::{determinant_sign_small, singular_values_small, svd_small, De
 use crate::modal::energy::{energy_of, Conditions};
 use crate::modal::inputs::check_frequency_of;
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
+use crate::system::spectra::ScanKey;
 use crate::system::{BarSystem, NonsmoothSystem};
 
 /// Which linear state the unilateral conditions take.
@@ -178,6 +179,15 @@ impl Resolution {
         per_spacing: 50.0,
         tolerance: 1e-10,
     };
+
+    /// The key of a scan of `state` at this resolution among the system's scans.
+    fn key(self, state: ContactState) -> ScanKey {
+        let tag = match state {
+            ContactState::Open => 0,
+            ContactState::Closed => 1,
+        };
+        (tag, self.per_spacing, self.tolerance)
+    }
 }
 
 /// The frequencies of [`natural_frequencies`] without their shapes, located to
@@ -213,6 +223,45 @@ pub(crate) fn natural_frequency_values(
             limit: MAX_SCAN,
         });
     }
+    let key = resolution.key(state);
+    if let Some(values) = system.spectra().exact(key, omega_max) {
+        return Ok(values);
+    }
+    let modes = scan(system, state, (omega_max, h), resolution);
+    system.spectra().keep(key, omega_max, &modes);
+    Ok(modes)
+}
+
+/// The natural frequencies of [`natural_frequency_values`] up to some bound at or above
+/// `omega_max`, with that bound: a scan of the system already run up to a higher one where
+/// there is one ([`Spectra::covering`](crate::system::spectra::Spectra::covering): its values
+/// below `omega_max` less a few scan steps are the same), else a new scan up to `omega_max`.
+///
+/// # Errors
+/// See [`natural_frequencies`].
+pub(crate) fn natural_frequencies_covering(
+    system: &BarSystem,
+    state: ContactState,
+    omega_max: f64,
+    resolution: Resolution,
+) -> Result<(f64, Vec<f64>), SettingsError> {
+    if omega_max.is_finite() && omega_max > 0.0 {
+        if let Some(found) = system.spectra().covering(resolution.key(state), omega_max) {
+            return Ok(found);
+        }
+    }
+    natural_frequency_values(system, state, omega_max, resolution).map(|v| (omega_max, v))
+}
+
+/// The scan of [`natural_frequency_values`] up to `omega_max` with step `h`, its arguments
+/// checked.
+fn scan(
+    system: &BarSystem,
+    state: ContactState,
+    (omega_max, h): (f64, f64),
+    resolution: Resolution,
+) -> Vec<f64> {
+    let samples = omega_max / h;
     let steps = samples.ceil() as usize + 1;
     let mut matrix = StateMatrix::new(system, state);
     let at = |i: usize| (i as f64 + 0.5) * h;
@@ -246,7 +295,7 @@ pub(crate) fn natural_frequency_values(
         }
     }
     modes.sort_by(f64::total_cmp);
-    Ok(modes)
+    modes
 }
 
 /// The point of `(lo, hi)` where `sign` (`sign_lo` at `lo`, the opposite at `hi`) changes,

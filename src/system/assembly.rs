@@ -5,6 +5,7 @@ use crate::bc::{
     BoundaryCondition, Contact, Dirichlet, Neumann, Robin, Signorini, Term, UnilateralLaw,
 };
 use crate::error::ModelError;
+use crate::system::spectra::Spectra;
 use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -263,6 +264,7 @@ impl AssemblyBuilder {
         Ok(BarSystem {
             bars: self.bars.clone(),
             conditions: self.conditions.clone(),
+            spectra: Arc::default(),
         })
     }
 }
@@ -290,6 +292,9 @@ fn finite(
 pub struct BarSystem {
     bars: Vec<Bar>,
     conditions: Vec<Arc<dyn BoundaryCondition>>,
+    /// Natural-frequency scans of this system, shared by its clones (built fresh with new
+    /// conditions).
+    spectra: Arc<Spectra>,
 }
 
 impl BarSystem {
@@ -303,7 +308,13 @@ impl BarSystem {
         BarSystem {
             bars: self.bars.clone(),
             conditions: self.conditions.iter().map(f).collect(),
+            spectra: Arc::default(),
         }
+    }
+
+    /// The natural-frequency scans of this system ([`Spectra`]).
+    pub(crate) fn spectra(&self) -> &Spectra {
+        &self.spectra
     }
 
     /// The bars, in the order they were added.

@@ -15,6 +15,7 @@ mod phase;
 pub(crate) use phase::shift_of;
 pub mod problem;
 pub mod rows;
+pub(crate) mod spectra;
 
 pub use assembly::{AssemblyBuilder, BarSystem};
 pub use family::{ParameterFamily, SystemFamily};

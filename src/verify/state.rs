@@ -8,6 +8,7 @@ use crate::fourier::Basis;
 use crate::modal::inputs::check_frequency;
 use crate::modal::FieldEvaluator;
 use crate::system::BarSystem;
+use std::cell::RefCell;
 
 /// Three-point Gauss–Legendre rule on `[0, 1]`: nodes and weights.
 const GAUSS3: [(f64, f64); 3] = [
@@ -256,9 +257,10 @@ impl State {
         let mut dphi = vec![0.0; basis.len()];
         basis.functions_at(theta, &mut phi);
         basis.derivatives_at(theta, &mut dphi);
+        let (ks, table) = (evaluator.wavenumbers(), RefCell::new(Vec::new()));
         Self::from_fields(&model, &grid, |b, p| {
-            let v = evaluator.with_functions(b, p, &phi, &dphi);
-            (v.displacement, v.velocity)
+            let table = &mut table.borrow_mut();
+            evaluator.displacement_and_velocity((b, p), (&phi, &dphi), (&ks, table))
         })
     }
 

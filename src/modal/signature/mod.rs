@@ -14,6 +14,7 @@ use crate::modal::inputs::{
     check_finite, check_frequency, check_length, check_motion, check_unknowns_finite,
 };
 use crate::system::{BarSystem, Layout, NonsmoothSystem};
+use std::cell::Cell;
 
 /// The time-averaged mechanical energy of the bars carried by each harmonic `n = 0..=m` of
 /// the motion `x` at fundamental frequency `omega` (entry `n`; `m` the basis' highest
@@ -264,11 +265,15 @@ pub(crate) fn contact_and_gap_samples<B: Basis>(
     let values = histories.iter().flat_map(|(g, f)| g.iter().chain(f));
     check_finite("a gap or contact force sample", omega, values)?;
     let samples = problem.basis().samples();
-    let (mut values, mut d_gap, mut d_force) =
-        (vec![0.0; samples], vec![0.0; samples], vec![0.0; samples]);
+    // Every law writes each of its samples, so the buffers of an earlier call serve as they
+    // are; only their growth is zeroed.
+    let [mut values, mut d_gap, mut d_force] = LAW_SCRATCH.take();
+    for buffer in [&mut values, &mut d_gap, &mut d_force] {
+        buffer.resize(samples, 0.0);
+    }
     let a_c = problem.complementarity();
     let laws = problem.system().laws().zip(histories);
-    Ok(laws
+    let described = laws
         .map(|(law, (gap, force))| {
             let out = LawSamples {
                 values: &mut values,
@@ -278,7 +283,16 @@ pub(crate) fn contact_and_gap_samples<B: Basis>(
             law.sample(&gap, &force, a_c, 0.0, out);
             (d_gap.iter().map(|w| *w != 0.0).collect(), gap)
         })
-        .collect())
+        .collect();
+    LAW_SCRATCH.set([values, d_gap, d_force]);
+    Ok(described)
+}
+
+thread_local! {
+    /// The law values and derivatives of [`contact_and_gap_samples`], kept between calls on a
+    /// thread: a run describes every point it computes, and three zeroed buffers of `N`
+    /// samples per point were a few per cent of a labelled run.
+    static LAW_SCRATCH: Cell<[Vec<f64>; 3]> = const { Cell::new([Vec::new(), Vec::new(), Vec::new()]) };
 }
 
 /// The number of maximal runs of `true` in the periodic sequence `values` (the last value

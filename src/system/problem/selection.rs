@@ -36,7 +36,7 @@ use super::discretization::Discretization;
 use crate::error::SettingsError;
 use crate::fourier::Basis;
 use crate::linalg::DenseMatrix;
-use crate::modal::linear::{natural_frequency_values, Resolution};
+use crate::modal::linear::{natural_frequencies_covering, Resolution};
 use crate::modal::ContactState;
 use crate::system::BarSystem;
 
@@ -168,16 +168,22 @@ impl Selection {
         if needed > self.covered {
             let bound = 2.0 * needed;
             let mut natural = Vec::new();
+            // A scan of the system up to a higher bound, run for another problem on it,
+            // serves as well: the selection reads only frequencies below `needed`.
+            let mut covered = f64::INFINITY;
             for state in [ContactState::Open, ContactState::Closed] {
                 // A scan that cannot run leaves this state out: fewer harmonics dropped.
-                if let Ok(values) = natural_frequency_values(system, state, bound, Resolution::FULL)
-                {
-                    natural.extend(values.into_iter().filter(|w| *w > 0.0));
+                match natural_frequencies_covering(system, state, bound, Resolution::FULL) {
+                    Ok((reach, values)) => {
+                        natural.extend(values.into_iter().filter(|w| *w > 0.0));
+                        covered = covered.min(reach);
+                    }
+                    Err(_) => covered = covered.min(bound),
                 }
             }
             natural.sort_by(f64::total_cmp);
             self.natural = natural;
-            self.covered = bound;
+            self.covered = covered;
         }
         let natural = &self.natural;
         (0..basis.len())
