@@ -585,3 +585,31 @@ fn an_arclength_response_of_too_many_steps_is_refused() {
         }
     }
 }
+
+/// The stress suite's finding (case 17297 of the default seed): the open response to a base
+/// motion of `-f64::MAX` with a subnormal damping is finite, but its gap history overflows;
+/// it is a typed error instead of NaN in `Ok`.
+#[test]
+fn a_gap_history_that_overflows_is_a_typed_error() {
+    use nonsmooth_modes::SettingsError;
+    let system = clamped_bar_with_obstacle(0.03274889209035036).unwrap();
+    let base = system.bar_id(0).unwrap().left();
+    let forcing = Forcing {
+        damping: Damping::Uniform(5e-324),
+        excitations: vec![Excitation::base_motion(base, -f64::MAX)],
+    };
+    let s = HarmonicBalanceSettings {
+        harmonics: 2,
+        samples_per_harmonic: 37,
+        complementarity: 0.12870716386037875,
+        ..Default::default()
+    };
+    let mut problem = ForcedSystem::new(&system, s, &forcing).unwrap();
+    problem.set_parameter(2.8886608796619937);
+    let x = problem.open_response().unwrap();
+    assert!(x.iter().all(|v| v.is_finite()));
+    match problem.gap_history(&x, 0) {
+        Err(SettingsError::NonFiniteResult { what, .. }) => assert_eq!(what, "gap history"),
+        other => panic!("{other:?}"),
+    }
+}

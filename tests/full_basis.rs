@@ -424,3 +424,20 @@ fn a_quadrature_start_refuses_a_ratio_that_is_not_finite() {
         }
     }
 }
+
+/// The stress suite's finding (case 7084 of the default seed): a cosine and a sine both near
+/// `f64::MAX` rotate past it. A shift whose result stays within range is computed; one whose
+/// result passes `f64::MAX` is a typed error, not an infinity in `Ok`.
+#[test]
+fn a_shift_of_coefficients_near_f64_max_stays_finite_or_is_refused() {
+    let max = f64::MAX;
+    // A sine alone at `f64::MAX`, turned by `pi / 4`: both parts at `max / sqrt 2`.
+    let eighth = shift_origin(&[0.0, 0.0, max], 1, std::f64::consts::FRAC_PI_4).unwrap();
+    let half = max * std::f64::consts::FRAC_1_SQRT_2;
+    assert!((eighth[1] / half - 1.0).abs() < 1e-12, "{eighth:?}");
+    assert!((eighth[2] / half - 1.0).abs() < 1e-12, "{eighth:?}");
+    match shift_origin(&[0.0, max, max], 1, -0.6497515618015584) {
+        Err(SettingsError::NotFinite { value, .. }) => assert!(value.is_infinite()),
+        other => panic!("{other:?}"),
+    }
+}

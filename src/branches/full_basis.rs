@@ -330,7 +330,8 @@ fn symmetry_instant_of(x: &[f64], harmonics: usize) -> (f64, f64) {
 ///
 /// # Errors
 /// As [`symmetry_instant`] for `x` and `harmonics`; [`SettingsError::NotFinite`] for a
-/// `theta0` that is not finite.
+/// `theta0` that is not finite, or for a shifted coefficient beyond `f64::MAX` (a cosine and
+/// a sine both near it).
 pub fn shift_origin(x: &[f64], harmonics: usize, theta0: f64) -> Result<Vec<f64>, SettingsError> {
     let per = full_layout(x, harmonics)?;
     if !theta0.is_finite() {
@@ -351,7 +352,16 @@ pub fn shift_origin(x: &[f64], harmonics: usize, theta0: f64) -> Result<Vec<f64>
         let turn = (n as f64 * theta0).sin_cos();
         for k in 0..per {
             let (c, s) = (x[n * per + k], x[(harmonics + n) * per + k]);
-            (y[n * per + k], y[(harmonics + n) * per + k]) = rotate(c, s, turn);
+            let (c, s) = rotate(c, s, turn);
+            // The rotation keeps `|(c, s)|`, up to `sqrt 2` times the larger of the two: past
+            // `f64::MAX`, the shifted state has no representation.
+            if let Some(value) = [c, s].into_iter().find(|v| !v.is_finite()) {
+                return Err(SettingsError::NotFinite {
+                    what: "shifted coefficient (its rotation passes f64::MAX)",
+                    value,
+                });
+            }
+            (y[n * per + k], y[(harmonics + n) * per + k]) = (c, s);
         }
     }
     Ok(y)

@@ -255,7 +255,9 @@ impl ForcedSystem {
     ///
     /// # Errors
     /// [`SettingsError::IndexOutOfRange`] for a law `l` the system does not have;
-    /// [`SettingsError::Length`] for an `x` that is not a state of the system.
+    /// [`SettingsError::Length`] for an `x` that is not a state of the system;
+    /// [`SettingsError::NonFiniteResult`] for a history that overflows (a state near the ends
+    /// of `f64`).
     pub fn gap_history(&self, x: &[f64], l: usize) -> Result<Vec<f64>, SettingsError> {
         let count = self.offsets.len();
         if l >= count {
@@ -275,6 +277,14 @@ impl ForcedSystem {
         self.basis
             .synthesize(&self.observable(x, l, true, false), &mut gap);
         gap.iter_mut().for_each(|v| *v += self.offsets[l].0);
+        // A state near the ends of `f64` (the open response to an amplitude of `f64::MAX`)
+        // overflows the synthesis.
+        if gap.iter().any(|v| !v.is_finite()) {
+            return Err(SettingsError::NonFiniteResult {
+                what: "gap history",
+                omega: self.omega,
+            });
+        }
         Ok(gap)
     }
 
