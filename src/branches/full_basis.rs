@@ -287,7 +287,8 @@ pub fn asymmetry(x: &[f64], harmonics: usize) -> Result<f64, SettingsError> {
 ///
 /// A motion even about `theta0` is even about `theta0 + pi` too, so the search covers
 /// `[0, pi)`: a scan of `8 m` instants (the share varies on the scale `pi / m` of the
-/// highest harmonic), then a golden-section refinement around the best of them.
+/// highest harmonic), then a golden-section refinement around the best of them. Each
+/// instant costs a pass over `x`: about `8 m x.len()` operations in all (`m` harmonics).
 ///
 /// # Errors
 /// [`SettingsError::ZeroHarmonics`] for no harmonics; [`SettingsError::StateLayout`] when
