@@ -189,7 +189,7 @@ fn not_even_motion(system: &BarSystem, period: f64) -> Res<Option<FullBasisPoint
             else {
                 continue;
             };
-            let lifted = with_harmonics(&p.point.x, m, fine.harmonics);
+            let lifted = with_harmonics(&p.point.x, m, fine.harmonics)?;
             let Some(q) = full_basis_branch(system, &checked, &lifted, vec![period])?
                 .points
                 .pop()
@@ -226,8 +226,8 @@ fn not_even_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
     )?
     .basis()
     .clone();
-    let (theta0, _) = symmetry_instant(&q.x, m);
-    let about = shift_origin(&q.x, m, theta0);
+    let (theta0, _) = symmetry_instant(&q.x, m)?;
+    let about = shift_origin(&q.x, m, theta0)?;
     let samples = 400;
     let end = system.bar_id(0).ok_or("no bar 1")?.right();
     let h = end_history(&system, &basis, &about, q.omega, end, samples);

@@ -265,7 +265,7 @@ fn refined(
         samples_per_harmonic,
         ..*settings
     };
-    let start = with_harmonics(&p.point.x, settings.harmonics, harmonics);
+    let start = with_harmonics(&p.point.x, settings.harmonics, harmonics)?;
     let request = Request::new(1)
         .settings(finer)
         .checked(TimeDomainCheck::for_system(system));

@@ -344,6 +344,23 @@ pub enum SettingsError {
     /// not positive.
     #[error(transparent)]
     Range(#[from] BadRange),
+    /// A state whose length is not a whole, positive number of blocks of its basis's
+    /// coefficients (`m + 1` of a cosine basis, `2 m + 1` of a full one, for `m` harmonics):
+    /// it was written for another number of harmonics, or is empty.
+    #[error(
+        "{what} has length {got}, not a positive multiple of the {coefficients} coefficients \
+         of {harmonics} harmonics"
+    )]
+    StateLayout {
+        /// Which state.
+        what: &'static str,
+        /// Its length.
+        got: usize,
+        /// The harmonics it was said to have.
+        harmonics: usize,
+        /// Coefficients per unknown for that many harmonics (wide: it may exceed `usize`).
+        coefficients: u128,
+    },
     /// A request within the memory budget that the allocator refused all the same (the
     /// process has less memory than the budget left): returned instead of aborting.
     #[error("{what} needs {bytes:.3e} bytes, which the allocator refused")]
@@ -767,6 +784,19 @@ pub enum StabilityError {
         dimension: u128,
         /// [`MAX_HILL_DIMENSION`](crate::stability::MAX_HILL_DIMENSION).
         limit: usize,
+    },
+    /// A number of the report is NaN or infinite although every input was finite: the
+    /// state's norms and energies overflow or underflow (a state scaled by about `1e300` or
+    /// `1e-300`), so its defects and corrections cannot be measured.
+    #[error(
+        "the {what} of the stability check is not finite ({value}): the state's norms or \
+         energies overflow or underflow in f64; rescale it"
+    )]
+    NonFiniteResult {
+        /// Which number of the report.
+        what: &'static str,
+        /// Its value.
+        value: f64,
     },
     /// A multiplier or a matrix entry is not finite.
     #[error("the monodromy matrix has a non-finite entry ({value}) in column {column}")]

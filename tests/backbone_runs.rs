@@ -207,3 +207,89 @@ fn a_failed_start_search_is_bounded_and_says_why() {
     );
     assert!(run.converged().count() > 0);
 }
+
+/// Counts what an arclength backbone's observer sees.
+#[derive(Default)]
+struct Seen {
+    points: usize,
+    rejected: usize,
+}
+
+impl nonsmooth_modes::branches::BackboneObserver for &mut Seen {
+    fn point(&mut self, _: &nonsmooth_modes::branches::BackbonePoint) -> std::ops::ControlFlow<()> {
+        self.points += 1;
+        std::ops::ControlFlow::Continue(())
+    }
+    fn rejected(
+        &mut self,
+        _: &nonsmooth_modes::continuation::Rejection,
+    ) -> std::ops::ControlFlow<()> {
+        self.rejected += 1;
+        std::ops::ControlFlow::Continue(())
+    }
+}
+
+/// The reliability reproducer of an observer that missed steps: an arclength backbone whose
+/// start lies beyond the asked period first walks back to it, and the walk's rejected steps
+/// were counted in `rejected_steps` but never handed to `BackboneObserver::rejected`. On the
+/// contact chain (whose start converges only at a higher frequency) with the library's
+/// default options, the observer now sees every point and every rejection counted.
+#[test]
+fn an_arclength_observer_sees_every_rejection_counted() {
+    use nonsmooth_modes::branches::{compute_observed, ArclengthBackboneOptions};
+    let system = nonsmooth_modes::reference::contact_chain(3, 1e-3, 0.5).unwrap();
+    let options = ArclengthBackboneOptions::for_mode(&system, 1, 1).unwrap();
+    let request =
+        Request::for_method(Method::Arclength(options)).settings(HarmonicBalanceSettings {
+            harmonics: 10,
+            ..Default::default()
+        });
+    let mut seen = Seen::default();
+    let run = compute_observed(&system, &request, &mut seen).unwrap();
+    eprintln!(
+        "{} points, {} rejected, end {:?}; seen {} and {}",
+        run.points.len(),
+        run.rejected_steps,
+        run.end,
+        seen.points,
+        seen.rejected
+    );
+    assert_eq!(seen.points, run.points.len());
+    assert_eq!(seen.rejected, run.rejected_steps);
+    // The walk back ran: the first point lies at the asked period's end of the range.
+    assert!(run.points.len() > 1);
+}
+
+/// The reliability reproducer of `Method::Auto`'s unbounded arclength: a request of 6 steps
+/// returned 274 to 304 points from the driver's default budget. On the contact chain, where
+/// Auto enters the branch at a shorter period and runs pseudo-arclength over the grid's
+/// range, its steps and rejections are now at most 4 per grid step (the walk back to the
+/// first period within the same), whatever it chooses.
+#[test]
+fn auto_keeps_its_arclength_within_the_grids_steps() {
+    let system = nonsmooth_modes::reference::contact_chain(3, 1e-3, 0.5).unwrap();
+    let mut grid = BackboneOptions::for_mode(&system, 1, 1).unwrap();
+    grid.grid.steps = 6;
+    let request = Request::for_method(Method::Auto(Some(grid))).settings(HarmonicBalanceSettings {
+        harmonics: 10,
+        ..Default::default()
+    });
+    let run = compute(&system, &request).unwrap();
+    eprintln!(
+        "{} points by {}, {:?}, end {:?}",
+        run.points.len(),
+        run.method.name(),
+        run.auto,
+        run.end
+    );
+    if let Method::Arclength(options) = run.method {
+        assert!(options.arclength.max_steps <= 24, "{options:?}");
+        assert!(options.arclength.max_rejections <= 24, "{options:?}");
+    }
+    // The run and the walk back, 24 steps each, and the start.
+    assert!(
+        run.points.len() <= 2 * 24 + 1,
+        "{} points",
+        run.points.len()
+    );
+}

@@ -306,7 +306,7 @@ fn undamped_and_unforced_the_backbone_points_solve_the_forced_system_with_their_
         let mut checked = 0;
         for p in run.converged() {
             problem.set_parameter(p.omega);
-            let x = to_full_basis(&p.x, m);
+            let x = to_full_basis(&p.x, m).unwrap();
             let mut f = vec![0.0; x.len()];
             problem.residual(&x, &mut f);
             let residual = f.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -483,4 +483,133 @@ fn the_forced_systems_calls_refuse_what_they_cannot_use() {
     let x = big.open_response().unwrap();
     let defect = big.contact_defect(&x);
     assert!(defect.is_finite() && defect >= 0.0, "{defect}");
+}
+
+/// The reliability reproducers of an open response that was NaN in `Ok`: a frequency of
+/// infinity or +-1e300 (the rows' sines carry no digit there), amplitudes of +-`f64::MAX` and
+/// a damping of 1.7e112 (the solve overflows) are typed errors quoting the value.
+#[test]
+fn an_open_response_beyond_the_range_of_f64_is_a_typed_error() {
+    use nonsmooth_modes::SettingsError;
+    let (system, forcing) = clamped_base(1e-3, 0.02, 1e-6);
+    let mut problem = ForcedSystem::new(&system, settings(3), &forcing).unwrap();
+    for omega in [f64::INFINITY, f64::NEG_INFINITY, -1e300, 0.0, -1.2] {
+        problem.set_parameter(omega);
+        match problem.open_response() {
+            Err(Error::Settings(SettingsError::NotPositive { value, .. })) => {
+                assert_eq!(value, omega)
+            }
+            other => panic!("{omega}: {other:?}"),
+        }
+    }
+    problem.set_parameter(1e300);
+    match problem.open_response() {
+        Err(Error::Settings(SettingsError::FrequencyTooLarge { omega, max, .. })) => {
+            assert!(omega == 1e300 && max < 1e300 && max > 1e12, "{max:e}")
+        }
+        other => panic!("{other:?}"),
+    }
+    problem.set_parameter(1e-310);
+    assert!(matches!(
+        problem.open_response(),
+        Err(Error::Settings(SettingsError::FrequencyTooSmall { .. }))
+    ));
+    let mut refused = Vec::new();
+    let mut non_finite = |forcing: &Forcing| {
+        let mut problem = ForcedSystem::new(&system, settings(3), forcing).unwrap();
+        problem.set_parameter(1.2);
+        match problem.open_response() {
+            Err(Error::Settings(SettingsError::NonFiniteResult { what, omega })) => {
+                assert!(what.contains("open-contact") && omega == 1.2, "{what}");
+                refused.push(forcing.clone());
+            }
+            Ok(x) => assert!(x.iter().all(|v| v.is_finite()), "{x:?}"),
+            Err(e) => panic!("{e}"),
+        }
+    };
+    let base = system.bar_id(0).unwrap().left();
+    for amplitude in [f64::MAX, -f64::MAX] {
+        non_finite(&Forcing {
+            damping: Damping::Uniform(0.02),
+            excitations: vec![Excitation::base_motion(base, amplitude)],
+        });
+    }
+    non_finite(&Forcing {
+        damping: Damping::Uniform(1.7e112),
+        excitations: vec![Excitation::base_motion(base, 1e-6)],
+    });
+    let robin = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let end = robin.bar_id(0).unwrap().left();
+    for amplitude in [f64::MAX, -f64::MAX] {
+        let forcing = Forcing {
+            damping: Damping::PerBar(vec![0.121]),
+            excitations: vec![Excitation::force(end, amplitude)],
+        };
+        let mut problem = ForcedSystem::new(&robin, settings(6), &forcing).unwrap();
+        problem.set_parameter(0.7);
+        match problem.open_response() {
+            Err(Error::Settings(SettingsError::NonFiniteResult { .. })) => refused.push(forcing),
+            Ok(x) => assert!(x.iter().all(|v| v.is_finite()), "{x:?}"),
+            Err(e) => panic!("{e}"),
+        }
+    }
+    // Every reproducer's NaN response is refused.
+    assert_eq!(refused.len(), 5, "{refused:?}");
+}
+
+/// The reliability reproducer of an arclength response that never ended: `steps` of 2^40 or
+/// `usize::MAX` are refused before the run with `TooLarge`, as the sequential grid refuses
+/// them, instead of sizing a run of `4 steps` points.
+#[test]
+fn an_arclength_response_of_too_many_steps_is_refused() {
+    use nonsmooth_modes::ContinuationError;
+    let (system, forcing) = clamped_base(1e-3, 0.02, 1e-6);
+    for method in [ResponseMethod::Arclength, ResponseMethod::Sequential] {
+        for steps in [1usize << 40, usize::MAX] {
+            let request = ResponseRequest {
+                settings: settings(3),
+                forcing: forcing.clone(),
+                omega_range: (1.2, 1.8),
+                steps,
+                method,
+                solver: Default::default(),
+            };
+            let started = std::time::Instant::now();
+            match forced_response(&system, &request) {
+                Err(Error::Continuation(ContinuationError::TooLarge(e))) => {
+                    assert!(e.requested_bytes >= 8.0 * steps as f64, "{e}")
+                }
+                other => panic!("{method:?}, {steps}: {:?}", other.map(|r| r.points.len())),
+            }
+            assert!(started.elapsed().as_secs() < 5);
+        }
+    }
+}
+
+/// The stress suite's finding (case 17297 of the default seed): the open response to a base
+/// motion of `-f64::MAX` with a subnormal damping is finite, but its gap history overflows;
+/// it is a typed error instead of NaN in `Ok`.
+#[test]
+fn a_gap_history_that_overflows_is_a_typed_error() {
+    use nonsmooth_modes::SettingsError;
+    let system = clamped_bar_with_obstacle(0.03274889209035036).unwrap();
+    let base = system.bar_id(0).unwrap().left();
+    let forcing = Forcing {
+        damping: Damping::Uniform(5e-324),
+        excitations: vec![Excitation::base_motion(base, -f64::MAX)],
+    };
+    let s = HarmonicBalanceSettings {
+        harmonics: 2,
+        samples_per_harmonic: 37,
+        complementarity: 0.12870716386037875,
+        ..Default::default()
+    };
+    let mut problem = ForcedSystem::new(&system, s, &forcing).unwrap();
+    problem.set_parameter(2.8886608796619937);
+    let x = problem.open_response().unwrap();
+    assert!(x.iter().all(|v| v.is_finite()));
+    match problem.gap_history(&x, 0) {
+        Err(SettingsError::NonFiniteResult { what, .. }) => assert_eq!(what, "gap history"),
+        other => panic!("{other:?}"),
+    }
 }

@@ -4,9 +4,9 @@
 //! time-domain check.
 
 use nonsmooth_modes::branches::{
-    compute, full_basis_branch, full_basis_system, quadrature_start, shift_origin, to_full_basis,
-    with_harmonics, BackboneOptions, BackbonePoint, FullBasisBranch, Method, Request,
-    TimeDomainCheck,
+    asymmetry, compute, full_basis_branch, full_basis_system, quadrature_start, shift_origin,
+    symmetry_instant, to_full_basis, with_harmonics, BackboneOptions, BackbonePoint,
+    FullBasisBranch, Method, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::fourier::{frequency_of_period, CosineBasis};
 use nonsmooth_modes::modal::{energy_at, Label};
@@ -41,7 +41,7 @@ fn both(system: &BarSystem) -> (Vec<BackbonePoint>, FullBasisBranch) {
         .filter(|p| p.step >= first.step)
         .map(|p| p.period)
         .collect();
-    let start = to_full_basis(&first.x, M);
+    let start = to_full_basis(&first.x, M).unwrap();
     let full = full_basis_branch(
         system,
         &Request::new(1).settings(settings()),
@@ -105,11 +105,11 @@ fn a_shifted_motion_is_the_same_motion() {
         .iter()
         .find(|p| p.converged && p.period < 3.6)
         .unwrap();
-    let even = to_full_basis(&p.x, M);
+    let even = to_full_basis(&p.x, M).unwrap();
     let samples = settings().samples_per_harmonic * M;
     let on_grid = 2.0 * PI * 7.0 / samples as f64;
     let solve = |phi: f64| {
-        let start = shift_origin(&even, M, phi);
+        let start = shift_origin(&even, M, phi).unwrap();
         let run = full_basis_branch(
             &system,
             &Request::new(1).settings(settings()),
@@ -189,7 +189,7 @@ fn the_clamped_bar_has_motions_that_are_not_even() {
             if p.asymmetry < 1e-2 {
                 continue;
             }
-            let start = with_harmonics(&p.point.x, M, 2 * M);
+            let start = with_harmonics(&p.point.x, M, 2 * M).unwrap();
             let run = full_basis_branch(&system, &checked, &start, vec![period]);
             let Some(q) = run.unwrap().points.pop() else {
                 continue;
@@ -255,7 +255,7 @@ fn full_basis_points_are_checked_and_labelled_as_the_cosine_ones() {
         .filter(|p| p.step >= first.step)
         .map(|p| p.period)
         .collect();
-    let start = to_full_basis(&first.x, M);
+    let start = to_full_basis(&first.x, M).unwrap();
     let full = full_basis_branch(&system, &request, &start, periods).unwrap();
     assert!(!full.points.is_empty());
     for q in &full.points {
@@ -310,4 +310,134 @@ fn a_quadrature_start_puts_the_second_mode_on_a_sine() {
             ..
         }))
     ));
+}
+
+/// The reliability reproducers of the full-basis helpers: counts near `usize::MAX` (whose
+/// `m + 1` or `2 m + 1` overflowed), a state whose length does not fit its harmonics (a
+/// slice panic), 2^40 harmonics (an aborted allocation) and `shift_origin` at `1 << 62`
+/// harmonics (a loop that never ended) are typed errors quoting what was given; a state
+/// scaled to the ends of `f64` keeps a finite asymmetry, the same as unscaled.
+#[test]
+fn the_full_basis_helpers_refuse_what_does_not_fit() {
+    let layout = |r: Result<Vec<f64>, SettingsError>| match r {
+        Err(SettingsError::StateLayout {
+            got,
+            harmonics,
+            coefficients,
+            ..
+        }) => (got, harmonics, coefficients),
+        other => panic!("{other:?}"),
+    };
+    let x = [1.0, 2.0, 3.0, 4.0, 5.0];
+    let max = usize::MAX;
+    let wide = max as u128;
+    assert_eq!(layout(to_full_basis(&x, max)), (5, max, wide + 1));
+    assert_eq!(layout(to_full_basis(&x, 3)), (5, 3, 4));
+    assert_eq!(layout(with_harmonics(&x, max, max)), (5, max, 2 * wide + 1));
+    // 5 values are no state of 3 harmonics (7 coefficients): the cosines were sliced past
+    // the end.
+    assert_eq!(layout(with_harmonics(&x, 3, 4)), (5, 3, 7));
+    assert_eq!(
+        layout(shift_origin(&[], 1 << 62, 0.5)),
+        (0, 1 << 62, (1 << 63) + 1)
+    );
+    assert_eq!(
+        layout(shift_origin(&x, 1 << 62, 0.5)),
+        (5, 1 << 62, (1 << 63) + 1)
+    );
+    for r in [
+        symmetry_instant(&x, max).map(|(t, s)| vec![t, s]),
+        asymmetry(&x[..4], 2).map(|a| vec![a]),
+    ] {
+        assert!(matches!(r, Err(SettingsError::StateLayout { .. })), "{r:?}");
+    }
+    assert_eq!(to_full_basis(&x, 0), Err(SettingsError::ZeroHarmonics));
+    // One unknown, one harmonic, lifted to 2^40: 17.6 TB, over the budget.
+    let one = [1.0, 0.5, 0.25];
+    match with_harmonics(&one, 1, 1 << 40) {
+        Err(SettingsError::TooLarge(e)) => {
+            assert!(e.requested_bytes >= 8.0 * (2.0 * 2f64.powi(40) + 1.0))
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        with_harmonics(&one, 2, 1),
+        Err(SettingsError::StateLayout {
+            what: "full-basis state",
+            got: 3,
+            harmonics: 2,
+            coefficients: 5,
+        })
+    );
+    assert_eq!(
+        with_harmonics(&[1.0; 5], 2, 1),
+        Err(SettingsError::LiftToFewerHarmonics { from: 2, to: 1 })
+    );
+    assert_eq!(
+        with_harmonics(&one, 1, 2).unwrap(),
+        vec![1.0, 0.5, 0.0, 0.25, 0.0]
+    );
+    assert_eq!(to_full_basis(&[1.0, 0.5], 1).unwrap(), vec![1.0, 0.5, 0.0]);
+    for theta in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        match shift_origin(&one, 1, theta) {
+            Err(SettingsError::NotFinite { value, .. }) => {
+                assert_eq!(value.to_bits(), theta.to_bits())
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    match to_full_basis(&[1.0, f64::NAN], 1) {
+        Err(SettingsError::NotFinite { value, .. }) => assert!(value.is_nan()),
+        other => panic!("{other:?}"),
+    }
+    // A phase of many turns stays finite: `n theta0` no longer overflows to a NaN sine.
+    let far = shift_origin(&one, 1, 1e308).unwrap();
+    assert!(far.iter().all(|v| v.is_finite()), "{far:?}");
+    // A motion with sines about no instant of symmetry, at the ends of `f64`.
+    let odd = [0.1, 1.0, 0.3, 0.5, 0.7];
+    let reference = asymmetry(&odd, 2).unwrap();
+    assert!(reference > 1e-3 && reference.is_finite(), "{reference}");
+    for scale in [1e300, 1e-300, f64::MAX] {
+        let scaled: Vec<f64> = odd.iter().map(|v| v * scale).collect();
+        let a = asymmetry(&scaled, 2).unwrap();
+        assert!(
+            (a - reference).abs() <= 1e-9,
+            "scale {scale:e}: {a} vs {reference}"
+        );
+    }
+}
+
+/// A quadrature start of an infinite or NaN ratio is a typed error quoting it, not a start
+/// of infinite or NaN sines.
+#[test]
+fn a_quadrature_start_refuses_a_ratio_that_is_not_finite() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let omega = frequency_of_period(3.9);
+    let mut full = full_basis_system(&system, &settings()).unwrap();
+    for ratio in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+        match quadrature_start(&mut full, 2, ratio, omega) {
+            Err(Error::Settings(SettingsError::NotFinite { what, value })) => {
+                assert!(what.contains("ratio"), "{what}");
+                assert_eq!(value.to_bits(), ratio.to_bits());
+            }
+            other => panic!("{ratio}: {other:?}"),
+        }
+    }
+}
+
+/// The stress suite's finding (case 7084 of the default seed): a cosine and a sine both near
+/// `f64::MAX` rotate past it. A shift whose result stays within range is computed; one whose
+/// result passes `f64::MAX` is a typed error, not an infinity in `Ok`.
+#[test]
+fn a_shift_of_coefficients_near_f64_max_stays_finite_or_is_refused() {
+    let max = f64::MAX;
+    // A sine alone at `f64::MAX`, turned by `pi / 4`: both parts at `max / sqrt 2`.
+    let eighth = shift_origin(&[0.0, 0.0, max], 1, std::f64::consts::FRAC_PI_4).unwrap();
+    let half = max * std::f64::consts::FRAC_1_SQRT_2;
+    assert!((eighth[1] / half - 1.0).abs() < 1e-12, "{eighth:?}");
+    assert!((eighth[2] / half - 1.0).abs() < 1e-12, "{eighth:?}");
+    match shift_origin(&[0.0, max, max], 1, -0.6497515618015584) {
+        Err(SettingsError::NotFinite { value, .. }) => assert!(value.is_infinite()),
+        other => panic!("{other:?}"),
+    }
 }

@@ -438,3 +438,51 @@ fn auto_keeps_the_multipliers_of_the_run_it_keeps() {
         assert_eq!(verdicts(p), verdicts(q), "T = {}", p.period);
     }
 }
+
+/// The reliability reproducer of states at the ends of `f64`: the clamped bar's exact first
+/// mode at `T = 3.5` scaled by `1e300` or `1e-300` has norms and energies that overflow or
+/// underflow. `floquet` returned an unresolved report with a NaN energy correction or
+/// periodicity defect; it is now a typed error naming the number (or a report whose numbers
+/// are all finite).
+#[test]
+fn a_state_at_the_ends_of_f64_gives_a_typed_error_or_finite_numbers() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let m = 4;
+    let problem = nonsmooth_modes::system::NonsmoothSystem::new(
+        &system,
+        nonsmooth_modes::system::HarmonicBalanceSettings {
+            harmonics: m,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let x = nonsmooth_modes::reference::ClampedFirstMode::new(1e-3, 3.5).unknowns(m);
+    let omega = 2.0 * PI / 3.5;
+    let mut refused = 0;
+    for scale in [1e300, 1e-300] {
+        let scaled: Vec<f64> = x.iter().map(|v| v * scale).collect();
+        match floquet(&system, problem.basis(), &scaled, omega, &options(50.0)) {
+            Ok(f) => {
+                for v in [
+                    f.initial_defect,
+                    f.periodicity_defect,
+                    f.correction,
+                    f.displacement_correction,
+                    f.energy_correction,
+                    f.max_modulus,
+                ] {
+                    assert!(v.is_finite(), "scale {scale:e}: {f:?}");
+                }
+            }
+            Err(StabilityError::NonFiniteResult { what, value }) => {
+                assert!(!value.is_finite() && !what.is_empty(), "{what} {value}");
+                refused += 1;
+            }
+            Err(e) => panic!("scale {scale:e}: {e}"),
+        }
+    }
+    assert!(
+        refused >= 1,
+        "the scaled states were accepted with finite numbers"
+    );
+}

@@ -47,7 +47,7 @@ pub fn run_full_basis(
         hill: a.hill.then(HillOptions::default),
         ..request.clone()
     };
-    let start = to_full_basis(&first.x, a.settings.harmonics);
+    let start = to_full_basis(&first.x, a.settings.harmonics)?;
     let rest = periods[first.step..].to_vec();
     let full = full_basis_branch(system, &full_request, &start, rest)?;
     let mut converged = 0;

@@ -144,7 +144,7 @@ fn judged_run(
     if !grid_fell_short(&grid, steps) {
         return Ok((grid, method, auto, problem));
     }
-    let arclength = ArclengthBackboneOptions::over_grid(&options);
+    let arclength = within_grid_budget(&options);
     let other = Method::Arclength(arclength);
     let solver = request.solver_for(&other)?;
     let plan = Plan::Arclength(arclength, start);
@@ -160,6 +160,24 @@ fn judged_run(
     } else {
         (grid, method, auto, problem)
     })
+}
+
+/// Steps, and rejected steps, that an arclength run of [`Method::Auto`] may take per step of
+/// the grid it stands in for.
+const ARCLENGTH_STEPS_PER_GRID_STEP: usize = 4;
+
+/// The pseudo-arclength options [`Method::Auto`] runs over `grid`'s range
+/// ([`ArclengthBackboneOptions::over_grid`]) within the grid's budget: at most
+/// [`ARCLENGTH_STEPS_PER_GRID_STEP`] steps and as many rejected steps per grid step (the
+/// walk back to the grid's first period keeps within the same). The driver's defaults
+/// (2,000 steps) let a request of 6 steps return about 300 points, each then given the
+/// multipliers the request asks; the default grid of 181 steps allows 724.
+fn within_grid_budget(grid: &BackboneOptions) -> ArclengthBackboneOptions {
+    let mut options = ArclengthBackboneOptions::over_grid(grid);
+    let budget = (grid.grid.steps).saturating_mul(ARCLENGTH_STEPS_PER_GRID_STEP);
+    options.arclength.max_steps = options.arclength.max_steps.min(budget);
+    options.arclength.max_rejections = options.arclength.max_rejections.min(budget);
+    options
 }
 
 /// Whether the run of a period grid of `steps` steps falls short of a backbone: it stalled,
@@ -227,7 +245,7 @@ fn resolve(
             tethered,
         ));
     }
-    let options = ArclengthBackboneOptions::over_grid(&grid);
+    let options = within_grid_budget(&grid);
     let entered_at = period_of_frequency(start.omega);
     Ok((
         Plan::Arclength(options, None),

@@ -529,12 +529,20 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         point.step += offset;
         point
     };
-    let stopped_at = (walked.iter()).position(|p| observer.point(backbone_point(p, 0)).is_break());
-    if let Some(k) = stopped_at {
+    // The observer sees the walk once it is over: its rejected steps (counted in the run's
+    // rejections, so seen as well), then its points. It may stop the run on either.
+    let stopped_on_rejection = (walk_rejections.iter())
+        .position(|r| observer.rejected(r).is_break())
+        .map(|k| (0, k + 1));
+    let stopped = stopped_on_rejection.or_else(|| {
+        (walked.iter())
+            .position(|p| observer.point(backbone_point(p, 0)).is_break())
+            .map(|k| (k + 1, walk_rejections.len()))
+    });
+    if let Some((kept, rejections)) = stopped {
         let mut points = walked;
-        points.truncate(k + 1);
+        points.truncate(kept);
         let end = EndReason::StoppedByObserver;
-        let rejections = walk_rejections;
         return Ok((
             e_g,
             Branch {
@@ -558,6 +566,6 @@ pub(crate) fn arclength_backbone_observed<S: NonlinearSolver>(
         p.step += offset;
     }
     branch.points.splice(0..0, walked);
-    branch.rejections += walk_rejections;
+    branch.rejections += walk_rejections.len();
     Ok((e_g, branch))
 }

@@ -16,10 +16,12 @@ use crate::continuation::{
     EndReason, PeriodParametrised, Rejection, Sequential, SequentialOptions, Step,
 };
 use crate::error::{Error, SettingsError};
-use crate::fourier::{frequency_of_period, Basis, SineCosineBasis};
+use crate::fourier::{check_memory, frequency_of_period, Basis, SineCosineBasis};
+use crate::modal::diagnostics::reserve_exact;
 use crate::modal::{branch_seed, energy, grazing_energy, open_mode};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem, PhaseLocked};
 use std::cell::RefCell;
+use std::f64::consts::TAU;
 use std::ops::ControlFlow;
 
 /// Energies below this fraction of `E_g` are the state of rest, which is no point of a
@@ -77,25 +79,109 @@ pub fn full_basis_system(
     Ok(problem)
 }
 
+/// The unknowns per coefficient of a state of `len` values in a basis of `blocks`
+/// coefficients per unknown (`m + 1` cosine, `2 m + 1` full), with `blocks` given wide so
+/// that it cannot overflow. A state holds at least one unknown: an empty one, or one whose
+/// length is not a whole number of blocks, was written for another basis.
+fn unknowns_per_coefficient(
+    what: &'static str,
+    len: usize,
+    (harmonics, blocks): (usize, u128),
+) -> Result<usize, SettingsError> {
+    if harmonics == 0 {
+        return Err(SettingsError::ZeroHarmonics);
+    }
+    let len_wide = len as u128;
+    if len == 0 || len_wide % blocks != 0 {
+        return Err(SettingsError::StateLayout {
+            what,
+            got: len,
+            harmonics,
+            coefficients: blocks,
+        });
+    }
+    // `len_wide / blocks <= len`, which is a `usize`.
+    Ok((len_wide / blocks) as usize)
+}
+
+/// The unknowns per coefficient of the full-basis state `x` of `harmonics` harmonics, its
+/// values checked finite.
+fn full_layout(x: &[f64], harmonics: usize) -> Result<usize, SettingsError> {
+    let per = unknowns_per_coefficient(
+        "full-basis state",
+        x.len(),
+        (harmonics, 2 * harmonics as u128 + 1),
+    )?;
+    check_finite(x)?;
+    Ok(per)
+}
+
+/// [`SettingsError::NotFinite`] quoting the first value of `x` that is NaN or infinite.
+fn check_finite(x: &[f64]) -> Result<(), SettingsError> {
+    match x.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(SettingsError::NotFinite {
+            what: "state coefficient",
+            value,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// A vector of `per (2 to + 1)` zeros, the size checked against the memory budget first
+/// (`to` may be any count: the product is taken in floating point) and the allocation
+/// refused with a typed error rather than aborted.
+fn full_zeros(per: usize, to: usize) -> Result<Vec<f64>, SettingsError> {
+    let doubles = per as f64 * (2.0 * to as f64 + 1.0);
+    check_memory("a full-basis state", doubles)?;
+    // Within the budget, so within `usize`.
+    let n = per * (2 * to + 1);
+    let mut y = reserve_exact("a full-basis state", n)?;
+    y.resize(n, 0.0);
+    Ok(y)
+}
+
 /// A state of the cosine basis with `harmonics` harmonics as one of the full basis: the
 /// cosine coefficients first, then zero sines (both layouts are coefficient-major).
-pub fn to_full_basis(x: &[f64], harmonics: usize) -> Vec<f64> {
-    let per_coefficient = x.len() / (harmonics + 1);
-    let mut y = x.to_vec();
-    y.resize(per_coefficient * (2 * harmonics + 1), 0.0);
-    y
+///
+/// # Errors
+/// [`SettingsError::ZeroHarmonics`] for no harmonics; [`SettingsError::StateLayout`] when
+/// `x` is empty or its length is not a multiple of `harmonics + 1`;
+/// [`SettingsError::NotFinite`] for a value of `x` that is not finite;
+/// [`SettingsError::TooLarge`] or [`SettingsError::AllocationFailed`] for a result beyond
+/// the memory budget or refused by the allocator.
+pub fn to_full_basis(x: &[f64], harmonics: usize) -> Result<Vec<f64>, SettingsError> {
+    let per = unknowns_per_coefficient(
+        "cosine-basis state",
+        x.len(),
+        (harmonics, harmonics as u128 + 1),
+    )?;
+    check_finite(x)?;
+    let mut y = full_zeros(per, harmonics)?;
+    y[..x.len()].copy_from_slice(x);
+    Ok(y)
 }
 
 /// A full-basis state of `harmonics` harmonics written with `to >= harmonics` of them (the
 /// added cosines and sines zero), as a start at more harmonics.
-pub fn with_harmonics(x: &[f64], harmonics: usize, to: usize) -> Vec<f64> {
-    let per = x.len() / (2 * harmonics + 1);
-    let mut y = vec![0.0; per * (2 * to.max(harmonics) + 1)];
+///
+/// # Errors
+/// As [`to_full_basis`] for `x` (its length a multiple of `2 harmonics + 1`) and the
+/// result; [`SettingsError::LiftToFewerHarmonics`] for `to < harmonics`.
+pub fn with_harmonics(x: &[f64], harmonics: usize, to: usize) -> Result<Vec<f64>, SettingsError> {
+    let per = full_layout(x, harmonics)?;
+    if to < harmonics {
+        return Err(SettingsError::LiftToFewerHarmonics {
+            from: harmonics,
+            to,
+        });
+    }
+    let mut y = full_zeros(per, to)?;
+    // `x` holds `per (2 harmonics + 1)` values, so these products fit in `usize`.
     let (cosines, sines) = x.split_at(per * (harmonics + 1));
     y[..cosines.len()].copy_from_slice(cosines);
-    let at = per * (to.max(harmonics) + 1);
+    let at = per * (to + 1);
     y[at..at + sines.len()].copy_from_slice(sines);
-    y
+    Ok(y)
 }
 
 /// A start for motions that are not even in time: the grazing seed of the first linear
@@ -105,13 +191,21 @@ pub fn with_harmonics(x: &[f64], harmonics: usize, to: usize) -> Vec<f64> {
 ///
 /// # Errors
 /// As [`branch_seed`] and [`open_mode`]; [`SettingsError::HarmonicOutOfRange`] when `n` is
-/// 0 or beyond the basis.
+/// 0 or beyond the basis; [`SettingsError::NotFinite`] for a `ratio` that is not finite, and
+/// [`SettingsError::NonFiniteResult`] for one so large that the start overflows.
 pub fn quadrature_start(
     problem: &mut NonsmoothSystem<SineCosineBasis>,
     mode: usize,
     ratio: f64,
     omega: f64,
 ) -> Result<(Vec<f64>, usize), Error> {
+    if !ratio.is_finite() {
+        return Err(SettingsError::NotFinite {
+            what: "quadrature ratio",
+            value: ratio,
+        }
+        .into());
+    }
     let m = problem.basis().harmonics();
     let n = (open_mode(problem.system(), mode)?.omega / omega).round();
     if !(n >= 1.0 && n <= m as f64) {
@@ -133,6 +227,14 @@ pub fn quadrature_start(
     for k in 0..per {
         start[sine + k] += ratio * other[cosine + k];
     }
+    // A finite ratio so large that the sum overflows starts nothing.
+    if start.iter().any(|v| !v.is_finite()) {
+        return Err(SettingsError::NonFiniteResult {
+            what: "quadrature start",
+            omega,
+        }
+        .into());
+    }
     Ok((start, n))
 }
 
@@ -145,20 +247,25 @@ fn rotate(c: f64, s: f64, (sin, cos): (f64, f64)) -> (f64, f64) {
 /// The sine share `|x_sin|^2 / |x|^2` of the state shifted to `theta0` (of the state itself
 /// at `theta0 = 0`): every harmonic `n` of every signal,
 /// `c cos(n theta) + s sin(n theta)`, has the sine `s cos(n theta0) - c sin(n theta0)` about
-/// `theta0`.
+/// `theta0`. The values are divided by the largest first, so that the squares of a state
+/// near the ends of the range of `f64` neither overflow nor underflow.
 fn share_about(x: &[f64], harmonics: usize, theta0: f64) -> f64 {
     let per = x.len() / (2 * harmonics + 1);
+    let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(scale > 0.0 && scale.is_finite()) {
+        return 0.0;
+    }
     let (mut odd, mut all) = (0.0, 0.0);
     for n in 1..=harmonics {
         let turn = (n as f64 * theta0).sin_cos();
         for k in 0..per {
-            let (c, s) = (x[n * per + k], x[(harmonics + n) * per + k]);
+            let (c, s) = (x[n * per + k] / scale, x[(harmonics + n) * per + k] / scale);
             let (_, sine) = rotate(c, s, turn);
             odd += sine * sine;
             all += c * c + s * s;
         }
     }
-    all += x[..per].iter().map(|v| v * v).sum::<f64>();
+    all += x[..per].iter().map(|v| (v / scale).powi(2)).sum::<f64>();
     if all > 0.0 {
         odd / all
     } else {
@@ -168,8 +275,11 @@ fn share_about(x: &[f64], harmonics: usize, theta0: f64) -> f64 {
 
 /// How far a full-basis state is from even in time about any instant: the smallest sine
 /// share `|x_sin|^2 / |x|^2` over the shifts of its time origin ([`symmetry_instant`]).
-pub fn asymmetry(x: &[f64], harmonics: usize) -> f64 {
-    symmetry_instant(x, harmonics).1
+///
+/// # Errors
+/// As [`symmetry_instant`].
+pub fn asymmetry(x: &[f64], harmonics: usize) -> Result<f64, SettingsError> {
+    Ok(symmetry_instant(x, harmonics)?.1)
 }
 
 /// The phase `theta0` about which a full-basis state is closest to even, and its sine share
@@ -177,11 +287,21 @@ pub fn asymmetry(x: &[f64], harmonics: usize) -> f64 {
 ///
 /// A motion even about `theta0` is even about `theta0 + pi` too, so the search covers
 /// `[0, pi)`: a scan of `8 m` instants (the share varies on the scale `pi / m` of the
-/// highest harmonic), then a golden-section refinement around the best of them.
-pub fn symmetry_instant(x: &[f64], harmonics: usize) -> (f64, f64) {
-    if harmonics == 0 || x.len() < 2 * harmonics + 1 {
-        return (0.0, 0.0);
-    }
+/// highest harmonic), then a golden-section refinement around the best of them. Each
+/// instant costs a pass over `x`: about `8 m x.len()` operations in all (`m` harmonics).
+///
+/// # Errors
+/// [`SettingsError::ZeroHarmonics`] for no harmonics; [`SettingsError::StateLayout`] when
+/// `x` is empty or its length is not a multiple of `2 harmonics + 1` (which also bounds the
+/// scan by the length of `x`); [`SettingsError::NotFinite`] for a value of `x` that is not
+/// finite.
+pub fn symmetry_instant(x: &[f64], harmonics: usize) -> Result<(f64, f64), SettingsError> {
+    full_layout(x, harmonics)?;
+    Ok(symmetry_instant_of(x, harmonics))
+}
+
+/// [`symmetry_instant`] of a state whose layout is known to fit `harmonics`.
+fn symmetry_instant_of(x: &[f64], harmonics: usize) -> (f64, f64) {
     let scan = 8 * harmonics;
     let h = std::f64::consts::PI / scan as f64;
     let share = |t: f64| share_about(x, harmonics, t);
@@ -208,17 +328,44 @@ pub fn symmetry_instant(x: &[f64], harmonics: usize) -> (f64, f64) {
 
 /// The full-basis state `x` with its time origin moved to `theta0`: every signal
 /// `s(theta)` becomes `s(theta + theta0)`.
-pub fn shift_origin(x: &[f64], harmonics: usize, theta0: f64) -> Vec<f64> {
-    let per = x.len() / (2 * harmonics + 1);
+///
+/// # Errors
+/// As [`symmetry_instant`] for `x` and `harmonics`; [`SettingsError::NotFinite`] for a
+/// `theta0` that is not finite, or for a shifted coefficient beyond `f64::MAX` (a cosine and
+/// a sine both near it).
+pub fn shift_origin(x: &[f64], harmonics: usize, theta0: f64) -> Result<Vec<f64>, SettingsError> {
+    let per = full_layout(x, harmonics)?;
+    if !theta0.is_finite() {
+        return Err(SettingsError::NotFinite {
+            what: "time origin theta0",
+            value: theta0,
+        });
+    }
+    // A phase of many turns is reduced to one, so that `n theta0` stays finite (its sine
+    // would be NaN past the range of `f64`); within a turn it is used as given.
+    let theta0 = if theta0.abs() <= TAU {
+        theta0
+    } else {
+        theta0.rem_euclid(TAU)
+    };
     let mut y = x.to_vec();
     for n in 1..=harmonics {
         let turn = (n as f64 * theta0).sin_cos();
         for k in 0..per {
             let (c, s) = (x[n * per + k], x[(harmonics + n) * per + k]);
-            (y[n * per + k], y[(harmonics + n) * per + k]) = rotate(c, s, turn);
+            let (c, s) = rotate(c, s, turn);
+            // The rotation keeps `|(c, s)|`, up to `sqrt 2` times the larger of the two: past
+            // `f64::MAX`, the shifted state has no representation.
+            if let Some(value) = [c, s].into_iter().find(|v| !v.is_finite()) {
+                return Err(SettingsError::NotFinite {
+                    what: "shifted coefficient (its rotation passes f64::MAX)",
+                    value,
+                });
+            }
+            (y[n * per + k], y[(harmonics + n) * per + k]) = (c, s);
         }
     }
-    y
+    Ok(y)
 }
 
 /// Continues a branch of `system` in the full basis over `periods`, natural-parameter, from
@@ -292,7 +439,7 @@ pub fn full_basis_branch(
                 measures.push((
                     PhaseLocked::unfolding(&p.x),
                     share_about(x, harmonics, 0.0),
-                    asymmetry(x, harmonics),
+                    symmetry_instant_of(x, harmonics).1,
                 ));
                 let point = BackbonePoint::from_parts(&p, (x, time), e, e_g, PointStatus::of(&p));
                 let _ = annotator.point(point);

@@ -6,7 +6,7 @@
 use crate::branches::escape::{EscapingArclength, StallEscape};
 use crate::branches::tether::tethered_start;
 use crate::continuation::{
-    Arclength, ArclengthOptions, Branch, ContinuationProblem, Event, Point, Step,
+    Arclength, ArclengthOptions, Branch, ContinuationProblem, Event, Point, Rejection, Step,
 };
 use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::Basis;
@@ -399,7 +399,8 @@ pub(crate) fn tethered_backbone_start<S: NonlinearSolver>(
 /// other way (with the stall escape, if any) until it leaves the range between `omega` and
 /// the far end of `options.parameter_range`. Returns the walk as the first part of the run:
 /// its points from the far end back to the one before the start, in the run's direction and
-/// numbered from 0 ([`reversed`]), and the walk's rejected steps. The run then goes on from
+/// numbered from 0 ([`reversed`]), and the walk's rejected steps, each as the walk's
+/// observer saw it. The run then goes on from
 /// the start, so that the branch between `omega` and `from` is not lost. A start not beyond
 /// `omega`, or one the driver cannot start from, has no walk. The walk keeps within the
 /// drivers' default step and rejection budgets ([`ArclengthOptions::default`]): the run's
@@ -411,10 +412,10 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
     omega: f64,
     options: ArclengthOptions,
     (escape, floor): (Option<StallEscape>, f64),
-) -> (Vec<Point>, usize) {
+) -> (Vec<Point>, Vec<Rejection>) {
     let direction = options.direction.signum();
     if (from - omega) * direction <= 0.0 {
-        return (Vec::new(), 0);
+        return (Vec::new(), Vec::new());
     }
     let (lo, hi) = options.parameter_range;
     // The run's observer sees the walk only once it is over, so it cannot stop it: the walk
@@ -438,13 +439,21 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
         Ok(driver) => driver
             .with_rest_accepted()
             .with_acceptance(|y, at| energy(system, basis, y, at) > floor),
-        Err(_) => return (Vec::new(), 0),
+        Err(_) => return (Vec::new(), Vec::new()),
     };
-    let mut go_on = |_: &Step| ControlFlow::Continue(());
+    // The rejections are kept to be handed to the run's observer, which counts them with
+    // the run's own.
+    let mut rejections = Vec::new();
+    let mut go_on = |step: &Step| {
+        if let Step::Rejected(r) = step {
+            rejections.push(r.clone());
+        }
+        ControlFlow::Continue(())
+    };
     let mut branch: Branch = match escape {
         Some(escape) => match EscapingArclength::new(driver, escape) {
             Ok(mut escaping) => escaping.run(&mut go_on),
-            Err(_) => return (Vec::new(), 0),
+            Err(_) => return (Vec::new(), Vec::new()),
         },
         None => {
             let mut plain = driver;
@@ -455,7 +464,7 @@ pub(crate) fn walk_back<S: NonlinearSolver>(
     if !branch.points.is_empty() {
         branch.points.remove(0);
     }
-    (reversed(branch.points), branch.rejections)
+    (reversed(branch.points), rejections)
 }
 
 /// Points of a branch in the opposite order, numbered from 0, each event moved to the point

@@ -9,8 +9,9 @@ use crate::continuation::{
 };
 use crate::error::{ContinuationError, Error, SettingsError};
 use crate::forced::{ForcedSystem, Forcing};
+use crate::fourier::check_memory;
 use crate::modal::grazing_energy;
-use crate::solve::{norm, Solver};
+use crate::solve::{norm, Problem, Solver};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use std::ops::ControlFlow;
 
@@ -122,7 +123,9 @@ impl ForcedResponse {
 /// [`SettingsError`] and [`ForcingError`](crate::ForcingError) as [`ForcedSystem::new`];
 /// [`SettingsError::Range`] for a frequency range that is not positive and finite, empty
 /// or reversed (`lo > hi`), quoting it;
-/// [`ContinuationError`] for zero steps or a start that does not converge. A run that stops
+/// [`ContinuationError`] for zero steps or a start that does not converge, and
+/// [`ContinuationError::TooLarge`] for more steps than the memory budget holds (the grid's
+/// values, or the arclength's `4 steps` points). A run that stops
 /// part-way returns its points and its [`EndReason`].
 pub fn forced_response(
     system: &BarSystem,
@@ -176,6 +179,15 @@ fn follow(
             sweep(problem, solver, start, &linspace(lo, hi, steps)?, observer)
         }
         ResponseMethod::Arclength => {
+            // The run keeps every point it takes, up to `4 steps` of them: a budget checked
+            // before it starts, as the sequential grid's values are (an unbounded count
+            // would run for ever).
+            let dimension = problem.dimension() as f64 + 1.0;
+            check_memory(
+                "the points of an arclength response",
+                4.0 * steps as f64 * dimension,
+            )
+            .map_err(ContinuationError::TooLarge)?;
             let scale = state_scale(problem, (lo, hi), steps)?;
             let ds_max = 4.0 / steps as f64;
             let options = ArclengthOptions {

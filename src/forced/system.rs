@@ -1,5 +1,6 @@
 //! The forced, damped harmonic-balance system `F(x; Omega) = 0` in the full Fourier basis.
 
+use crate::bar::Bar;
 use crate::bc::{LawSamples, Observable};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError, SolveError};
@@ -7,9 +8,10 @@ use crate::forced::excitation::{Damping, Driven, Excitation};
 use crate::forced::rows::{real_form, DampedRows};
 use crate::fourier::{check_memory, Basis, SineCosineBasis};
 use crate::linalg::{DenseMatrix, Lu};
+use crate::modal::inputs::MIN_FREQUENCY;
 use crate::solve::{Problem, Structured};
 use crate::system::problem::selection::{Selection, Shape};
-use crate::system::problem::{check_complementarity, law_grams, law_offsets, unit_gram};
+use crate::system::problem::{check_complementarity, law_grams, law_offsets, unit_gram, MAX_PHASE};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use crate::ForcingError;
 
@@ -253,7 +255,9 @@ impl ForcedSystem {
     ///
     /// # Errors
     /// [`SettingsError::IndexOutOfRange`] for a law `l` the system does not have;
-    /// [`SettingsError::Length`] for an `x` that is not a state of the system.
+    /// [`SettingsError::Length`] for an `x` that is not a state of the system;
+    /// [`SettingsError::NonFiniteResult`] for a history that overflows (a state near the ends
+    /// of `f64`).
     pub fn gap_history(&self, x: &[f64], l: usize) -> Result<Vec<f64>, SettingsError> {
         let count = self.offsets.len();
         if l >= count {
@@ -273,6 +277,14 @@ impl ForcedSystem {
         self.basis
             .synthesize(&self.observable(x, l, true, false), &mut gap);
         gap.iter_mut().for_each(|v| *v += self.offsets[l].0);
+        // A state near the ends of `f64` (the open response to an amplitude of `f64::MAX`)
+        // overflows the synthesis.
+        if gap.iter().any(|v| !v.is_finite()) {
+            return Err(SettingsError::NonFiniteResult {
+                what: "gap history",
+                omega: self.omega,
+            });
+        }
         Ok(gap)
     }
 
@@ -323,17 +335,22 @@ impl ForcedSystem {
     ///
     /// # Errors
     /// [`SettingsError::NotFinite`] before a frequency is set
-    /// ([`ContinuationProblem::set_parameter`]);
+    /// ([`ContinuationProblem::set_parameter`]); [`SettingsError::NotPositive`],
+    /// [`SettingsError::FrequencyTooSmall`] or [`SettingsError::FrequencyTooLarge`] for a
+    /// frequency set that is not positive and finite or out of the basis' range;
+    /// [`SettingsError::NonFiniteResult`] when amplitudes or damping near the ends of `f64`
+    /// overflow the response;
     /// [`SolveError::SingularJacobian`](crate::SolveError::SingularJacobian) when the open
     /// system is singular at harmonic 1 (an undamped natural frequency).
     pub fn open_response(&self) -> Result<Vec<f64>, Error> {
-        if !self.omega.is_finite() {
+        if self.omega.is_nan() {
             return Err(SettingsError::NotFinite {
                 what: "forcing frequency (none set yet: set_parameter gives it)",
                 value: self.omega,
             }
             .into());
         }
+        self.check_forcing_frequency()?;
         let (u, m) = (self.unknowns, self.basis.harmonics());
         let rows = &self.rows[1];
         // Harmonic 1's equations: the linear rows, then every law's force held at zero, for
@@ -362,10 +379,45 @@ impl ForcedSystem {
             ratio: p.ratio,
         })?;
         lu.solve_in_place(&mut b);
+        // Amplitudes or damping near the ends of `f64` (finite, so accepted) can overflow
+        // the solve.
+        if b.iter().any(|v| !v.is_finite()) {
+            return Err(SettingsError::NonFiniteResult {
+                what: "open-contact response",
+                omega: self.omega,
+            }
+            .into());
+        }
         let mut x = vec![0.0; self.dimension()];
         x[u..2 * u].copy_from_slice(&b[..u]);
         x[(m + 1) * u..(m + 2) * u].copy_from_slice(&b[u..]);
         Ok(x)
+    }
+
+    /// Checks the frequency set: positive and finite, not subnormal
+    /// ([`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY)), and not so high that the phase
+    /// `k l` of the highest harmonic over a bar passes [`MAX_PHASE`], where the rows'
+    /// sines and cosines carry no digit (they came out NaN at `1e300`).
+    fn check_forcing_frequency(&self) -> Result<(), SettingsError> {
+        let (what, omega) = ("forcing frequency", self.omega);
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(SettingsError::NotPositive { what, value: omega });
+        }
+        if omega < MIN_FREQUENCY {
+            return Err(SettingsError::FrequencyTooSmall {
+                what,
+                omega,
+                min: MIN_FREQUENCY,
+            });
+        }
+        let slowest = (self.system.bars().iter())
+            .map(Bar::travel_time)
+            .fold(0.0, f64::max);
+        let max = MAX_PHASE / (self.basis.harmonics().max(1) as f64 * slowest);
+        if omega > max {
+            return Err(SettingsError::FrequencyTooLarge { what, omega, max });
+        }
+        Ok(())
     }
 
     /// Adds `scale` times the derivative of `real_form(row, x_i, partner)` in `x` to row

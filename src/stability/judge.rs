@@ -92,7 +92,7 @@ pub(crate) fn judge(
         dt: map.template.grid().dt(),
         period: map.period,
     };
-    Ok(floquet::verdict(
+    finite(floquet::verdict(
         multipliers,
         options.tolerance,
         pair,
@@ -100,4 +100,23 @@ pub(crate) fn judge(
         corrected,
         shape,
     ))
+}
+
+/// `floquet`, or [`StabilityError::NonFiniteResult`] naming its first number that is NaN or
+/// infinite. A state scaled towards the ends of `f64` (by `1e300` or `1e-300`) has norms and
+/// energies that overflow or underflow, and its defects and corrections come out NaN: no
+/// verdict, unresolved or not, can be drawn from them.
+fn finite(floquet: Floquet) -> Result<Floquet, StabilityError> {
+    let numbers = [
+        ("initial periodicity defect", floquet.initial_defect),
+        ("periodicity defect", floquet.periodicity_defect),
+        ("correction", floquet.correction),
+        ("displacement correction", floquet.displacement_correction),
+        ("energy correction", floquet.energy_correction),
+        ("largest multiplier modulus", floquet.max_modulus),
+    ];
+    match numbers.into_iter().find(|(_, v)| !v.is_finite()) {
+        Some((what, value)) => Err(StabilityError::NonFiniteResult { what, value }),
+        None => Ok(floquet),
+    }
 }

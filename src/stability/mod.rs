@@ -312,7 +312,8 @@ impl StabilityOptions {
 /// for a grid of more than [`MAX_DIMENSION`] coordinates; [`StabilityError::AtRest`] for a
 /// state at rest; [`StabilityError::Verify`] if a march fails (a bad period, a march too
 /// costly); [`StabilityError::NonFinite`] and [`StabilityError::NoEigenvalues`] if the
-/// matrix or its eigenvalues cannot be computed.
+/// matrix or its eigenvalues cannot be computed; [`StabilityError::NonFiniteResult`] when a
+/// defect or correction of a state near the ends of `f64` is not finite.
 pub fn floquet_of_state(
     initial: &State,
     period: f64,

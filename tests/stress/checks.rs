@@ -6,6 +6,7 @@
 
 use nonsmooth_modes::branches::{BackbonePoint, ModeBranches, PointStatus};
 use nonsmooth_modes::continuation::{Branch, EndReason, Event, Point};
+use nonsmooth_modes::modal::Label;
 use nonsmooth_modes::solve::SolveInfo;
 use nonsmooth_modes::system::BarSystem;
 
@@ -122,10 +123,16 @@ impl Checks {
         self.expect(grouped == labelled, || {
             format!("{what}: {grouped} points in label groups for {labelled} labelled")
         });
+        // Off-branch points form one group whatever their ratios (`group_by_label`).
+        let same = |a: &Label, b: &Label| match (a, b) {
+            (Label::OffBranch { .. }, Label::OffBranch { .. }) => true,
+            (a, b) => a == b,
+        };
         for (i, g) in groups.iter().enumerate() {
-            let alone = groups[i + 1..].iter().all(|h| h.label != g.label);
+            let alone = groups[i + 1..].iter().all(|h| !same(&h.label, &g.label));
             let own_first = !g.is_own_branch() || groups[..i].iter().all(|h| h.is_own_branch());
-            let consistent = g.points.iter().all(|p| p.label.as_ref() == Some(&g.label));
+            let consistent =
+                (g.points.iter()).all(|p| p.label.as_ref().is_some_and(|l| same(l, &g.label)));
             self.expect(
                 !g.points.is_empty() && alone && own_first && consistent,
                 || {

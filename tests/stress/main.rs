@@ -5,7 +5,8 @@
 //! infinities and NaN; sizes `0`, `1`, small, `2^40` and `usize::MAX`, and one and twice past
 //! the memory budget; tolerances below the rounding floor with `usize::MAX` iterations;
 //! parameters at the extremes the constructors accept; assemblies written to JSON and TOML
-//! and read back bit for bit.
+//! and read back bit for bit; the surfaces added after the core (the full-basis helpers,
+//! the forced system's calls, Floquet multipliers) with the same hostile values.
 //!
 //! Each case runs under `catch_unwind` on a worker thread and is classified: `Ok`, typed
 //! error, panic (with its message), a non-finite number in an `Ok` result, a run without a

@@ -207,8 +207,8 @@ mod tests {
             ..HarmonicBalanceSettings::default()
         };
         let omega = frequency_of_period(3.5);
-        let x = to_full_basis(&ClampedFirstMode::new(1e-3, 3.5).unknowns(m), m);
-        let x = crate::branches::shift_origin(&x, m, 0.37);
+        let x = to_full_basis(&ClampedFirstMode::new(1e-3, 3.5).unknowns(m), m).unwrap();
+        let x = crate::branches::shift_origin(&x, m, 0.37).unwrap();
         let mut free = ForcedSystem::free(&system, settings).unwrap();
         free.set_parameter(omega);
         let matrix = HillMatrix::new(&free, &x, omega).unwrap();

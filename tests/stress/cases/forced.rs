@@ -35,8 +35,9 @@ pub(crate) fn forced_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     };
     let lo = d.real("lowest frequency", 0.1..=4.0);
     let hi = lo * d.real("range ratio", 1.0..=1.5);
-    // The grid is the caller's memory: its edge sizes are capped (0 stays, a typed error).
-    let steps = d.size("steps", 1..=8).min(8);
+    // Any count, `2^40` and `usize::MAX` included: both methods refuse one over the memory
+    // budget before they start (`0` and `1` are typed errors too).
+    let steps = d.size("steps", 1..=8);
     let method = d.pick(
         "method",
         &[ResponseMethod::Sequential, ResponseMethod::Arclength],
@@ -72,8 +73,9 @@ pub(crate) fn forced_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
         }
     }
     // The arclength takes at most four times its steps, plus its start.
-    c.expect(run.points.len() <= 4 * steps + 1, || {
-        format!("{} points from {steps} steps", run.points.len())
-    });
+    c.expect(
+        run.points.len() <= steps.saturating_mul(4).saturating_add(1),
+        || format!("{} points from {steps} steps", run.points.len()),
+    );
     Ok(())
 }

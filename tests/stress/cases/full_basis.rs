@@ -35,7 +35,7 @@ pub(crate) fn full_basis_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
             let omega = frequency_of_period(periods.first().copied().unwrap_or(base));
             let seed = typed(c, "seed", branch_seed(&mut cosine, 1, 1, omega))?;
             let scale = d.real("seed scale", 0.5..=3.0);
-            let mut start = to_full_basis(&seed, s.harmonics);
+            let mut start = typed(c, "to full basis", to_full_basis(&seed, s.harmonics))?;
             start.iter_mut().for_each(|v| *v *= scale);
             if kind == "seed with sines" {
                 let sines = start.len() / (2 * s.harmonics + 1) * (s.harmonics + 1);

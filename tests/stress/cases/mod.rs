@@ -8,6 +8,7 @@ mod full_basis;
 mod model;
 mod post;
 mod solvers;
+mod surfaces;
 
 use crate::checks::{typed, CaseResult, Checks};
 use crate::draw::Draw;
@@ -37,10 +38,13 @@ pub(crate) enum Kind {
     Request,
     FullBasis,
     Forced,
+    FullBasisHelpers,
+    ForcedCalls,
+    Stability,
 }
 
 /// Every kind, drawn uniformly by each case.
-pub(crate) const KINDS: [Kind; 12] = [
+pub(crate) const KINDS: [Kind; 15] = [
     Kind::Assembly,
     Kind::Settings,
     Kind::Solver,
@@ -53,6 +57,9 @@ pub(crate) const KINDS: [Kind; 12] = [
     Kind::Request,
     Kind::FullBasis,
     Kind::Forced,
+    Kind::FullBasisHelpers,
+    Kind::ForcedCalls,
+    Kind::Stability,
 ];
 
 impl Kind {
@@ -70,6 +77,9 @@ impl Kind {
             Kind::Request => backbones::request_case(d, c),
             Kind::FullBasis => full_basis::full_basis_case(d, c),
             Kind::Forced => forced::forced_case(d, c),
+            Kind::FullBasisHelpers => surfaces::full_basis_helpers_case(d, c),
+            Kind::ForcedCalls => surfaces::forced_calls_case(d, c),
+            Kind::Stability => surfaces::stability_case(d, c),
         }
     }
 }
