@@ -12,6 +12,12 @@ use std::time::{Duration, Instant};
 /// A case that has not answered after this long is a hang (a valid case takes milliseconds).
 pub(crate) const HANG_SECONDS: u64 = 60;
 
+/// A case that answers after this many seconds counts as slow in the report.
+const SLOW_SECONDS: f64 = 5.0;
+
+/// How many of the slowest cases the report lists.
+const SLOWEST_LISTED: usize = 5;
+
 /// How a case ended.
 #[derive(Debug, Clone, PartialEq)]
 enum Outcome {
@@ -163,8 +169,10 @@ pub(crate) fn run_suite(base: u64, indices: impl Iterator<Item = usize>) -> Vec<
     let mut per_kind: BTreeMap<Kind, Counts> = BTreeMap::new();
     let mut total = Counts::default();
     let mut failures = Vec::new();
-    // The slowest case that answered: (seconds, index, kind).
-    let mut slowest: Option<(f64, usize, Kind)> = None;
+    // The slowest cases that answered, slowest first: (seconds, index, kind); and how many
+    // answered after `SLOW_SECONDS`.
+    let mut slowest: Vec<(f64, usize, Kind)> = Vec::new();
+    let mut slow = 0;
     for index in indices {
         let log = Arc::new(Mutex::new(String::new()));
         let sent = Instant::now();
@@ -178,9 +186,10 @@ pub(crate) fn run_suite(base: u64, indices: impl Iterator<Item = usize>) -> Vec<
         {
             Ok(report) => {
                 let seconds = sent.elapsed().as_secs_f64();
-                if slowest.is_none_or(|(s, ..)| seconds > s) {
-                    slowest = Some((seconds, index, report.kind));
-                }
+                slow += usize::from(seconds > SLOW_SECONDS);
+                slowest.push((seconds, index, report.kind));
+                slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
+                slowest.truncate(SLOWEST_LISTED);
                 report
             }
             Err(_) => {
@@ -223,7 +232,8 @@ pub(crate) fn run_suite(base: u64, indices: impl Iterator<Item = usize>) -> Vec<
         println!("{}", counts.row(&format!("{kind:?}")));
     }
     println!("{}", total.row("total"));
-    if let Some((seconds, index, kind)) = slowest {
+    println!("slow cases (over {SLOW_SECONDS} s): {slow}");
+    for (seconds, index, kind) in &slowest {
         println!("slowest case: {index} ({kind:?}), {seconds:.2} s");
     }
     println!("aborts: 0 (the process finished)");
