@@ -120,6 +120,8 @@ impl Sampled {
 pub(crate) struct Judge {
     system: BarSystem,
     basis: CosineBasis,
+    /// The check each sampled point is marched with ([`judge_check`]).
+    check: TimeDomainCheck,
     /// Indices of the sample among the run's points, in marching order.
     sample: Vec<usize>,
     /// How many of the sample were marched, and with what outcome.
@@ -137,6 +139,7 @@ impl Judge {
         Self {
             system: problem.system().clone(),
             basis: problem.basis().clone(),
+            check: judge_check(problem.system()),
             sample: (0..s)
                 .map(|k| converged[(2 * k + 1) * n / (2 * s)])
                 .collect(),
@@ -155,8 +158,7 @@ impl Judge {
         let Some(point) = points.get(i) else {
             return true;
         };
-        let check = judge_check(&self.system);
-        match check_point(&check, (&self.system, &self.basis), point).0 {
+        match check_point(&self.check, (&self.system, &self.basis), point).0 {
             CheckOutcome::Passed => self.sampled.passed += 1,
             CheckOutcome::Failed => self.sampled.failed += 1,
             _ => {}

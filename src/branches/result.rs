@@ -163,33 +163,24 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             self.describe(&mut point);
         }
         self.splitter.push(point, ());
-        let released: Vec<_> = self.splitter.release().map(|(p, ())| p).collect();
-        self.show(released)
-    }
-
-    /// Shows `points` to the observer and keeps them, up to the one at which it stops the
-    /// run: the result holds the points the observer saw (a point computed after a held one
-    /// at which it stops is past where it asked to stop).
-    fn show(&mut self, points: impl IntoIterator<Item = BackbonePoint>) -> ControlFlow<()> {
-        for point in points {
-            if self.stopped {
-                break;
-            }
-            self.stopped = self.observer.point(&point).is_break();
-            self.points.push(point);
-        }
-        if self.stopped {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
+        let released = self.splitter.release().map(|(p, ())| p);
+        show(
+            &mut self.observer,
+            (&mut self.points, &mut self.stopped),
+            released,
+        )
     }
 
     /// Shows the points still held (the run ended); returns whether the observer stopped the
     /// run, then or before.
     fn flush(&mut self) -> bool {
-        let held: Vec<_> = self.splitter.flush().map(|(p, ())| p).collect();
-        self.show(held).is_break()
+        let held = self.splitter.flush().map(|(p, ())| p);
+        show(
+            &mut self.observer,
+            (&mut self.points, &mut self.stopped),
+            held,
+        )
+        .is_break()
     }
 
     /// Shows a rejected step to the observer.
@@ -209,7 +200,8 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
                 self.check(&mut point);
                 self.assess(&mut point);
             }
-            if self.show([point]).is_break() {
+            let kept = (&mut self.points, &mut self.stopped);
+            if show(&mut self.observer, kept, [point]).is_break() {
                 return EndReason::StoppedByObserver;
             }
         }
@@ -364,6 +356,28 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
             self.natural_up_to = up_to;
         }
         changed
+    }
+}
+
+/// Shows `points` to `observer` and keeps them in `kept`, up to the one at which it stops
+/// the run (`stopped`): the result holds the points the observer saw (a point computed after
+/// a held one at which it stops is past where it asked to stop).
+fn show<O: BackboneObserver>(
+    observer: &mut O,
+    (kept, stopped): (&mut Vec<BackbonePoint>, &mut bool),
+    points: impl IntoIterator<Item = BackbonePoint>,
+) -> ControlFlow<()> {
+    for point in points {
+        if *stopped {
+            break;
+        }
+        *stopped = observer.point(&point).is_break();
+        kept.push(point);
+    }
+    if *stopped {
+        ControlFlow::Break(())
+    } else {
+        ControlFlow::Continue(())
     }
 }
 

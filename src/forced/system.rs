@@ -1,6 +1,5 @@
 //! The forced, damped harmonic-balance system `F(x; Omega) = 0` in the full Fourier basis.
 
-use crate::bar::Bar;
 use crate::bc::{LawSamples, Observable};
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError, SolveError};
@@ -8,10 +7,12 @@ use crate::forced::excitation::{Damping, Driven, Excitation};
 use crate::forced::rows::{real_form, DampedRows};
 use crate::fourier::{check_memory, Basis, SineCosineBasis};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::modal::inputs::MIN_FREQUENCY;
+use crate::modal::inputs::check_frequency_named;
 use crate::solve::{Problem, Structured};
 use crate::system::problem::selection::{Selection, Shape};
-use crate::system::problem::{check_complementarity, law_grams, law_offsets, unit_gram, MAX_PHASE};
+use crate::system::problem::{
+    check_complementarity, law_grams, law_offsets, max_frequency, unit_gram,
+};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use crate::ForcingError;
 
@@ -396,28 +397,11 @@ impl ForcedSystem {
 
     /// Checks the frequency set: positive and finite, not subnormal
     /// ([`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY)), and not so high that the phase
-    /// `k l` of the highest harmonic over a bar passes [`MAX_PHASE`], where the rows'
+    /// `k l` of the highest harmonic over a bar passes [`MAX_PHASE`](crate::system::MAX_PHASE), where the rows'
     /// sines and cosines carry no digit (they came out NaN at `1e300`).
     fn check_forcing_frequency(&self) -> Result<(), SettingsError> {
-        let (what, omega) = ("forcing frequency", self.omega);
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(SettingsError::NotPositive { what, value: omega });
-        }
-        if omega < MIN_FREQUENCY {
-            return Err(SettingsError::FrequencyTooSmall {
-                what,
-                omega,
-                min: MIN_FREQUENCY,
-            });
-        }
-        let slowest = (self.system.bars().iter())
-            .map(Bar::travel_time)
-            .fold(0.0, f64::max);
-        let max = MAX_PHASE / (self.basis.harmonics().max(1) as f64 * slowest);
-        if omega > max {
-            return Err(SettingsError::FrequencyTooLarge { what, omega, max });
-        }
-        Ok(())
+        let max = max_frequency(&self.system, self.basis.harmonics());
+        check_frequency_named("forcing frequency", self.omega, max).map(|_| ())
     }
 
     /// Adds `scale` times the derivative of `real_form(row, x_i, partner)` in `x` to row

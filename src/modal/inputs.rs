@@ -15,7 +15,17 @@ pub const MIN_FREQUENCY: f64 = frequency_of_period(f64::MAX) * (1.0 + 4.0 * f64:
 /// Checks a fundamental frequency: positive and finite ([`SettingsError::NotPositive`]) and
 /// at least [`MIN_FREQUENCY`] ([`SettingsError::FrequencyTooSmall`]).
 pub(crate) fn check_frequency(omega: f64) -> Result<f64, SettingsError> {
-    let what = "fundamental frequency";
+    check_frequency_named("fundamental frequency", omega, f64::INFINITY)
+}
+
+/// Checks a frequency named `what`: positive and finite ([`SettingsError::NotPositive`]), at
+/// least [`MIN_FREQUENCY`] ([`SettingsError::FrequencyTooSmall`]) and at most `max`
+/// ([`SettingsError::FrequencyTooLarge`]).
+pub(crate) fn check_frequency_named(
+    what: &'static str,
+    omega: f64,
+    max: f64,
+) -> Result<f64, SettingsError> {
     if !(omega.is_finite() && omega > 0.0) {
         Err(SettingsError::NotPositive { what, value: omega })
     } else if omega < MIN_FREQUENCY {
@@ -24,6 +34,8 @@ pub(crate) fn check_frequency(omega: f64) -> Result<f64, SettingsError> {
             omega,
             min: MIN_FREQUENCY,
         })
+    } else if omega > max {
+        Err(SettingsError::FrequencyTooLarge { what, omega, max })
     } else {
         Ok(omega)
     }
@@ -36,17 +48,8 @@ pub(crate) fn check_frequency_of<B: Basis>(
     problem: &NonsmoothSystem<B>,
     omega: f64,
 ) -> Result<f64, SettingsError> {
-    check_frequency(omega)?;
     let max = problem.description().max_frequency();
-    if omega > max {
-        Err(SettingsError::FrequencyTooLarge {
-            what: "fundamental frequency",
-            omega,
-            max,
-        })
-    } else {
-        Ok(omega)
-    }
+    check_frequency_named("fundamental frequency", omega, max)
 }
 
 /// Checks a motion `x` of `problem` at `omega`: the length of `x`

@@ -155,10 +155,7 @@ impl<B: Basis> Discretization<B> {
     /// `k l = m Omega l / c` of every bar at most [`MAX_PHASE`]:
     /// `MAX_PHASE / (m max_b(l_b / c_b))`.
     pub fn max_frequency(&self) -> f64 {
-        let slowest = (self.system.bars().iter())
-            .map(Bar::travel_time)
-            .fold(0.0, f64::max);
-        MAX_PHASE / (self.basis.harmonics().max(1) as f64 * slowest)
+        max_frequency(&self.system, self.basis.harmonics())
     }
 
     /// The largest gap of the unilateral laws: residual entries are gaps and forces of that
@@ -465,6 +462,16 @@ fn affine_relation(w_gap: &[f64], w_force: &[f64]) -> Option<(f64, f64)> {
             <= 4.0 * f64::EPSILON * (f.abs() + alpha.abs() + (beta * g).abs()))
     });
     (fits && alpha.is_finite() && beta.is_finite()).then_some((alpha, beta))
+}
+
+/// The highest fundamental frequency at which the phase `k l` of harmonic `harmonics` over
+/// the slowest bar of `system` stays within [`MAX_PHASE`] (the rows' sines and cosines still
+/// carry digits there).
+pub(crate) fn max_frequency(system: &BarSystem, harmonics: usize) -> f64 {
+    let slowest = (system.bars().iter())
+        .map(Bar::travel_time)
+        .fold(0.0, f64::max);
+    MAX_PHASE / (harmonics.max(1) as f64 * slowest)
 }
 
 #[cfg(test)]

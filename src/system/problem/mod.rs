@@ -33,7 +33,9 @@ mod staircase;
 mod state;
 mod step;
 
-pub(crate) use discretization::{check_complementarity, law_grams, law_offsets, unit_gram};
+pub(crate) use discretization::{
+    check_complementarity, law_grams, law_offsets, max_frequency, unit_gram,
+};
 pub use discretization::{Discretization, COMPLEMENTARITY_RANGE, MAX_OFFSET, MAX_PHASE};
 
 use crate::continuation::ContinuationProblem;
