@@ -259,10 +259,13 @@ pub fn verification_cells(p: &BackbonePoint) -> String {
 pub fn stability_cells(p: &BackbonePoint) -> String {
     let outcome = p.stability.as_ref().map(|o| {
         o.as_ref().map(|f| {
+            let damped = f
+                .damping
+                .map(|d| format!("stable up to the grid's damping of {d:.1e} per period"));
             (
                 f.verdict,
                 f.max_multiplier,
-                f.unresolved.map(|r| r.to_string()),
+                f.unresolved.map(|r| r.to_string()).or(damped),
             )
         })
     });

@@ -21,7 +21,7 @@ pub(crate) struct Limits {
     pub relative_step: f64,
     /// The defect `|P(x) - x| / |x|` at which the correction stops.
     pub tolerance: f64,
-    /// The largest norm of a step (a trust radius): a longer one is shortened to it.
+    /// The largest norm of a step (the trust radius it starts from).
     pub max_step: f64,
 }
 
@@ -39,12 +39,13 @@ pub(crate) struct Outcome {
     pub refreshes: usize,
 }
 
-/// Corrects `x0` towards `P(x) = x` by minimum-norm steps `(M - I) d = x - P(x)`, with `M`
+/// Corrects `x0` towards `P(x) = x` by steps `(M - I) d = x - P(x)`, with `M`
 /// the monodromy factored in `jacobian` (the previous orbit's, or `None`). Where a step does
 /// not contract the defect by [`CONTRACTION`], `M` is recomputed at the current state (at
-/// most `limits.refreshes` times); `jacobian` holds the last matrix used. Steps longer than
-/// `limits.max_step` are shortened: near a point the map has other periodic orbits, and a
-/// long step from a prediction in another piece of the map lands on one of them.
+/// most `limits.refreshes` times); `jacobian` holds the last matrix used. Steps are
+/// Levenberg–Marquardt steps within a trust radius, at most `limits.max_step`: near a point
+/// the map has other periodic orbits, and a long step from a prediction in another piece of
+/// the map lands on one of them. Where a fresh matrix's step fails, the radius shrinks.
 pub(crate) fn correct(
     map: &PeriodMap,
     x0: &[f64],
@@ -59,6 +60,10 @@ pub(crate) fn correct(
     // Whether the matrix was computed at the current state: a step it cannot take ends.
     let mut fresh = false;
     let mut stale = false;
+    // The trust radius: a fresh matrix whose step fails is tried again within a quarter of
+    // it (the step turns towards the steepest descent of the defect), and a step that
+    // succeeds restores it.
+    let mut radius = limits.max_step;
     while defect > limits.tolerance && iterations < limits.iterations {
         if jacobian.is_none() || stale {
             if refreshes >= limits.refreshes {
@@ -72,19 +77,20 @@ pub(crate) fn correct(
             break;
         };
         let rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-        let mut d = inverse.solve(&rhs);
-        let length = norm(&d);
-        if length > limits.max_step {
-            d.iter_mut().for_each(|v| *v *= limits.max_step / length);
-        }
+        let d = inverse.solve_within(&rhs, radius);
         iterations += 1;
         match line_step(map, &x, &d, defect, &mut trial_r)? {
             Some((next, next_defect)) => {
                 stale = next_defect > CONTRACTION * defect;
-                (x, defect, fresh) = (next, next_defect, false);
+                (x, defect, fresh, radius) = (next, next_defect, false, limits.max_step);
                 std::mem::swap(&mut r, &mut trial_r);
             }
-            None if fresh => break,
+            None if fresh => {
+                radius = radius.min(norm(&d)) / 4.0;
+                if radius <= limits.tolerance * norm(&x) {
+                    break;
+                }
+            }
             None => stale = true,
         }
     }

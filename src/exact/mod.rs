@@ -28,14 +28,16 @@
 //!
 //! The period is the continuation parameter; the energy is measured on the orbit found. The
 //! predictor is the secant through the last two orbits in `(X, T)` (the previous orbit alone
-//! after a seed or a gap). The corrector takes minimum-norm steps `(M - I) d = X - P_T(X)`
-//! over the singular values above `1e-4` of the largest, with `M` the **previous orbit's
+//! after a seed or a gap). The corrector takes Levenberg–Marquardt steps of
+//! `(M - I) d = X - P_T(X)` within a trust radius, with `M` the **previous orbit's
 //! monodromy**, factored once (a chord method): each step costs one march instead of the
 //! `2 n` of a fresh matrix. Where a step does not halve the defect, `M` is recomputed at the
-//! current state (at most [`ExactOptions::refreshes`] times per point). The minimum-norm step
-//! is orthogonal to the singular directions of `M - I`: the time shift (so no phase condition
-//! is needed) and the waves that free flight carries back onto themselves over the period,
-//! which would change the motion rather than correct it. A point counts when its defect
+//! current state (at most [`ExactOptions::refreshes`] times per point). The step has no
+//! component along the null direction of `M - I`, the time shift (so no phase condition is
+//! needed), and the trust radius damps it first along the small singular values: the family
+//! direction and the waves that free flight carries nearly back onto themselves over the
+//! period, a continuum with no gap where a cutoff could tell them from real directions;
+//! moving far along them would change the motion rather than correct it. A point counts when its defect
 //! `|P(X) - X| / |X|` is at most [`RESOLVED_DEFECT`](crate::stability::RESOLVED_DEFECT).
 //!
 //! The section drifts along the orbit from point to point (the steps have no phase
@@ -69,7 +71,9 @@
 //!
 //! One monodromy per point, at the corrected orbit: its eigenvalues give the verdict exactly
 //! as [`floquet_of_state`](crate::stability::floquet_of_state) does (trivial pair,
-//! tolerance; no other differences' steps: each costs a monodromy), and its factored `M - I` is the next point's corrector.
+//! tolerance, the grid's damping on periods of an odd number of steps; no other
+//! differences' steps: each costs a monodromy), and its factored `M - I` is the next point's
+//! corrector.
 //! Where the integrator merged wave pieces over the period (incommensurate travel times,
 //! chattering), the energy removed is reported ([`ExactPoint::removed_energy`]) and the point
 //! gets a verdict only below [`ExactOptions::max_removed_energy`]

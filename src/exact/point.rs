@@ -7,7 +7,6 @@ use super::walk::{Orbit, Walker};
 use crate::branches::{BackbonePoint, CheckOutcome, PointStatus};
 use crate::fourier::frequency_of_period;
 use crate::modal::Label;
-use crate::stability::monodromy::Monodromy;
 use crate::stability::shooting::PseudoInverse;
 use crate::stability::{judge, law_gap, open_section, Floquet, StabilityError, UnresolvedReason};
 use crate::verify::{
@@ -23,7 +22,8 @@ const MIN_OPEN_GAP: f64 = 0.25;
 struct Judged {
     outcome: Outcome,
     state: State,
-    monodromy: Monodromy,
+    /// The truncated pseudo-inverse of `M - I`: the next point's chord matrix.
+    inverse: PseudoInverse,
     floquet: Floquet,
     /// The orbit's march over one period (its removed energy decides `Merged`).
     report: PeriodicityReport,
@@ -53,12 +53,16 @@ impl Walker<'_> {
                 bound: self.options.max_removed_energy,
             });
         let corrected = self.corrected(&outcome, start.0, start.1)?;
-        let floquet = judge(&map, &corrected, &monodromy, failure, stability, &[])?;
+        // The eigenvalues and the singular value decomposition of one matrix are independent.
+        let (floquet, inverse) = both(
+            || judge(&map, &corrected, &monodromy, failure, stability, &[]),
+            || PseudoInverse::of_monodromy(&monodromy),
+        );
         Ok(Judged {
             outcome,
             state,
-            monodromy,
-            floquet,
+            inverse: inverse?,
+            floquet: floquet?,
             report,
         })
     }
@@ -95,7 +99,7 @@ impl Walker<'_> {
         let Judged {
             outcome,
             state,
-            monodromy,
+            inverse,
             floquet,
             report,
         } = self.judged(period, outcome, start)?;
@@ -138,10 +142,18 @@ impl Walker<'_> {
             period,
             energy,
             label,
-            jacobian: PseudoInverse::of_monodromy(&monodromy)?,
+            jacobian: inverse,
         };
         Ok((orbit, exact))
     }
+}
+
+/// `(a(), b())`, on rayon's pool with the `parallel` feature.
+fn both<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
+    #[cfg(feature = "parallel")]
+    return rayon::join(a, b);
+    #[cfg(not(feature = "parallel"))]
+    (a(), b())
 }
 
 /// The smallest gap of `state`'s unilateral conditions relative to their laws' gaps (`inf`

@@ -18,6 +18,12 @@ use crate::verify::State;
 /// The smallest trust radius of a continued point's corrector, relative to the state.
 const TRUST: f64 = 1e-2;
 
+/// The trust radius of a seed's corrector, relative to the harmonic-balance state: its
+/// strain's Gibbs oscillation puts it up to about a fifth of its norm from the orbit (the
+/// free–free bar between walls at `m = 20`), and longer steps along the small singular
+/// values of `M - I` lead to other orbits.
+const SEED_TRUST: f64 = 0.25;
+
 /// A harmonic-balance point's state at `t = 0` on the branch's grid, and its label.
 pub(crate) struct Seed {
     pub state: State,
@@ -203,7 +209,7 @@ impl Walker<'_> {
             refreshes: stability.corrections,
             relative_step: stability.relative_step,
             tolerance: crate::stability::PERIODIC_DEFECT,
-            max_step: f64::INFINITY,
+            max_step: SEED_TRUST * norm(&base),
         };
         let map = self.map(period);
         let outcome = correct(&map, &base, &mut None, &limits).map_err(LossReason::Error)?;

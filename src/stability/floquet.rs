@@ -104,7 +104,8 @@ pub struct Floquet {
     /// Stable when every multiplier lies within
     /// [`StabilityOptions::tolerance`](super::StabilityOptions::tolerance) of the unit circle
     /// or inside it, unresolved when the state is not a periodic orbit near the point or the
-    /// trivial pair is not found.
+    /// trivial pair is not found (and not explained by the grid's damping,
+    /// [`Floquet::damping`]).
     pub verdict: Verdict,
     /// Why the verdict is [`Verdict::Unresolved`]: `Some` exactly then.
     pub unresolved: Option<UnresolvedReason>,
@@ -119,9 +120,18 @@ pub struct Floquet {
     /// (Wilkinson's estimate of the distance to a double eigenvalue, within a factor 2; see the
     /// [module docs](super#the-trivial-pair)). The pair is found when this is within the
     /// tolerance: the error that splits it is then no larger than the error the verdict
-    /// allows every other multiplier. `None` where the pair lies within the tolerance, or
-    /// where the state is not periodic.
+    /// allows every other multiplier. `None` where the pair lies within the tolerance, where
+    /// the state is not periodic, or where the grid's damping explains the miss
+    /// ([`Floquet::damping`]).
     pub trivial_perturbation: Option<f64>,
+    /// Where the trivial pair is missed only because the grid damps the directions next to
+    /// the time shift (a period of an odd number of steps; see the
+    /// [module docs](super#the-trivial-pair)): `1 - |mu|` of the multiplier nearest 1 after
+    /// the time shift, at most
+    /// [`StabilityOptions::max_damping`](super::StabilityOptions::max_damping). The verdict
+    /// is then stable (nothing lies outside the circle) for growth faster than this per
+    /// period; slower growth would be hidden. `None` where the pair is found.
+    pub damping: Option<f64>,
     /// Rows of the monodromy matrix.
     pub dimension: usize,
     /// The time step of the grid.
@@ -316,6 +326,24 @@ fn snap_trivial_pair(multipliers: &mut [Multiplier]) {
     }
 }
 
+/// The grid's damping of the neutral directions, where it is all that keeps the trivial pair
+/// from 1: the multiplier nearest 1 (the time shift) lies within `tolerance` of it, the next
+/// lies inside the circle, and none lies outside `1 + tolerance`. Then `1 - |mu_2|`.
+///
+/// On a period of an odd number of steps the grid damps the family direction and the waves
+/// near it (the clamped bar's `T = 3.945` at 200 cells: the time shift at `1 - 2e-5`, then
+/// `0.978`, `0.976 +- 0.019 i`, ...), where a period of an even number of steps keeps them on
+/// the circle. The damping is the grid's error near 1: growth slower than it would not show,
+/// so a stable verdict stands for growth faster than it.
+pub(crate) fn grid_damping(multipliers: &[Multiplier], tolerance: f64) -> Option<f64> {
+    let order = nearest_one(multipliers);
+    let (&shift, &next) = (order.first()?, order.get(1)?);
+    let outside = multipliers.iter().any(|mu| mu.modulus() > 1.0 + tolerance);
+    let inward = multipliers[next].modulus() < 1.0;
+    (multipliers[shift].distance_to_one() <= tolerance && inward && !outside)
+        .then(|| 1.0 - multipliers[next].modulus())
+}
+
 /// The size of the map whose multipliers are judged: rows of the matrix, time step, period.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct MapShape {
@@ -330,22 +358,31 @@ pub(crate) struct MapShape {
 /// verdict is resolved only when the correction counts and the trivial pair is found: where
 /// the differences cannot find it, they are not accurate enough for the others either (an
 /// event whose timing is singular, such as a grazing impact).
+///
+/// A pair missed only inward, by at most `max_damping`, is the grid's damping
+/// ([`grid_damping`]): the verdict is then stable where nothing lies outside the circle, and
+/// [`Floquet::damping`] says by how much the grid damps.
 pub(crate) fn verdict(
     mut multipliers: Vec<Multiplier>,
-    tolerance: f64,
+    (tolerance, max_damping): (f64, f64),
     pair: TrivialPair,
     failure: Option<UnresolvedReason>,
     corrected: &Corrected,
     shape: MapShape,
 ) -> Floquet {
+    let found = pair.found(tolerance);
+    let damping = match (&failure, found) {
+        (None, false) => grid_damping(&multipliers, tolerance).filter(|d| *d <= max_damping),
+        _ => None,
+    };
     let unresolved = failure.or_else(|| {
-        (!pair.found(tolerance)).then(|| UnresolvedReason::TrivialPairMissing {
+        (!found && damping.is_none()).then(|| UnresolvedReason::TrivialPairMissing {
             distance: pair.distance,
             perturbation: pair.perturbation.unwrap_or(pair.distance),
             tolerance,
         })
     });
-    if unresolved.is_none() {
+    if found && unresolved.is_none() {
         snap_trivial_pair(&mut multipliers);
     }
     let max_modulus = multipliers.first().map_or(0.0, Multiplier::modulus);
@@ -374,6 +411,7 @@ pub(crate) fn verdict(
         unresolved,
         trivial_distance: pair.distance,
         trivial_perturbation: pair.perturbation,
+        damping,
         dimension: shape.dimension,
         dt: shape.dt,
         initial_defect: corrected.initial_defect,
@@ -596,6 +634,44 @@ mod tests {
         period: 3.5,
     };
 
+    /// A pair missed only inward is the grid's damping up to the bound: stable, with the
+    /// damping said; a multiplier outside the circle, a damping over the bound or a time shift
+    /// that is not found leave the point unresolved.
+    #[test]
+    fn a_pair_damped_by_the_grid_is_said_and_bounded() {
+        let judged = |pair: [[f64; 2]; 2], phases: &[f64], scale: f64, max_damping: f64| {
+            let mut m = monodromy(pair, phases);
+            for i in 2..m.nrows() {
+                for j in 2..m.ncols() {
+                    m[(i, j)] *= scale;
+                }
+            }
+            let multipliers = eigenvalues(&m).unwrap();
+            let pair = pair_of(&m, 1e-3);
+            verdict(
+                multipliers,
+                (1e-3, max_damping),
+                pair,
+                None,
+                &corrected(),
+                SHAPE,
+            )
+        };
+        let damped = [[1.0, 0.0], [0.0, 0.97]];
+        let f = judged(damped, &[0.5, 1.5], 0.98, 0.1);
+        assert_eq!((f.verdict, f.unresolved), (Verdict::Stable, None), "{f:?}");
+        assert!((f.damping.unwrap() - 0.03).abs() < 1e-9, "{f:?}");
+        for (pair, scale, bound) in [
+            (damped, 1.01, 0.1),
+            (damped, 0.98, 0.01),
+            ([[1.0 + 2e-3, 0.0], [0.0, 0.97]], 0.98, 0.1),
+        ] {
+            let f = judged(pair, &[0.5], scale, bound);
+            assert_eq!(f.verdict, Verdict::Unresolved, "{pair:?} {scale} {bound}");
+            assert!(f.damping.is_none());
+        }
+    }
+
     /// A failed correction is the reason, whatever the pair; a found pair is set to 1 and the
     /// verdict follows from the others; a missing pair is the reason, with its numbers.
     #[test]
@@ -609,7 +685,7 @@ mod tests {
         };
         let f = verdict(
             multipliers.clone(),
-            1e-3,
+            (1e-3, 0.1),
             pair,
             Some(failure),
             &corrected(),
@@ -620,13 +696,20 @@ mod tests {
             (Verdict::Unresolved, Some(failure))
         );
 
-        let f = verdict(multipliers.clone(), 1e-3, pair, None, &corrected(), SHAPE);
+        let f = verdict(
+            multipliers.clone(),
+            (1e-3, 0.1),
+            pair,
+            None,
+            &corrected(),
+            SHAPE,
+        );
         assert_eq!((f.verdict, f.unresolved), (Verdict::Stable, None), "{f:?}");
         assert_eq!(f.max_multiplier, 1.0);
         assert_eq!(f.multipliers.iter().filter(|mu| mu.re == 1.0).count(), 2);
 
         let pair = pair_of(&m, 1e-5);
-        let f = verdict(multipliers, 1e-5, pair, None, &corrected(), SHAPE);
+        let f = verdict(multipliers, (1e-5, 0.1), pair, None, &corrected(), SHAPE);
         let Some(UnresolvedReason::TrivialPairMissing {
             distance,
             perturbation,

@@ -62,12 +62,15 @@ pub(crate) fn judge(
     let assess = |monodromy: &Monodromy| -> Result<(Vec<Multiplier>, TrivialPair), StabilityError> {
         let mut multipliers = floquet::eigenvalues(monodromy)?;
         floquet::remove_nearest_one(&mut multipliers, spurious);
+        // A miss the grid's damping explains needs no perturbation (an eigenvector problem).
+        let damped = floquet::grid_damping(&multipliers, options.tolerance)
+            .is_some_and(|d| d <= options.max_damping);
         let pair = floquet::trivial_pair(
             monodromy,
             &multipliers,
             spurious,
             options.tolerance,
-            periodic,
+            periodic && !damped,
         )?;
         Ok((multipliers, pair))
     };
@@ -94,7 +97,7 @@ pub(crate) fn judge(
     };
     finite(floquet::verdict(
         multipliers,
-        options.tolerance,
+        (options.tolerance, options.max_damping),
         pair,
         failure,
         corrected,

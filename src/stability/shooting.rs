@@ -11,8 +11,16 @@ use faer::Mat;
 /// inverted. Their directions are those `M - I` (nearly) annihilates besides the time shift:
 /// the family direction, and waves that free flight carries back onto themselves over the
 /// period (on a commensurate grid, every wave whose period divides it). Moving along them
-/// does not reduce the defect; it changes the motion.
-const SINGULAR_CUTOFF: f64 = 1e-4;
+/// does not reduce the defect; it changes the motion. Their singular values are the
+/// differences' error, the marches' rounding over the step (`1e-14 / 1e-4 = 1e-10` of the
+/// largest); a direction the map only weakly couples is real and must be inverted (the
+/// free–free bar between walls stalls at a defect of `2.4e-6` with a cutoff of `1e-4`, and
+/// converges with this one).
+const SINGULAR_CUTOFF: f64 = 1e-7;
+
+/// Singular values below this fraction of the largest are rounding: the directions `M - I`
+/// annihilates exactly (the time shift, and the exact invariants of the coordinates).
+const NUMERICAL_RANK: f64 = 1e-12;
 
 /// A state corrected towards `P(X) = X`.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,8 +48,10 @@ pub(crate) struct Corrected {
 pub(crate) struct PseudoInverse {
     u: faer::Mat<f64>,
     v: faer::Mat<f64>,
-    /// The inverted singular values (those above the cutoff).
+    /// The singular values above rounding ([`NUMERICAL_RANK`]).
     s: Vec<f64>,
+    /// The largest singular value.
+    largest: f64,
 }
 
 impl Corrected {
@@ -75,13 +85,77 @@ impl PseudoInverse {
         let (u, s, v) = (svd.U(), svd.S(), svd.V());
         let largest = (0..s.dim()).map(|k| s[k]).fold(0.0, f64::max);
         let kept: Vec<usize> = (0..s.dim())
-            .filter(|&k| s[k] > SINGULAR_CUTOFF * largest)
+            .filter(|&k| s[k] > NUMERICAL_RANK * largest)
             .collect();
         Ok(Self {
             u: Mat::from_fn(a.nrows(), kept.len(), |i, k| u[(i, kept[k])]),
             v: Mat::from_fn(a.ncols(), kept.len(), |j, k| v[(j, kept[k])]),
             s: kept.iter().map(|&k| s[k]).collect(),
+            largest,
         })
+    }
+
+    /// `u_k . b` for every kept singular value.
+    fn coefficients(&self, b: &[f64]) -> Vec<f64> {
+        (0..self.s.len())
+            .map(|k| (0..self.u.nrows()).map(|i| self.u[(i, k)] * b[i]).sum())
+            .collect()
+    }
+
+    /// `sum_k w_k v_k`.
+    fn combine(&self, weights: &[f64]) -> Vec<f64> {
+        let mut d = vec![0.0; self.v.nrows()];
+        for (k, w) in weights.iter().enumerate() {
+            for (j, dj) in d.iter_mut().enumerate() {
+                *dj += w * self.v[(j, k)];
+            }
+        }
+        d
+    }
+
+    /// The Levenberg–Marquardt step of `a d = b` within `radius`: the minimum-norm solution
+    /// over every singular value where it is no longer than `radius`, otherwise
+    /// `d(mu) = sum_k s_k (u_k . b) / (s_k^2 + mu^2) v_k` with `|d(mu)| = radius`. The
+    /// damping `mu` shortens the step along the small singular values first: near a
+    /// periodic orbit `M - I` has a continuum of them (the waves whose multipliers lie near
+    /// 1), with no gap below which a direction could be called null, so a fixed cutoff
+    /// either drops directions the correction needs or takes long steps along them.
+    pub(crate) fn solve_within(&self, b: &[f64], radius: f64) -> Vec<f64> {
+        let c = self.coefficients(b);
+        let length = |mu: f64| -> f64 {
+            self.s
+                .iter()
+                .zip(&c)
+                .map(|(s, c)| (s * c / (s * s + mu * mu)).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let mu = if length(0.0) <= radius || !radius.is_finite() {
+            0.0
+        } else {
+            // `|d(mu)|` falls from `|d(0)| > radius` to 0: bisect on a log scale between
+            // rounding of the smallest kept value and far above the largest.
+            let (mut low, mut high) = (NUMERICAL_RANK * self.largest, 1e8 * self.largest);
+            for _ in 0..100 {
+                let mid = (low * high).sqrt();
+                if length(mid) > radius {
+                    low = mid;
+                } else {
+                    high = mid;
+                }
+                if high <= low * (1.0 + 1e-6) {
+                    break;
+                }
+            }
+            high
+        };
+        let weights: Vec<f64> = self
+            .s
+            .iter()
+            .zip(&c)
+            .map(|(s, c)| s * c / (s * s + mu * mu))
+            .collect();
+        self.combine(&weights)
     }
 
     /// `M - I` of a monodromy, pseudo-inverted.
@@ -93,19 +167,21 @@ impl PseudoInverse {
         }))
     }
 
-    /// The minimum-norm `d` of `a d = b` over the kept singular values.
+    /// The minimum-norm `d` of `a d = b` over the singular values above [`SINGULAR_CUTOFF`].
     pub(crate) fn solve(&self, b: &[f64]) -> Vec<f64> {
-        let mut d = vec![0.0; self.v.nrows()];
-        for (k, s) in self.s.iter().enumerate() {
-            let c = (0..self.u.nrows())
-                .map(|i| self.u[(i, k)] * b[i])
-                .sum::<f64>()
-                / s;
-            for (j, dj) in d.iter_mut().enumerate() {
-                *dj += c * self.v[(j, k)];
-            }
-        }
-        d
+        let weights: Vec<f64> = self
+            .s
+            .iter()
+            .zip(self.coefficients(b))
+            .map(|(s, c)| {
+                if *s > SINGULAR_CUTOFF * self.largest {
+                    c / s
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        self.combine(&weights)
     }
 }
 
@@ -200,5 +276,42 @@ impl PeriodMap<'_> {
             )?;
         }
         Ok((best, latest, at_base))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `diag(1, 1e-3, 0)`: within a long radius the step is the minimum-norm solution over
+    /// the two non-zero singular values; within a short one it has the radius' length, and
+    /// the small singular value's component is cut more than the large one's.
+    #[test]
+    fn the_step_within_a_radius_damps_small_singular_values_first() {
+        let a = Mat::<f64>::from_fn(3, 3, |i, j| match (i, j) {
+            (0, 0) => 1.0,
+            (1, 1) => 1e-3,
+            _ => 0.0,
+        });
+        let inverse = PseudoInverse::new(&a).unwrap();
+        let b = [1.0, 1e-3, 5.0];
+        let full = inverse.solve_within(&b, 10.0);
+        for (d, expected) in full.iter().zip([1.0, 1.0, 0.0]) {
+            assert!((d - expected).abs() < 1e-12, "{full:?}");
+        }
+        let short = inverse.solve_within(&b, 0.5);
+        assert!((norm(&short) - 0.5).abs() < 1e-5, "{short:?}");
+        assert!(
+            short[1].abs() < short[0].abs() && short[2] == 0.0,
+            "{short:?}"
+        );
+        // Below the cutoff, the minimum-norm solve drops a singular value instead.
+        let tiny = Mat::<f64>::from_fn(2, 2, |i, j| match (i, j) {
+            (0, 0) => 1.0,
+            (1, 1) => 1e-9,
+            _ => 0.0,
+        });
+        let cut = PseudoInverse::new(&tiny).unwrap().solve(&[1.0, 1e-9]);
+        assert!((cut[0] - 1.0).abs() < 1e-12 && cut[1] == 0.0, "{cut:?}");
     }
 }

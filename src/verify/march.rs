@@ -93,6 +93,18 @@ pub struct Integrator {
     options: MarchOptions,
     incoming: Vec<Vec<Piece>>,
     outgoing: Vec<Vec<(f64, f64)>>,
+    /// The last step's mean end strains and contact forces: kept here so that a march that
+    /// does not record them allocates nothing per step.
+    end_strain: Vec<[f64; 2]>,
+    contact_force: Vec<f64>,
+}
+
+/// The numbers of one step that are not kept in the integrator's buffers.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct StepScalars {
+    min_contact_force: f64,
+    max_penetration: f64,
+    projected_energy: f64,
 }
 
 /// One end of a condition during a step.
@@ -199,6 +211,8 @@ impl Integrator {
             options,
             incoming: vec![Vec::new(), Vec::new()],
             outgoing: vec![Vec::new(), Vec::new()],
+            end_strain: Vec::new(),
+            contact_force: Vec::new(),
         }
     }
 
@@ -231,15 +245,35 @@ impl Integrator {
         Ok(self.advance_unchecked(fraction))
     }
 
+    /// A partial step of `fraction * dt` (`0 < fraction <= 1`), with its summary.
     pub(super) fn advance_unchecked(&mut self, fraction: f64) -> StepSummary {
+        let scalars = self.advance_quietly(fraction);
+        StepSummary {
+            time: self.state.time(),
+            duration: fraction * self.state.grid.dt(),
+            end_strain: self.end_strain.clone(),
+            contact_force: self.contact_force.clone(),
+            min_contact_force: scalars.min_contact_force,
+            max_penetration: scalars.max_penetration,
+            projected_energy: scalars.projected_energy,
+        }
+    }
+
+    /// A partial step of `fraction * dt` (`0 < fraction <= 1`); its end strains and contact
+    /// forces are left in the integrator's buffers.
+    pub(super) fn advance_quietly(&mut self, fraction: f64) -> StepScalars {
         let projected_before = self.state.projected_energy();
         let s0 = self.state.clock;
         let s1 = s0 + fraction;
         let dt = self.state.grid.dt();
         let nb = self.state.bars.len();
-        let mut end_strain = vec![[0.0; 2]; nb];
+        let mut end_strain = std::mem::take(&mut self.end_strain);
+        end_strain.clear();
+        end_strain.resize(nb, [0.0; 2]);
         let count = self.state.model.conditions().len();
-        let mut contact_force = vec![0.0; count];
+        let mut contact_force = std::mem::take(&mut self.contact_force);
+        contact_force.clear();
+        contact_force.resize(count, 0.0);
         let mut min_force = f64::INFINITY;
         let mut penetration: f64 = 0.0;
         for (ci, force) in contact_force.iter_mut().enumerate() {
@@ -441,11 +475,8 @@ impl Integrator {
             }
         }
         self.state.clock = s1;
-        StepSummary {
-            time: self.state.time(),
-            duration: fraction * dt,
-            end_strain,
-            contact_force,
+        (self.end_strain, self.contact_force) = (end_strain, contact_force);
+        StepScalars {
             min_contact_force: min_force,
             max_penetration: penetration,
             projected_energy: self.state.projected_energy() - projected_before,
