@@ -2,7 +2,7 @@
 //! branches against their exact families, verdicts against the grid and the gap, and bad
 //! input. Checks that can fail: the families are closed forms, not recorded results.
 
-use nonsmooth_modes::branches::{BackboneOptions, Method, PeriodGrid, Request};
+use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
 use nonsmooth_modes::exact::{exact_branch, ExactBranch, ExactEnd, ExactOptions};
 use nonsmooth_modes::io::assembly::Assembly;
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
@@ -176,6 +176,31 @@ fn verdicts_do_not_depend_on_the_grid() {
     assert!(!both.is_empty());
     let agree = both.iter().filter(|(v, w)| v == w).count();
     assert!(agree as f64 >= 0.95 * both.len() as f64, "{both:?}");
+}
+
+/// The request's exact branch is `exact_branch`'s, beside the harmonic-balance points it was
+/// seeded from; bad options are refused before anything runs.
+#[test]
+fn the_request_carries_the_exact_branch() {
+    let system = clamped_bar_with_obstacle(1e-3).unwrap();
+    let base = request(&system, 3.90, 3.88, 5);
+    let alone = exact_branch(&system, &base, &options(100.0)).unwrap();
+    let run = compute(&system, &base.clone().with_exact(options(100.0))).unwrap();
+    assert_eq!(run.points.len(), 5);
+    match run.exact {
+        Some(Ok(exact)) => assert_eq!(exact, alone),
+        other => panic!("{other:?}"),
+    }
+    let bad = ExactOptions {
+        max_lost: 0,
+        ..ExactOptions::default()
+    };
+    match compute(&system, &base.with_exact(bad)) {
+        Err(Error::Stability(StabilityError::InvalidOption { what, .. })) => {
+            assert_eq!(what, "max_lost")
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 /// Bad input is a typed error before anything runs; a seed that cannot be corrected is a

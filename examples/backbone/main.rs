@@ -76,7 +76,7 @@
 //! `stability-gained`. Period and energy runs only; empty cells for `--parameter` runs.
 //!
 //! `--exact` runs the harmonic-balance branch of the flags (its rows not written), then the
-//! exact branch seeded by it over the same period grid (`exact::exact_branch_from`: periodic
+//! exact branch seeded by it over the same period grid (`Request::with_exact`: periodic
 //! orbits of the integrator's one-period map, continued in the period) and writes one row per
 //! exact point, in the same columns with the stability columns always present: `iterations`
 //! and `residual_norm` are the corrector's steps and the orbit's periodicity defect, `label`

@@ -11,7 +11,7 @@ use nonsmooth_modes::branches::{
     PeriodGrid, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::{linspace, ArclengthOptions, SequentialOptions, Speculation};
-use nonsmooth_modes::exact::{exact_branch_from, ExactOptions};
+use nonsmooth_modes::exact::ExactOptions;
 use nonsmooth_modes::solve::{Dogleg, NewtonOptions, SemismoothNewton, Solver};
 use nonsmooth_modes::stability::{HillOptions, StabilityOptions};
 use nonsmooth_modes::system::{BarSystem, NonsmoothSystem};
@@ -119,22 +119,15 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
     Ok((sink.total, sink.converged))
 }
 
-/// `--exact`: the harmonic-balance run of `request` (its rows not written), then the exact
-/// branch seeded by it over the same period grid, one row per exact point.
+/// `--exact`: the request with its exact branch ([`Request::with_exact`]): the
+/// harmonic-balance run (its rows not written), then the exact branch seeded by it over the
+/// same period grid, one row per exact point.
 fn run_exact(
     a: &Args,
     system: &BarSystem,
     request: &Request,
     sink: &mut Sink<'_>,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let grid = match request.method {
-        Method::Auto(Some(o)) | Method::PeriodGrid(o) | Method::GenuineSubharmonic(o) => o.grid,
-        _ => BackboneOptions::for_mode(system, a.mode, a.subharmonic)?.grid,
-    };
-    let harmonic_balance = Request {
-        stability: None,
-        ..request.clone()
-    };
     let options = ExactOptions {
         stability: StabilityOptions {
             cells_per_travel: (a.cells_per_travel)
@@ -143,9 +136,17 @@ fn run_exact(
         },
         ..ExactOptions::default()
     };
+    let exact = Request {
+        stability: None,
+        ..request.clone()
+    }
+    .with_exact(options);
     let start = std::time::Instant::now();
-    let run = compute(system, &harmonic_balance)?;
-    let branch = exact_branch_from(&run, &grid, &options)?;
+    let run = compute(system, &exact)?;
+    let Some(branch) = run.exact else {
+        return Err("the run returned no exact branch".into());
+    };
+    let branch = branch?;
     let mut problem = NonsmoothSystem::new(system, a.settings)?;
     for p in &branch.points {
         if sink.exact_row(&mut problem, p).is_break() {

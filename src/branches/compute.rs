@@ -7,6 +7,7 @@ use crate::branches::request::Request;
 use crate::branches::result::{Annotator, ModeBranches};
 use crate::branches::selected::judged_with_selection;
 use crate::error::{Error, SettingsError};
+use crate::exact::from_run::{exact_branch_from, period_grid};
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::ops::ControlFlow;
 
@@ -121,6 +122,12 @@ pub fn compute_observed(
         }
     }
     request.method.validate_grid()?;
+    if let Some(options) = &request.exact {
+        period_grid(system, request)?
+            .validate()
+            .map_err(SettingsError::from)?;
+        options.check()?;
+    }
     let problem = NonsmoothSystem::new(system, request.settings)?;
     let (plan, method) = match asked(request) {
         Ok(planned) => planned,
@@ -132,13 +139,24 @@ pub fn compute_observed(
             let end = annotator.replay(run.points, run.end);
             let mut result = annotator.finish((method, auto), run.e_g, end, run.rejected);
             result.selection = selection;
-            return Ok(result);
+            return Ok(with_exact(system, request, result));
         }
     };
     let mut annotator = Annotator::new(problem, request, observer);
     let solver = request.solver_for(&method)?;
     let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
-    Ok(annotator.finish((method, None), e_g, end, rejected))
+    let result = annotator.finish((method, None), e_g, end, rejected);
+    Ok(with_exact(system, request, result))
+}
+
+/// `result` with the exact branch [`Request::exact`] asks for, continued from its points.
+fn with_exact(system: &BarSystem, request: &Request, mut result: ModeBranches) -> ModeBranches {
+    if let Some(options) = &request.exact {
+        let branch = period_grid(system, request)
+            .and_then(|grid| exact_branch_from(&result, &grid, options));
+        result.exact = Some(branch);
+    }
+    result
 }
 
 #[cfg(test)]

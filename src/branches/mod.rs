@@ -4,8 +4,8 @@
 //! what a run returns.
 
 mod auto;
-mod backbone;
-mod compute;
+pub(crate) mod backbone;
+pub(crate) mod compute;
 mod continuity;
 mod convergence;
 mod defaults;
@@ -19,9 +19,9 @@ mod level;
 mod lift;
 mod parameter;
 mod plan;
-mod point;
-mod request;
-mod result;
+pub(crate) mod point;
+pub(crate) mod request;
+pub(crate) mod result;
 mod selected;
 mod start;
 mod subharmonic;

@@ -8,6 +8,7 @@ use crate::branches::energy_backbone::EnergyBackboneOptions;
 use crate::branches::switch::SwitchAt;
 use crate::continuation::Speculation;
 use crate::error::{BadRange, SolveError};
+use crate::exact::options::ExactOptions;
 use crate::solve::{NewtonOptions, SemismoothNewton, Solver};
 use crate::stability::{HillOptions, StabilityOptions};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
@@ -246,6 +247,12 @@ pub struct Request {
     /// Compute the Hill exponents of every converged point ([`hill`](fn@crate::stability::hill);
     /// `None`: none), as a cross-check of [`Request::stability`].
     pub hill: Option<HillOptions>,
+    /// Continue the exact periodic orbits of the time-domain integrator's one-period map
+    /// over the period grid, seeded by the harmonic-balance points, with a Floquet verdict at
+    /// every point ([`exact`](crate::exact); `None`: none). The result is
+    /// [`ModeBranches::exact`](crate::branches::ModeBranches::exact), beside the
+    /// harmonic-balance points it was seeded from.
+    pub exact: Option<ExactOptions>,
 }
 
 impl Request {
@@ -263,6 +270,7 @@ impl Request {
             check: None,
             stability: None,
             hill: None,
+            exact: None,
         }
     }
 
@@ -321,6 +329,13 @@ impl Request {
     /// `options` ([`StabilityOptions::default`] for the usual grid and tolerance).
     pub fn with_stability(mut self, options: StabilityOptions) -> Self {
         self.stability = Some(options);
+        self
+    }
+
+    /// The same request with the exact branch of the mode over its period grid, computed
+    /// with `options` ([`ExactOptions::default`] for the usual grid and tolerance).
+    pub fn with_exact(mut self, options: ExactOptions) -> Self {
+        self.exact = Some(options);
         self
     }
 

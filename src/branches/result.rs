@@ -7,7 +7,8 @@ use crate::branches::judge::check_point;
 use crate::branches::point::{BackbonePoint, CheckOutcome};
 use crate::branches::request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 use crate::continuation::{EndReason, Event, Rejection};
-use crate::error::{ContinuationError, SettingsError};
+use crate::error::{ContinuationError, Error, SettingsError};
+use crate::exact::types::ExactBranch;
 use crate::fourier::{Basis, CosineBasis};
 use crate::modal::linear::{natural_frequency_values, Resolution};
 use crate::modal::{character, label, nearest_mode, ContactState, Label};
@@ -42,6 +43,10 @@ pub struct ModeBranches {
     /// own, or a subharmonic order). The equations the points solve are
     /// [`ModeBranches::problem`]'s ([`NonsmoothSystem::resonance_band`](crate::system::NonsmoothSystem::resonance_band)).
     pub selection: Option<SelectionJudgement>,
+    /// The exact branch [`Request::exact`] asked for, continued from these points (`None`
+    /// where it was not asked). An error computing it keeps the harmonic-balance points: it
+    /// is stored here, not returned.
+    pub exact: Option<Result<ExactBranch, Error>>,
 }
 
 impl ModeBranches {
@@ -412,6 +417,7 @@ impl<O: BackboneObserver> Annotator<O> {
             rejected_steps,
             end,
             selection: None,
+            exact: None,
         }
     }
 }

@@ -10,6 +10,34 @@
 //! exact orbit itself: each point starts from the previous exact orbit, so the corrector
 //! starts within the step's change of the motion, not within the truncation's error.
 //!
+//! # Through the request
+//!
+//! [`Request::with_exact`](crate::branches::Request::with_exact) asks
+//! [`compute`](crate::branches::compute) for the exact branch of the run's mode over its period
+//! grid: the harmonic-balance points come first (they seed it), and the branch is
+//! [`ModeBranches::exact`](crate::branches::ModeBranches::exact), beside them. A refinement
+//! of the request rather than a method of its own, because it needs a harmonic-balance run
+//! (any method) to seed it, and because the two answers are worth comparing point by point
+//! ([`ExactPoint::harmonic_balance_distance`]). Its points are [`BackbonePoint`]s
+//! ([`ExactPoint::point`]), so what reads a backbone reads them. [`exact_branch`] gives the
+//! branch alone, [`exact_branch_from`] from a run already there.
+//!
+//! ```no_run
+//! use nonsmooth_modes::branches::{compute, Request};
+//! use nonsmooth_modes::exact::ExactOptions;
+//! use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+//!
+//! let system = clamped_bar_with_obstacle(1e-3)?;
+//! let run = compute(&system, &Request::new(1).with_exact(ExactOptions::default()))?;
+//! if let Some(Ok(exact)) = &run.exact {
+//!     for p in &exact.points {
+//!         let verdict = p.point.stability.as_ref().map(|s| s.as_ref().map(|f| f.verdict));
+//!         println!("T = {}: E/E_g = {}, {verdict:?}", p.point.period, p.point.energy_normalized);
+//!     }
+//! }
+//! # Ok::<(), nonsmooth_modes::Error>(())
+//! ```
+//!
 //! # The map and its grid
 //!
 //! The map is [`stability`](crate::stability)'s `P_T: X(0) -> X(T)` in the same coordinates
@@ -87,38 +115,30 @@
 //! correction (several monodromies).
 
 mod corrector;
+pub(crate) mod from_run;
 mod grid;
+pub(crate) mod options;
 mod point;
-mod types;
+pub(crate) mod types;
 mod walk;
 
-pub use types::{ExactBranch, ExactEnd, ExactOptions, ExactPoint, LossReason, Skipped};
+pub use from_run::exact_branch_from;
+pub(crate) use from_run::period_grid;
+pub use options::ExactOptions;
+pub use types::{ExactBranch, ExactEnd, ExactPoint, LossReason, Skipped};
 
-use crate::branches::{
-    compute, BackboneOptions, BackbonePoint, Method, ModeBranches, PeriodGrid, Request,
-};
-use crate::continuation::linspace;
+use crate::branches::{compute, Request};
 use crate::error::{Error, SettingsError};
-use crate::stability::{StabilityError, MAX_MARCH_STEPS};
 use crate::system::BarSystem;
-use crate::verify::{Model, State};
-use walk::{Seed, Walker};
 
-/// The period grid of `request`: its method's, or the system's default for the mode
-/// ([`BackboneOptions::for_mode`]) where the method carries none (arclength, energy).
-fn period_grid(system: &BarSystem, request: &Request) -> Result<PeriodGrid, Error> {
-    Ok(match request.method {
-        Method::Auto(Some(o)) | Method::PeriodGrid(o) | Method::GenuineSubharmonic(o) => o.grid,
-        _ => BackboneOptions::for_mode(system, request.mode, request.subharmonic)?.grid,
-    })
-}
-
-/// The exact branch of `request`'s mode over its period grid: the harmonic-balance run of
-/// `request` ([`compute`], without its stability and Hill exponents), then
-/// [`exact_branch_from`] it.
+/// The exact branch of `request`'s mode over its period grid, alone: the harmonic-balance run
+/// of `request` ([`compute`], without its stability, Hill exponents and exact branch), then
+/// [`exact_branch_from`] it. [`Request::with_exact`] asks [`compute`] for the same branch
+/// beside the harmonic-balance points.
 ///
 /// # Errors
-/// A bad grid ([`SettingsError::Range`]) or options ([`StabilityError::InvalidOption`])
+/// A bad grid ([`SettingsError::Range`]) or options
+/// ([`StabilityError::InvalidOption`](crate::stability::StabilityError::InvalidOption))
 /// before anything is computed; those of [`compute`]; those of [`exact_branch_from`].
 pub fn exact_branch(
     system: &BarSystem,
@@ -131,94 +151,8 @@ pub fn exact_branch(
     let harmonic_balance = Request {
         stability: None,
         hill: None,
+        exact: None,
         ..request.clone()
     };
     exact_branch_from(&compute(system, &harmonic_balance)?, &grid, options)
-}
-
-/// The exact branch over `grid`, seeded by the converged points of the harmonic-balance run
-/// `run` (the point nearest each grid period, within half a step). See the
-/// [module docs](self).
-///
-/// # Errors
-/// [`SettingsError::Range`] for a bad grid; [`StabilityError::InvalidOption`] for bad
-/// options; [`StabilityError::TooLarge`] and [`StabilityError::TooCostly`] for a grid whose
-/// matrices or marches exceed the limits of [`stability`](crate::stability);
-/// [`VerifyError`](crate::verify::VerifyError) for a system the integrator cannot march.
-/// A seed or a point that fails is no error: the branch says why
-/// ([`ExactBranch::end`], [`ExactBranch::skipped`]).
-pub fn exact_branch_from(
-    run: &ModeBranches,
-    grid: &PeriodGrid,
-    options: &ExactOptions,
-) -> Result<ExactBranch, Error> {
-    grid.validate().map_err(SettingsError::from)?;
-    options.check()?;
-    let requested = linspace(grid.start, grid.end, grid.steps)?;
-    let problem = run.problem();
-    let (system, basis) = (problem.system(), problem.basis());
-    let model = Model::from_system(system)?;
-    let branch = grid::branch_grid(&model, &requested, options.stability.cells_per_travel)?;
-    let dt = branch.grid.dt();
-    let coordinates = crate::stability::coordinates::Coordinates::new(&model, &branch.grid);
-    crate::stability::check_dimension(&coordinates, options.stability.cells_per_travel)?;
-    let longest = branch.periods.iter().fold(0.0f64, |m, t| m.max(*t));
-    let steps = 2.0
-        * coordinates.len() as f64
-        * (longest / dt).ceil()
-        * (2.0 + options.refreshes.max(options.stability.corrections) as f64);
-    if steps.is_nan() || steps > MAX_MARCH_STEPS {
-        return Err(StabilityError::TooCostly {
-            steps,
-            dimension: coordinates.len(),
-            corrections: options.refreshes.max(options.stability.corrections),
-            limit: MAX_MARCH_STEPS,
-        }
-        .into());
-    }
-    let half_step = 0.5 * (grid.end - grid.start).abs() / (grid.steps - 1) as f64;
-    let harmonic_balance: Vec<Option<&BackbonePoint>> = requested
-        .iter()
-        .map(|t| {
-            run.points
-                .iter()
-                .filter(|p| p.converged && (p.period - t).abs() <= half_step)
-                .min_by(|a, b| (a.period - t).abs().total_cmp(&(b.period - t).abs()))
-        })
-        .collect();
-    let seeds = |j: usize| -> Option<Result<Seed, StabilityError>> {
-        let p = harmonic_balance[j]?;
-        Some(
-            State::from_harmonic_balance(system, basis, &p.x, p.omega, 0.0, dt)
-                .map(|state| Seed {
-                    state,
-                    label: p.label.clone(),
-                })
-                .map_err(StabilityError::from),
-        )
-    };
-    // Any state of the grid: the map takes its model and grid.
-    let template = coordinates.to_state(&model, &branch.grid, &vec![0.0; coordinates.len()])?;
-    let walker = Walker {
-        coordinates: &coordinates,
-        template: &template,
-        periods: &branch.periods,
-        requested: &requested,
-        harmonic_balance: &harmonic_balance
-            .iter()
-            .map(|p| p.map(|p| p.energy))
-            .collect::<Vec<_>>(),
-        seeds: &seeds,
-        options,
-        grazing_energy: run.grazing_energy,
-    };
-    let (points, skipped, end) = walker.walk();
-    Ok(ExactBranch {
-        grazing_energy: run.grazing_energy,
-        dt,
-        dimension: coordinates.len(),
-        points,
-        skipped,
-        end,
-    })
 }

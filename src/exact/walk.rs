@@ -2,7 +2,8 @@
 //! verdict.
 
 use super::corrector::{correct, Limits, Outcome};
-use super::types::{ExactEnd, ExactOptions, ExactPoint, LossReason, Skipped};
+use super::options::ExactOptions;
+use super::types::{ExactEnd, ExactPoint, LossReason, Skipped};
 use crate::continuation::Event;
 use crate::modal::Label;
 use crate::solve::norm;
