@@ -25,7 +25,7 @@ pub(crate) fn period_grid(system: &BarSystem, request: &Request) -> Result<Perio
 
 /// The exact branch over `grid`, seeded by the converged points of the harmonic-balance run
 /// `run` (the point nearest each grid period, within half a step). See the
-/// [module docs](self).
+/// [module docs](crate::exact).
 ///
 /// # Errors
 /// [`SettingsError::Range`] for a bad grid; [`StabilityError::InvalidOption`] for bad

@@ -13,12 +13,12 @@
 //! # Through the request
 //!
 //! [`Request::with_exact`](crate::branches::Request::with_exact) asks
-//! [`compute`](crate::branches::compute) for the exact branch of the run's mode over its period
+//! [`compute`] for the exact branch of the run's mode over its period
 //! grid: the harmonic-balance points come first (they seed it), and the branch is
 //! [`ModeBranches::exact`](crate::branches::ModeBranches::exact), beside them. A refinement
 //! of the request rather than a method of its own, because it needs a harmonic-balance run
 //! (any method) to seed it, and because the two answers are worth comparing point by point
-//! ([`ExactPoint::harmonic_balance_distance`]). Its points are [`BackbonePoint`]s
+//! ([`ExactPoint::harmonic_balance_distance`]). Its points are [`BackbonePoint`](crate::branches::BackbonePoint)s
 //! ([`ExactPoint::point`]), so what reads a backbone reads them. [`exact_branch`] gives the
 //! branch alone, [`exact_branch_from`] from a run already there.
 //!
@@ -83,7 +83,7 @@
 //! matrix. If it still jumps, or the correction fails, a step over more than one step of the
 //! grid is **halved** (an orbit at the whole number of steps half-way, not reported, then on
 //! from it). Otherwise the branch is **lost** at that period and reseeded from the
-//! harmonic-balance point there (a new [`BackbonePoint::branch`] index and an
+//! harmonic-balance point there (a new [`BackbonePoint::branch`](crate::branches::BackbonePoint::branch) index and an
 //! [`Event::Jump`](crate::continuation::Event::Jump) on its first point); where that fails
 //! too, the period is skipped with its reason ([`ExactBranch::skipped`]).
 //!
