@@ -8,12 +8,15 @@
 //! - `stability_clamped.svg` and `.csv`: the clamped bar's first nonsmooth mode at `m = 20`
 //!   (the paper's equations, [`Method::PeriodGrid`] on the system's grid) with the Floquet verdict of
 //!   every converged point ([`nonsmooth_modes::stability`]): stable runs solid, unstable runs
-//!   dashed, points without a verdict hollow; the exact family, stable at every period
-//!   checked, as a black line; and the largest multiplier modulus of every point with a
-//!   verdict. CSV
+//!   dashed, points without a verdict hollow; its exact branch ([`Request::with_exact`]:
+//!   periodic orbits of the time-domain map continued from those points, with their
+//!   verdicts) drawn the same way; the exact family as a black line; and the largest
+//!   multiplier modulus of every harmonic-balance point with a verdict. CSV
 //!   columns `period,omega_normalized,energy_normalized,verdict,max_multiplier,
 //!   energy_correction` (`verdict`: 1 stable, -1 unstable, 0 unresolved, whose
-//!   `max_multiplier` is NaN).
+//!   `max_multiplier` is NaN); `stability_clamped_exact.csv` the exact branch's points,
+//!   columns `period,omega_normalized,energy_normalized,verdict,max_multiplier,damping`
+//!   (`damping`: the grid's, on periods of an odd number of steps; NaN elsewhere).
 //!
 //! - `not_even_clamped.svg` and `.csv`: a periodic motion of the clamped bar that is not
 //!   even in time, which the paper's cosine basis cannot hold. At `T = 3.089` (a period of
@@ -42,6 +45,7 @@ use nonsmooth_modes::branches::{
     symmetry_instant, with_harmonics, BackboneOptions, BackbonePoint, FullBasisPoint, Method,
     Request, TimeDomainCheck,
 };
+use nonsmooth_modes::exact::{ExactBranch, ExactOptions};
 use nonsmooth_modes::forced::{
     forced_response, Damping, Excitation, Forcing, ResponseMethod, ResponseRequest,
 };
@@ -78,11 +82,21 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
     };
     // The paper's equations: the points `docs/validation.md` ("Stability") discusses.
     let grid = BackboneOptions::for_mode(&system, 1, 1)?;
+    let exact_options = ExactOptions {
+        stability: options,
+        ..ExactOptions::default()
+    };
     let request = Request::new(1)
         .harmonics(20)
         .method(Method::PeriodGrid(grid))
-        .with_stability(options);
+        .with_stability(options)
+        .with_exact(exact_options);
     let result = compute(&system, &request)?;
+    let exact = match &result.exact {
+        Some(Ok(branch)) => branch.clone(),
+        Some(Err(e)) => return Err(e.clone().into()),
+        None => return Err("the run returned no exact branch".into()),
+    };
     // omega_1 = pi c / (2 l) for the clamped-free unit bar.
     let omega_1 = std::f64::consts::FRAC_PI_2;
     let points: Vec<&BackbonePoint> = result.converged().collect();
@@ -90,11 +104,25 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         .iter()
         .map(|p| (p.omega / omega_1, p.energy_normalized, stable(p)))
         .collect();
-    let exact = ClampedFamily::new(gap, 1)?.backbone(3.99, 3.04, 201);
-    let mut backbone = backbone_panel("E/E_g, m = 20", &[], None);
-    backbone.series = stability_series("NSM1", PALETTE[0], &marked);
+    let exact_marked: Vec<(f64, f64, Option<bool>)> = exact
+        .points
+        .iter()
+        .map(|p| {
+            (
+                p.point.omega / omega_1,
+                p.point.energy_normalized,
+                stable(&p.point),
+            )
+        })
+        .collect();
+    let family = ClampedFamily::new(gap, 1)?.backbone(3.99, 3.04, 201);
+    let mut backbone = backbone_panel("E/E_g", &[], None);
+    backbone.series = stability_series("NSM1, m = 20", PALETTE[0], &marked);
+    backbone
+        .series
+        .extend(stability_series("exact branch", PALETTE[1], &exact_marked));
     backbone.series.push(
-        Series::line("exact family (stable)", exact)
+        Series::line("exact family", family)
             .with_color(Rgb::BLACK)
             .with_size(1),
     );
@@ -116,7 +144,8 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         )
     };
     let figure = Figure::new(
-        "Stability of the clamped bar's first nonsmooth mode (harmonic balance, m = 20)",
+        "Stability of the clamped bar's first nonsmooth mode: harmonic balance (m = 20) and \
+         the exact branch",
         2,
         vec![backbone.into(), multipliers.into()],
     );
@@ -150,9 +179,53 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
     ];
     let file = std::fs::File::create(out.join("stability_clamped.csv"))?;
     write_columns_csv(&names, &refs, std::io::BufWriter::new(file))?;
+    write_exact(out, &exact, omega_1)?;
     let count = |v: f64| columns[3].iter().filter(|&&c| c == v).count();
     println!(
         "stability_clamped: {} points, {} stable, {} unstable, {} unresolved",
+        points.len(),
+        count(1.0),
+        count(-1.0),
+        count(0.0)
+    );
+    Ok(())
+}
+
+/// `stability_clamped_exact.csv`: the exact branch's points, with their verdicts, largest
+/// multipliers (NaN without a verdict) and the grid's damping (NaN where the pair is found).
+fn write_exact(out: &std::path::Path, exact: &ExactBranch, omega_1: f64) -> Res<()> {
+    let points: Vec<&BackbonePoint> = exact.points.iter().map(|p| &p.point).collect();
+    let column = |f: &dyn Fn(&BackbonePoint) -> f64| points.iter().map(|p| f(p)).collect();
+    let judged = |p: &BackbonePoint| {
+        let f = p.stability.as_ref()?.as_ref().ok()?;
+        f.verdict.stable().map(|_| f.clone())
+    };
+    let columns: [Vec<f64>; 6] = [
+        column(&|p| p.period),
+        column(&|p| p.omega / omega_1),
+        column(&|p| p.energy_normalized),
+        column(&|p| match stable(p) {
+            Some(true) => 1.0,
+            Some(false) => -1.0,
+            None => 0.0,
+        }),
+        column(&|p| judged(p).map_or(f64::NAN, |f| f.max_modulus)),
+        column(&|p| judged(p).and_then(|f| f.damping).unwrap_or(f64::NAN)),
+    ];
+    let refs: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
+    let names = [
+        "period",
+        "omega_normalized",
+        "energy_normalized",
+        "verdict",
+        "max_multiplier",
+        "damping",
+    ];
+    let file = std::fs::File::create(out.join("stability_clamped_exact.csv"))?;
+    write_columns_csv(&names, &refs, std::io::BufWriter::new(file))?;
+    let count = |v: f64| columns[3].iter().filter(|&&c| c == v).count();
+    println!(
+        "stability_clamped: exact branch of {} points, {} stable, {} unstable, {} unresolved",
         points.len(),
         count(1.0),
         count(-1.0),
