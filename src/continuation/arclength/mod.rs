@@ -32,6 +32,7 @@
 mod bordered;
 mod branching;
 mod options;
+mod resume;
 
 pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
 
@@ -271,6 +272,18 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         let tangent = self
             .tangent_at(&y, &seed)
             .ok_or(ContinuationError::SingularTangent { lambda })?;
+        Ok(self.adopt(y, tangent, &info, Vec::new()))
+    }
+
+    /// Makes `y` with `tangent` the current point, numbered as the next step, with the
+    /// step size back to `options.ds` and no secant history; a finished driver runs again.
+    fn adopt(
+        &mut self,
+        y: Vec<f64>,
+        tangent: Vec<f64>,
+        info: &SolveInfo,
+        events: Vec<Event>,
+    ) -> Point {
         self.orientation = self.orientation_at(&y, &tangent);
         self.bracket = None;
         self.previous = None;
@@ -282,9 +295,9 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         self.start = None;
         self.finished = None;
         self.done = false;
-        let mut point = self.point(self.accepted, &info, Vec::new());
+        let mut point = self.point(self.accepted, info, events);
         point.step_size = 0.0;
-        Ok(point)
+        point
     }
 
     /// Current step size.
