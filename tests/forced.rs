@@ -337,7 +337,8 @@ fn undamped_and_unforced_the_backbone_points_solve_the_forced_system_with_their_
 /// The clamped bar's first mode, base-excited and swept up in frequency with the harmonic
 /// selection: the resonance peak lies on the backbone of the same discretisation (energy
 /// within 5 % of the backbone's at the peak frequency), on two grids, at two forcing levels,
-/// and as damping and forcing go to zero together, well past the band of frequencies where
+/// on a grid much finer than the linear peak's width, and as damping and forcing go to zero
+/// together, well past the band of frequencies where
 /// the selection drops most harmonics (`docs/validation.md`, "Forced response").
 /// The harmonic-balance settings of the forced sweeps: 20 harmonics with the default band.
 fn with_band() -> HarmonicBalanceSettings {
@@ -380,6 +381,9 @@ fn the_resonance_peak_lies_on_the_backbone() {
         (2e-3, 4e-6, 451),
         (1e-3, 2e-6, 901),
         (5e-4, 1e-6, 901),
+        // A grid of steps four times shorter than the width `eta` of a linear peak: counted
+        // in steps, its failures left the branch at the band's edge (`Omega = 1.5785`).
+        (2e-3, 2e-6, 901),
     ];
     for (eta, u0, steps) in cases {
         let (_, forcing) = clamped_base(1e-3, eta, u0);
@@ -407,9 +411,15 @@ fn the_resonance_peak_lies_on_the_backbone() {
             peak.energy_normalized,
             peak.omega
         );
-        // Past the peak the sweep drops to the low branch and ends the range there.
+        // Past the peak the sweep drops to the low branch and ends the range there, once its
+        // steps have failed over `MAX_CONSECUTIVE_FAILURES` widths `eta` (a peak closer to the
+        // end of the range leaves no room to drop).
+        let span = nonsmooth_modes::branches::MAX_CONSECUTIVE_FAILURES as f64 * eta;
         let last = response.points.last().unwrap();
-        assert!(last.converged && last.amplitude < 0.1 && last.omega == 2.0);
+        assert!(last.omega == 2.0);
+        if 2.0 - peak.omega > 1.1 * span {
+            assert!(last.converged && last.amplitude < 0.1, "{eta}: {last:?}");
+        }
     }
 }
 

@@ -192,10 +192,10 @@ fn arclength_options(
 }
 
 /// Natural-parameter continuation over `values`, as a frequency sweep of an experiment: where
-/// the branch followed ends (a resonant branch past its peak, a fold),
-/// [`MAX_CONSECUTIVE_FAILURES`] steps fail in a row (as a period grid stalls), and the sweep drops to the open-contact response at the next value
-/// and goes on from there. The branch's end reason is the last run's; its points and
-/// rejections are every run's.
+/// the branch followed ends (a resonant branch past its peak, a fold), its steps fail over a
+/// span of frequencies ([`allowed_failures`]), and the sweep drops to the open-contact
+/// response at the next value and goes on from there. The branch's end reason is the last
+/// run's; its points and rejections are every run's.
 fn sweep(
     problem: &mut ForcedSystem,
     solver: &Solver,
@@ -203,9 +203,14 @@ fn sweep(
     values: &[f64],
     observer: &mut impl FnMut(&Step) -> ControlFlow<()>,
 ) -> Result<Branch, Error> {
+    let grid_step = match values {
+        [a, b, ..] => (b - a).abs(),
+        _ => 0.0,
+    };
+    let eta = problem.damping().iter().copied().fold(0.0, f64::max);
     let options = SequentialOptions {
         predictor: Predictor::Secant,
-        max_consecutive_failures: MAX_CONSECUTIVE_FAILURES,
+        max_consecutive_failures: allowed_failures(grid_step, eta),
         ..Default::default()
     };
     let mut all = Branch {
@@ -238,6 +243,22 @@ fn sweep(
             // ends stalled, with what it has.
             Err(_) => return Ok(all),
         }
+    }
+}
+
+/// Consecutive failed steps a sweep in steps of `grid_step` allows before it leaves the
+/// branch: as many as span [`MAX_CONSECUTIVE_FAILURES`] widths `eta` of a linear resonance
+/// peak (`eta` the largest damping of the bars), so that the branch is given up over the same
+/// frequencies on any grid (counted in steps, a fine grid left it early). Without damping, or
+/// on a one-value grid, [`MAX_CONSECUTIVE_FAILURES`] steps.
+fn allowed_failures(grid_step: f64, eta: f64) -> usize {
+    let span = MAX_CONSECUTIVE_FAILURES as f64 * eta;
+    let steps = span / grid_step;
+    if steps.is_finite() && steps > 0.0 {
+        // At most the grid's own length counts: `u32::MAX` steps bound any grid in memory.
+        steps.ceil().min(f64::from(u32::MAX)) as usize
+    } else {
+        MAX_CONSECUTIVE_FAILURES
     }
 }
 
