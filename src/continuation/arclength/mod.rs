@@ -275,31 +275,6 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         Ok(self.adopt(y, tangent, &info, Vec::new()))
     }
 
-    /// Makes `y` with `tangent` the current point, numbered as the next step, with the
-    /// step size back to `options.ds` and no secant history; a finished driver runs again.
-    fn adopt(
-        &mut self,
-        y: Vec<f64>,
-        tangent: Vec<f64>,
-        info: &SolveInfo,
-        events: Vec<Event>,
-    ) -> Point {
-        self.orientation = self.orientation_at(&y, &tangent);
-        self.bracket = None;
-        self.previous = None;
-        self.y = y;
-        self.tangent = tangent;
-        self.active = self.active_set();
-        self.accepted += 1;
-        self.ds = self.options.ds;
-        self.start = None;
-        self.finished = None;
-        self.done = false;
-        let mut point = self.point(self.accepted, info, events);
-        point.step_size = 0.0;
-        point
-    }
-
     /// Current step size.
     pub fn step_size(&self) -> f64 {
         self.ds

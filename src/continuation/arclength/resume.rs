@@ -5,6 +5,7 @@
 
 use super::{augmented, Arclength, ContinuationError, ContinuationProblem, Event, Point};
 use crate::solve::NonlinearSolver;
+use crate::solve::SolveInfo;
 
 impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<'_, P, S> {
     /// Continues the branch from `x` at `lambda`: corrected at fixed `lambda`, its tangent
@@ -50,5 +51,30 @@ impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<'_, P, S> {
             events.push(Event::Fold { parameter: lambda });
         }
         Ok(self.adopt(y, tangent, &info, events))
+    }
+
+    /// Makes `y` with `tangent` the current point, numbered as the next step, with the
+    /// step size back to `options.ds` and no secant history; a finished driver runs again.
+    pub(super) fn adopt(
+        &mut self,
+        y: Vec<f64>,
+        tangent: Vec<f64>,
+        info: &SolveInfo,
+        events: Vec<Event>,
+    ) -> Point {
+        self.orientation = self.orientation_at(&y, &tangent);
+        self.bracket = None;
+        self.previous = None;
+        self.y = y;
+        self.tangent = tangent;
+        self.active = self.active_set();
+        self.accepted += 1;
+        self.ds = self.options.ds;
+        self.start = None;
+        self.finished = None;
+        self.done = false;
+        let mut point = self.point(self.accepted, info, events);
+        point.step_size = 0.0;
+        point
     }
 }
