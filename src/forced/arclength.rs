@@ -84,7 +84,8 @@ fn run(
         points.push(measured(driver.problem_mut(), points.len(), &p, e_g));
     };
     let omegas: Vec<f64> = points.iter().map(|p| p.omega).collect();
-    for i in folds(&omegas, step) {
+    let energies: Vec<f64> = points.iter().map(|p| p.energy).collect();
+    for i in folds(&omegas, &energies, step) {
         points[i].fold = true;
     }
     let rejections = driver.rejections();

@@ -27,7 +27,8 @@ pub struct ResponsePoint {
     /// ([`ForcedSystem::contact_defect`]).
     pub contact_defect: f64,
     /// Whether the curve turns back in frequency at this point (arclength runs): the extreme
-    /// in frequency from which the curve comes back by more than a grid step of the request.
+    /// in frequency from which the curve comes back by more than a grid step of the request,
+    /// along another branch than the one it came by.
     pub fold: bool,
     /// The harmonics the harmonic selection held at zero at this point
     /// ([`HarmonicBalanceSettings::resonance_band`](crate::system::HarmonicBalanceSettings::resonance_band); empty without it).
