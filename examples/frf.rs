@@ -24,21 +24,26 @@
 //!
 //! `--method sequential` (the default) sweeps the frequency up as an experiment does: it
 //! follows the branch it is on, and where that branch ends (past a resonance peak) it drops
-//! to the open-contact response and goes on. `--method arclength` follows one branch through
-//! its folds. `--resonance-band C` holds at zero every harmonic `n >= 2` within `C / m` of a
+//! to the open-contact response and goes on. `--method arclength` follows one curve through
+//! its folds: the harmonic selection is held while a step is corrected and moved between
+//! points, where the point is solved again with the new selection, switching the harmonics it
+//! adds on one at a time; a point that cannot be moved there, or a step that collapses at a
+//! kink of the laws, moves on by up to three grid steps before the run ends (stalled). `--resonance-band C` holds at zero every harmonic `n >= 2` within `C / m` of a
 //! natural frequency (`HarmonicBalanceSettings::resonance_band`); its default here is
 //! `system::RESONANCE_BAND` = 0.1, not 0 as in `backbone`: the clamped bar's natural
 //! frequencies are odd multiples of the first, so near `omega_1` every odd harmonic sits on
 //! one, and without the band the response climbs that internal resonance instead of the
 //! backbone (`docs/validation.md`, "Forced response"). Where the band switches a harmonic on
-//! or off the equations jump, which stops an arclength run; the sweep steps over it.
+//! or off the equations jump: a sweep steps over it, an arclength run moves the point across.
 //!
 //! Columns: `omega,amplitude,energy,energy_normalized,converged,status,contact_defect,
-//! dropped_harmonics,residual_norm,iterations`: `amplitude` is the largest closure of the first unilateral
+//! dropped_harmonics,residual_norm,iterations,fold`: `amplitude` is the largest closure of the first unilateral
 //! end's gap over the period divided by its gap, `energy` the bars' mechanical energy
 //! averaged over the period, `contact_defect` how far the truncated motion is from the
 //! contact law between the samples (`forced::ForcedSystem::contact_defect`) and
-//! `dropped_harmonics` the harmonics the band held at zero there (separated by `;`). Every point
+//! `dropped_harmonics` the harmonics the band held at zero there (separated by `;`), and
+//! `fold` whether the curve turns back in frequency there (arclength; the folds are also
+//! listed on stderr with their frequency, amplitude and `E/E_g`). Every point
 //! computed is written; a run that ends early, or whose start does not converge, says why on
 //! stderr and exits with code 1. Usage errors, including a system, forcing or frequency range
 //! the library refuses (`--omega-range 2:1` is reversed: the sweep climbs from `LO`), exit
@@ -328,12 +333,12 @@ fn run(a: Args) -> Result<ExitCode, Box<dyn std::error::Error>> {
     };
     writeln!(
         w,
-        "omega,amplitude,energy,energy_normalized,converged,status,contact_defect,dropped_harmonics,residual_norm,iterations"
+        "omega,amplitude,energy,energy_normalized,converged,status,contact_defect,dropped_harmonics,residual_norm,iterations,fold"
     )?;
     for p in &response.points {
         writeln!(
             w,
-            "{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{}",
             p.omega,
             p.amplitude,
             p.energy,
@@ -347,7 +352,8 @@ fn run(a: Args) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 .collect::<Vec<_>>()
                 .join(";"),
             p.residual_norm,
-            p.iterations
+            p.iterations,
+            p.fold
         )?;
     }
     w.flush()?;
@@ -358,6 +364,12 @@ fn run(a: Args) -> Result<ExitCode, Box<dyn std::error::Error>> {
         response.end,
         response.rejected_steps
     );
+    for f in response.folds() {
+        eprintln!(
+            "fold at omega = {} (amplitude {}, E/E_g {})",
+            f.omega, f.amplitude, f.energy_normalized
+        );
+    }
     Ok(match response.end {
         EndReason::Completed | EndReason::ParameterOutOfRange { .. } | EndReason::MaxSteps => {
             ExitCode::SUCCESS

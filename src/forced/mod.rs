@@ -62,15 +62,19 @@
 //! # Ok::<(), nonsmooth_modes::Error>(())
 //! ```
 
+mod arclength;
 mod excitation;
+mod folds;
+mod hold;
+mod leap;
 mod measures;
+mod point;
 mod response;
 pub(crate) mod rows;
 mod system;
 pub mod waves;
 
 pub use excitation::{Damping, Excitation, ExcitationKind};
-pub use response::{
-    forced_response, ForcedResponse, ResponseMethod, ResponsePoint, ResponseRequest,
-};
+pub use point::ResponsePoint;
+pub use response::{forced_response, ForcedResponse, ResponseMethod, ResponseRequest};
 pub use system::{ForcedSystem, Forcing};

@@ -2,12 +2,14 @@
 //! natural-parameter or pseudo-arclength (through folds), from the open-contact linear
 //! response at the first frequency.
 
-use crate::branches::{PointStatus, MAX_CONSECUTIVE_FAILURES};
+use crate::branches::MAX_CONSECUTIVE_FAILURES;
 use crate::continuation::{
-    linspace, Arclength, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem, Direction,
-    EndReason, Ends, Point, Predictor, Range, Sequential, SequentialOptions, Step,
+    linspace, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem, Direction, EndReason,
+    Ends, Predictor, Range, Sequential, SequentialOptions, Step,
 };
 use crate::error::{ContinuationError, Error, SettingsError};
+use crate::forced::arclength::{trace, Traced};
+use crate::forced::point::{measured, ResponsePoint};
 use crate::forced::{ForcedSystem, Forcing};
 use crate::fourier::check_memory;
 use crate::modal::grazing_energy;
@@ -23,7 +25,9 @@ pub enum ResponseMethod {
     /// pass a fold, where the curve turns back in frequency.
     #[default]
     Sequential,
-    /// Pseudo-arclength continuation in `(x, Omega)`, through folds.
+    /// Pseudo-arclength continuation in `(x, Omega)`, through folds, with the harmonic
+    /// selection held while a step is corrected and moved between points (the equations
+    /// jump where it changes); the folds are marked on the points.
     Arclength,
 }
 
@@ -44,39 +48,6 @@ pub struct ResponseRequest {
     pub method: ResponseMethod,
     /// The corrector (semismooth Newton by default).
     pub solver: Solver,
-}
-
-/// One point of a response curve.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct ResponsePoint {
-    /// Step number.
-    pub step: usize,
-    /// Forcing frequency `Omega`.
-    pub omega: f64,
-    /// Largest closure of the first law's gap over the period divided by its gap at rest
-    /// ([`ForcedSystem::amplitude`]).
-    pub amplitude: f64,
-    /// Mechanical energy averaged over the period ([`ForcedSystem::average_energy`]).
-    pub energy: f64,
-    /// `energy / E_g`, `E_g` the first grazing energy of the undamped system.
-    pub energy_normalized: f64,
-    /// `status == PointStatus::Converged`.
-    pub converged: bool,
-    /// Converged, solver failed, or a non-finite energy.
-    pub status: PointStatus,
-    /// How far the motion is from the contact laws between the samples
-    /// ([`ForcedSystem::contact_defect`]).
-    pub contact_defect: f64,
-    /// The harmonics the harmonic selection held at zero at this frequency
-    /// ([`HarmonicBalanceSettings::resonance_band`]; empty without it).
-    pub dropped_harmonics: Vec<usize>,
-    /// `|F|_2`.
-    pub residual_norm: f64,
-    /// Solver iterations.
-    pub iterations: usize,
-    /// The unknowns (layout of [`ForcedSystem`]).
-    pub x: Vec<f64>,
 }
 
 /// A computed response curve.
@@ -102,6 +73,11 @@ impl ForcedResponse {
     /// The converged points.
     pub fn converged(&self) -> impl Iterator<Item = &ResponsePoint> {
         self.points.iter().filter(|p| p.converged)
+    }
+
+    /// The folds of the curve, in order along it.
+    pub fn folds(&self) -> impl Iterator<Item = &ResponsePoint> {
+        self.points.iter().filter(|p| p.fold)
     }
 
     /// The converged point of largest energy (the resonance peak), if any.
@@ -147,71 +123,79 @@ pub fn forced_response(
     let solver = request.solver;
     problem.set_parameter(lo);
     let start = problem.open_response()?;
-    let mut steps: Vec<Step> = Vec::new();
-    let branch = follow(&mut problem, (&solver, request), start, &mut |s: &Step| {
-        steps.push(s.clone());
-        ControlFlow::Continue(())
-    })?;
-    let points = (steps.iter().filter_map(Step::point).enumerate())
-        .map(|(step, p)| measured(&mut problem, step, p, e_g))
-        .collect();
+    let traced = match request.method {
+        ResponseMethod::Sequential => {
+            let mut steps: Vec<Step> = Vec::new();
+            let values = linspace(lo, hi, request.steps)?;
+            let branch = sweep(&mut problem, &solver, start, &values, &mut |s: &Step| {
+                steps.push(s.clone());
+                ControlFlow::Continue(())
+            })?;
+            let points = (steps.iter().filter_map(Step::point).enumerate())
+                .map(|(step, p)| measured(&mut problem, step, p, e_g))
+                .collect();
+            Traced {
+                points,
+                rejections: branch.rejections,
+                end: branch.end,
+            }
+        }
+        ResponseMethod::Arclength => {
+            let options = arclength_options(&mut problem, request)?;
+            problem.set_parameter(lo);
+            let step = (hi - lo) / request.steps as f64;
+            trace(&mut problem, &solver, start, options, (e_g, step))?
+        }
+    };
     Ok(ForcedResponse {
         problem,
         grazing_energy: e_g,
-        points,
-        rejected_steps: branch.rejections,
-        end: branch.end,
+        points: traced.points,
+        rejected_steps: traced.rejections,
+        end: traced.end,
     })
 }
 
-/// Follows the curve from `start` at the lowest frequency to the highest, by the request's
-/// method; `observer` sees every step.
-fn follow(
+/// The options of an arclength run over the request's range, sized for its steps.
+///
+/// # Errors
+/// [`ContinuationError::TooLarge`] for more points than the memory budget holds;
+/// [`SettingsError::NotPositive`] for a range with no open-contact response to scale by.
+fn arclength_options(
     problem: &mut ForcedSystem,
-    (solver, request): (&Solver, &ResponseRequest),
-    start: Vec<f64>,
-    observer: &mut impl FnMut(&Step) -> ControlFlow<()>,
-) -> Result<Branch, Error> {
+    request: &ResponseRequest,
+) -> Result<ArclengthOptions, Error> {
     let (lo, hi) = request.omega_range;
     let steps = request.steps;
-    match request.method {
-        ResponseMethod::Sequential => {
-            sweep(problem, solver, start, &linspace(lo, hi, steps)?, observer)
-        }
-        ResponseMethod::Arclength => {
-            // The run keeps every point it takes, up to `4 steps` of them: a budget checked
-            // before it starts, as the sequential grid's values are (an unbounded count
-            // would run for ever).
-            let dimension = problem.dimension() as f64 + 1.0;
-            check_memory(
-                "the points of an arclength response",
-                4.0 * steps as f64 * dimension,
-            )
-            .map_err(ContinuationError::TooLarge)?;
-            let scale = state_scale(problem, (lo, hi), steps)?;
-            let ds_max = 4.0 / steps as f64;
-            let options = ArclengthOptions {
-                ds: 0.5 * ds_max,
-                ds_min: 1e-4 * ds_max,
-                ds_max,
-                max_steps: steps.saturating_mul(4),
-                parameter_range: (lo, hi),
-                scale: ArclengthScale::Fixed(scale, hi - lo),
-                branch_points: false,
-                ..Default::default()
-            };
-            problem.set_parameter(lo);
-            let mut driver = Arclength::new(problem, solver, start, lo, options)?;
-            Ok(driver.run(observer))
-        }
-    }
+    // The run keeps every point it takes, up to `4 steps` of them: a budget checked
+    // before it starts, as the sequential grid's values are (an unbounded count
+    // would run for ever).
+    let dimension = problem.dimension() as f64 + 1.0;
+    check_memory(
+        "the points of an arclength response",
+        4.0 * steps as f64 * dimension,
+    )
+    .map_err(ContinuationError::TooLarge)?;
+    let scale = state_scale(problem, (lo, hi), steps)?;
+    let ds_max = 4.0 / steps as f64;
+    let options = ArclengthOptions {
+        ds: 0.5 * ds_max,
+        ds_min: 1e-4 * ds_max,
+        ds_max,
+        max_steps: steps.saturating_mul(4),
+        parameter_range: (lo, hi),
+        scale: ArclengthScale::Fixed(scale, hi - lo),
+        branch_points: false,
+        ..Default::default()
+    };
+    Ok(options)
 }
 
 /// Natural-parameter continuation over `values`, as a frequency sweep of an experiment: where
-/// the branch followed ends (a resonant branch past its peak, a fold),
-/// [`MAX_CONSECUTIVE_FAILURES`] steps fail in a row (as a period grid stalls), and the sweep drops to the open-contact response at the next value
-/// and goes on from there. The branch's end reason is the last run's; its points and
-/// rejections are every run's.
+/// the branch followed ends (a resonant branch past its peak, a fold), its steps fail over a
+/// span of frequencies ([`allowed_failures`]), and the sweep drops to the open-contact
+/// response at the next value and goes on from there. The branch's end reason is the last
+/// run's; its points and rejections are every run's.
 fn sweep(
     problem: &mut ForcedSystem,
     solver: &Solver,
@@ -219,9 +203,14 @@ fn sweep(
     values: &[f64],
     observer: &mut impl FnMut(&Step) -> ControlFlow<()>,
 ) -> Result<Branch, Error> {
+    let grid_step = match values {
+        [a, b, ..] => (b - a).abs(),
+        _ => 0.0,
+    };
+    let eta = problem.damping().iter().copied().fold(0.0, f64::max);
     let options = SequentialOptions {
         predictor: Predictor::Secant,
-        max_consecutive_failures: MAX_CONSECUTIVE_FAILURES,
+        max_consecutive_failures: allowed_failures(grid_step, eta),
         ..Default::default()
     };
     let mut all = Branch {
@@ -254,6 +243,22 @@ fn sweep(
             // ends stalled, with what it has.
             Err(_) => return Ok(all),
         }
+    }
+}
+
+/// Consecutive failed steps a sweep in steps of `grid_step` allows before it leaves the
+/// branch: as many as span [`MAX_CONSECUTIVE_FAILURES`] widths `eta` of a linear resonance
+/// peak (`eta` the largest damping of the bars), so that the branch is given up over the same
+/// frequencies on any grid (counted in steps, a fine grid left it early). Without damping, or
+/// on a one-value grid, [`MAX_CONSECUTIVE_FAILURES`] steps.
+fn allowed_failures(grid_step: f64, eta: f64) -> usize {
+    let span = MAX_CONSECUTIVE_FAILURES as f64 * eta;
+    let steps = span / grid_step;
+    if steps.is_finite() && steps > 0.0 {
+        // At most the grid's own length counts: `u32::MAX` steps bound any grid in memory.
+        steps.ceil().min(f64::from(u32::MAX)) as usize
+    } else {
+        MAX_CONSECUTIVE_FAILURES
     }
 }
 
@@ -291,31 +296,5 @@ fn state_scale(
             value: scale,
         }
         .into())
-    }
-}
-
-/// `p`, step `step` of the curve, measured on `problem` (moved to its frequency).
-fn measured(problem: &mut ForcedSystem, step: usize, p: &Point, e_g: f64) -> ResponsePoint {
-    problem.set_parameter(p.parameter);
-    let energy = problem.average_energy(&p.x);
-    let energy_normalized = energy / e_g;
-    let status = match &p.error {
-        Some(e) => PointStatus::SolverFailed(e.clone()),
-        None if p.converged => PointStatus::Converged.with_energy(energy, energy_normalized),
-        None => PointStatus::Rejected,
-    };
-    ResponsePoint {
-        step,
-        omega: p.parameter,
-        amplitude: problem.amplitude(&p.x),
-        energy,
-        energy_normalized,
-        converged: status == PointStatus::Converged,
-        status,
-        contact_defect: problem.contact_defect(&p.x),
-        dropped_harmonics: problem.dropped_harmonics(),
-        residual_norm: p.residual_norm,
-        iterations: p.iterations,
-        x: p.x.clone(),
     }
 }

@@ -40,12 +40,12 @@ pub struct Forcing {
 /// wrong length (the drivers check them first).
 #[derive(Debug, Clone)]
 pub struct ForcedSystem {
-    system: BarSystem,
-    basis: SineCosineBasis,
+    pub(super) system: BarSystem,
+    pub(super) basis: SineCosineBasis,
     complementarity: f64,
     damping: Vec<f64>,
     driven: Vec<Driven>,
-    omega: f64,
+    pub(super) omega: f64,
     /// Rows of harmonics `0..=m` at `omega`.
     rows: Vec<DampedRows>,
     /// `(row, value, d value / d Omega)` of the right-hand side at harmonic 1.
@@ -58,7 +58,9 @@ pub struct ForcedSystem {
     /// `G(1)`, for the law Gram matrices ([`law_grams`]).
     unit_gram: Vec<f64>,
     /// Harmonic selection, if asked ([`HarmonicBalanceSettings::resonance_band`]).
-    selection: Option<Selection>,
+    pub(super) selection: Option<Selection>,
+    /// Whether a new frequency keeps the dropped harmonics ([`ForcedSystem::hold_selection`]).
+    pub(super) selection_held: bool,
 }
 
 /// Time samples of every law at one state: gap, force, the law's residual and gradient.
@@ -155,6 +157,7 @@ impl ForcedSystem {
             unit_gram: unit_gram(&basis),
             basis,
             selection: None,
+            selection_held: false,
         }
     }
 
@@ -566,8 +569,8 @@ impl ContinuationProblem for ForcedSystem {
             return;
         }
         self.omega = omega;
-        if let Some(s) = &mut self.selection {
-            s.select((&self.system, &self.basis), omega);
+        if !self.selection_held {
+            self.reselect();
         }
         let m = self.basis.harmonics();
         self.rows = (0..=m)

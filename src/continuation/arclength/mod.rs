@@ -32,6 +32,7 @@
 mod bordered;
 mod branching;
 mod options;
+mod resume;
 
 pub use options::{ArclengthOptions, ArclengthScale, TangentPredictor};
 
@@ -271,20 +272,7 @@ impl<'a, P: ContinuationProblem, S: NonlinearSolver> Arclength<'a, P, S> {
         let tangent = self
             .tangent_at(&y, &seed)
             .ok_or(ContinuationError::SingularTangent { lambda })?;
-        self.orientation = self.orientation_at(&y, &tangent);
-        self.bracket = None;
-        self.previous = None;
-        self.y = y;
-        self.tangent = tangent;
-        self.active = self.active_set();
-        self.accepted += 1;
-        self.ds = self.options.ds;
-        self.start = None;
-        self.finished = None;
-        self.done = false;
-        let mut point = self.point(self.accepted, &info, Vec::new());
-        point.step_size = 0.0;
-        Ok(point)
+        Ok(self.adopt(y, tangent, &info, Vec::new()))
     }
 
     /// Current step size.

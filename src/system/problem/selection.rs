@@ -142,9 +142,19 @@ impl Selection {
         &self.dropped
     }
 
-    /// The harmonics dropped at the current frequency, ascending.
+    /// Drops the coefficients `dropped` (ascending, from [`Selection::dropped`]) until the
+    /// next [`Selection::select`].
+    pub(crate) fn set_dropped(&mut self, dropped: Vec<usize>) {
+        self.dropped = dropped;
+    }
+
+    /// The harmonics dropped at the current frequency, ascending, each once (a full basis
+    /// drops a harmonic's cosine and sine together).
     pub(crate) fn dropped_harmonics<B: Basis>(&self, basis: &B) -> Vec<usize> {
-        self.dropped.iter().map(|&i| basis.harmonic(i)).collect()
+        let mut harmonics: Vec<usize> = self.dropped.iter().map(|&i| basis.harmonic(i)).collect();
+        harmonics.sort_unstable();
+        harmonics.dedup();
+        harmonics
     }
 
     /// Recomputes the dropped coefficients at `omega`, extending the natural frequencies when
