@@ -69,9 +69,10 @@
 //! `stable,max_multiplier,stability_reason`: `true`, `false` or `unresolved` (no periodic
 //! orbit of the map within 5 % of the point's energy and displacement, or its trivial
 //! multipliers not found); the largest multiplier modulus (1 when every multiplier lies
-//! within `1e-3` of the unit circle), empty where unresolved; and, empty where there is a
-//! verdict, why there is none: the `stability::UnresolvedReason` with its numbers, or the
-//! error where the multipliers could not be computed (commas written as semicolons).
+//! within `1e-3` of the unit circle), empty where unresolved; and why there is no verdict:
+//! the `stability::UnresolvedReason` with its numbers, or the error where the multipliers
+//! could not be computed (commas written as semicolons); for a verdict, empty, or the grid's
+//! damping the stable verdict holds up to (`Floquet::damping`).
 //! Changes of verdict along a branch appear in `event` as `stability-lost` and
 //! `stability-gained`. Period and energy runs only; empty cells for `--parameter` runs.
 //!

@@ -253,9 +253,10 @@ pub fn verification_cells(p: &BackbonePoint) -> String {
 
 /// `,stable,max_multiplier,stability_reason` of a point: `true`, `false` or `unresolved`,
 /// `Floquet::max_multiplier` where there is a verdict (empty where unresolved: the number
-/// means nothing there), and why there is no verdict (empty where there is one): the
-/// `UnresolvedReason`, or the error where the multipliers could not be computed (with a
-/// message on stderr). All empty for a point without multipliers.
+/// means nothing there), and why there is no verdict: the `UnresolvedReason`, or the error
+/// where the multipliers could not be computed (with a message on stderr); for a verdict,
+/// empty, or the grid's damping a stable verdict holds up to. All empty for a point without
+/// multipliers.
 pub fn stability_cells(p: &BackbonePoint) -> String {
     let outcome = p.stability.as_ref().map(|o| {
         o.as_ref().map(|f| {
