@@ -3,6 +3,7 @@
 
 mod backbones;
 mod drivers;
+mod exact;
 mod forced;
 mod full_basis;
 mod model;
@@ -41,10 +42,11 @@ pub(crate) enum Kind {
     FullBasisHelpers,
     ForcedCalls,
     Stability,
+    Exact,
 }
 
 /// Every kind, drawn uniformly by each case.
-pub(crate) const KINDS: [Kind; 15] = [
+pub(crate) const KINDS: [Kind; 16] = [
     Kind::Assembly,
     Kind::Settings,
     Kind::Solver,
@@ -60,6 +62,7 @@ pub(crate) const KINDS: [Kind; 15] = [
     Kind::FullBasisHelpers,
     Kind::ForcedCalls,
     Kind::Stability,
+    Kind::Exact,
 ];
 
 impl Kind {
@@ -80,6 +83,7 @@ impl Kind {
             Kind::FullBasisHelpers => surfaces::full_basis_helpers_case(d, c),
             Kind::ForcedCalls => surfaces::forced_calls_case(d, c),
             Kind::Stability => surfaces::stability_case(d, c),
+            Kind::Exact => exact::exact_case(d, c),
         }
     }
 }
