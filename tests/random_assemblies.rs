@@ -450,3 +450,76 @@ fn random_assembly_census() {
         assert!(good + refused <= held);
     }
 }
+
+/// The exact-branch census of `docs/validation.md`: of `RANDOM_COUNT` (default 10) held
+/// assemblies from seed `RANDOM_SEED_OFFSET`, those with a verified harmonic-balance backbone
+/// at `m = 20` (at least 20 converged points passing the time-domain check on the system's
+/// grid), and among them those whose exact branch over the grid's first 25 periods
+/// (`Request::with_exact`, default options) has at least 20 points with a verdict.
+#[test]
+#[ignore = "minutes; the exact census of docs/validation.md"]
+fn random_assembly_exact_census() {
+    use nonsmooth_modes::branches::PeriodGrid;
+    use nonsmooth_modes::exact::ExactOptions;
+    let count = env_number("RANDOM_COUNT", 10);
+    let offset = env_number("RANDOM_SEED_OFFSET", 0) as u64;
+    let (mut held, mut verified, mut exact_ok, mut seed) = (0, 0, 0, offset);
+    while held < count {
+        let drawn = draw(seed);
+        seed += 1;
+        let hb = run(&drawn.system, Way::Grid, 20, true);
+        let checked = match hb {
+            Outcome::Unconfined => continue,
+            Outcome::Run { checked, .. } => checked.unwrap_or(0),
+            Outcome::Refused(_) => 0,
+        };
+        held += 1;
+        println!("{}\n  harmonic balance: {hb:?}", drawn.description);
+        if checked < 20 {
+            continue;
+        }
+        verified += 1;
+        let mut options = BackboneOptions::for_mode(&drawn.system, 1, 1).unwrap();
+        let step = (options.grid.end - options.grid.start) / (options.grid.steps - 1) as f64;
+        options.grid = PeriodGrid {
+            end: options.grid.start + 24.0 * step,
+            steps: 25,
+            ..options.grid
+        };
+        let request = Request::new(1)
+            .harmonics(20)
+            .method(Method::PeriodGrid(options))
+            .with_exact(ExactOptions::default());
+        let start = std::time::Instant::now();
+        let exact = compute(&drawn.system, &request).map(|r| r.exact);
+        let seconds = start.elapsed().as_secs_f64();
+        match exact {
+            Ok(Some(Ok(branch))) => {
+                let resolved = branch
+                    .points
+                    .iter()
+                    .filter(|p| {
+                        let f = p.point.stability.as_ref().and_then(|s| s.as_ref().ok());
+                        f.is_some_and(|f| f.verdict.stable().is_some())
+                    })
+                    .count();
+                println!(
+                    "  exact: {} points, {resolved} with a verdict, {} skipped, {:?}, {seconds:.1} s",
+                    branch.points.len(),
+                    branch.skipped.len(),
+                    branch.end
+                );
+                if resolved >= 20 {
+                    exact_ok += 1;
+                }
+            }
+            Ok(Some(Err(e))) | Err(e) => println!("  exact: {e} ({seconds:.1} s)"),
+            Ok(None) => panic!("compute asked for an exact branch returned none"),
+        }
+    }
+    println!(
+        "m = 20, {held} held assemblies (seeds {offset}..{seed}): {verified} with a verified \
+         backbone, {exact_ok} of them with an exact branch of at least 20 points with a verdict"
+    );
+    assert!(exact_ok <= verified && verified <= held);
+}
