@@ -2,10 +2,13 @@
 //! branches against their exact families, verdicts against the grid and the gap, and bad
 //! input. Checks that can fail: the families are closed forms, not recorded results.
 
+use nonsmooth_modes::bar::Bar;
 use nonsmooth_modes::branches::{compute, BackboneOptions, Method, PeriodGrid, Request};
 use nonsmooth_modes::exact::{exact_branch, ExactBranch, ExactEnd, ExactOptions};
 use nonsmooth_modes::io::assembly::Assembly;
-use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, two_bars_in_contact, ClampedFirstMode,
+};
 use nonsmooth_modes::stability::{StabilityError, StabilityOptions, Verdict};
 use nonsmooth_modes::system::BarSystem;
 use nonsmooth_modes::{Error, SettingsError};
@@ -200,6 +203,29 @@ fn the_request_carries_the_exact_branch() {
             assert_eq!(what, "max_lost")
         }
         other => panic!("{other:?}"),
+    }
+}
+
+/// The options a system can afford: the clamped bar keeps 200 cells per travel time; with a
+/// second bar eight times as long, 200 cells per shortest travel time are refused as too
+/// large, and `for_request` takes fewer.
+#[test]
+fn the_default_grid_is_one_the_system_can_afford() {
+    let clamped = clamped_bar_with_obstacle(1e-3).unwrap();
+    let short = request(&clamped, 3.95, 3.90, 3);
+    let options = ExactOptions::for_request(&clamped, &short).unwrap();
+    assert_eq!(options.stability.cells_per_travel, 200.0);
+    let long = two_bars_in_contact(Bar::new(8.0, 1.0, 1.0).unwrap(), 1e-3).unwrap();
+    let grid = BackboneOptions::for_mode(&long, 1, 1).unwrap().grid;
+    let run = request(&long, grid.start, grid.end, 3).harmonics(4);
+    let options = ExactOptions::for_request(&long, &run).unwrap();
+    let cells = options.stability.cells_per_travel;
+    assert!((8.0..200.0).contains(&cells), "{cells}");
+    match exact_branch(&long, &run, &ExactOptions::default()) {
+        Err(Error::Stability(
+            StabilityError::TooLarge { .. } | StabilityError::TooCostly { .. },
+        )) => {}
+        other => panic!("{:?}", other.map(|b| b.points.len())),
     }
 }
 

@@ -455,7 +455,8 @@ fn random_assembly_census() {
 /// assemblies from seed `RANDOM_SEED_OFFSET`, those with a verified harmonic-balance backbone
 /// at `m = 20` (at least 20 converged points passing the time-domain check on the system's
 /// grid), and among them those whose exact branch over the grid's first 25 periods
-/// (`Request::with_exact`, default options) has at least 20 points with a verdict.
+/// (`Request::with_exact`, `ExactOptions::for_request`: the grid the system can afford) has
+/// at least 20 points with a verdict.
 #[test]
 #[ignore = "minutes; the exact census of docs/validation.md"]
 fn random_assembly_exact_census() {
@@ -488,8 +489,13 @@ fn random_assembly_exact_census() {
         };
         let request = Request::new(1)
             .harmonics(20)
-            .method(Method::PeriodGrid(options))
-            .with_exact(ExactOptions::default());
+            .method(Method::PeriodGrid(options));
+        let exact = ExactOptions::for_request(&drawn.system, &request).unwrap();
+        println!(
+            "  exact on {} cells per shortest travel time",
+            exact.stability.cells_per_travel
+        );
+        let request = request.with_exact(exact);
         let start = std::time::Instant::now();
         let exact = compute(&drawn.system, &request).map(|r| r.exact);
         let seconds = start.elapsed().as_secs_f64();

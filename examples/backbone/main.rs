@@ -83,8 +83,10 @@
 //! and `residual_norm` are the corrector's steps and the orbit's periodicity defect, `label`
 //! that of the harmonic-balance point the segment was seeded from, `branch` one more after
 //! each reseed, `contacts_per_period` counted on the orbit, `dominant_harmonic` empty.
-//! `--cells-per-travel N` (default 200, at most 1000) is the map's smallest grid; the grid
-//! used may be finer, so that every period is a whole number of steps. Stderr says how many
+//! `--cells-per-travel N` (at most 1000) is the map's smallest grid, in cells per shortest
+//! travel time; the grid used may be finer, so that every period is a whole number of steps.
+//! Without it, `ExactOptions::for_request`: 200, or fewer where the system's other bars
+//! would make the matrices larger than the limits of `stability`. Stderr says how many
 //! points, verdicts and seconds, why the walk ended and why each skipped period has no
 //! point. With `--parameter omega` only, in the cosine basis, without `--hill`.
 //!

@@ -128,13 +128,16 @@ fn run_exact(
     request: &Request,
     sink: &mut Sink<'_>,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let options = ExactOptions {
-        stability: StabilityOptions {
-            cells_per_travel: (a.cells_per_travel)
-                .unwrap_or(StabilityOptions::default().cells_per_travel),
-            ..StabilityOptions::default()
+    // The grid the system can afford, unless `--cells-per-travel` names one.
+    let options = match a.cells_per_travel {
+        Some(cells_per_travel) => ExactOptions {
+            stability: StabilityOptions {
+                cells_per_travel,
+                ..StabilityOptions::default()
+            },
+            ..ExactOptions::default()
         },
-        ..ExactOptions::default()
+        None => ExactOptions::for_request(system, request)?,
     };
     let exact = Request {
         stability: None,

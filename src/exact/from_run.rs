@@ -1,6 +1,7 @@
 //! An exact branch from a harmonic-balance run that is already there: its seeds, grid and
 //! walk.
 
+use super::grid::{affordable, branch_grid, cost};
 use super::options::ExactOptions;
 use super::types::ExactBranch;
 use super::walk::{Seed, Walker};
@@ -10,9 +11,9 @@ use crate::branches::request::{Method, Request};
 use crate::branches::result::ModeBranches;
 use crate::continuation::linspace;
 use crate::error::{Error, SettingsError};
-use crate::stability::{StabilityError, MAX_MARCH_STEPS};
+use crate::stability::{StabilityError, MAX_DIMENSION, MAX_MARCH_STEPS};
 use crate::system::BarSystem;
-use crate::verify::{Model, State};
+use crate::verify::{Grid, Model, State};
 
 /// The period grid of `request`: its method's, or the system's default for the mode
 /// ([`BackboneOptions::for_mode`]) where the method carries none (arclength, energy).
@@ -21,6 +22,44 @@ pub(crate) fn period_grid(system: &BarSystem, request: &Request) -> Result<Perio
         Method::Auto(Some(o)) | Method::PeriodGrid(o) | Method::GenuineSubharmonic(o) => o.grid,
         _ => BackboneOptions::for_mode(system, request.mode, request.subharmonic)?.grid,
     })
+}
+
+/// The fewest cells per shortest travel time [`ExactOptions::for_request`] goes down to.
+const MIN_CELLS: f64 = 8.0;
+
+impl ExactOptions {
+    /// The default options with a grid `system` can afford over `request`'s period grid: 200
+    /// cells per shortest travel time, or fewer where the bars of longer travel times would
+    /// make the monodromy larger than [`MAX_DIMENSION`](crate::stability::MAX_DIMENSION) rows
+    /// or its marches longer than [`MAX_MARCH_STEPS`] (the cost grows like the square of the
+    /// cells), down to 8. A branch on fewer cells resolves shorter waves less well: its
+    /// verdicts carry their grid ([`Floquet::dt`](crate::stability::Floquet::dt),
+    /// [`Floquet::dimension`](crate::stability::Floquet::dimension)).
+    ///
+    /// # Errors
+    /// Those of [`BackboneOptions::for_mode`] for a request without a grid, and of the
+    /// integrator's model for a system it cannot march.
+    pub fn for_request(system: &BarSystem, request: &Request) -> Result<Self, Error> {
+        let grid = period_grid(system, request)?;
+        let longest = grid.start.max(grid.end);
+        let model = Model::from_system(system)?;
+        let mut options = Self::default();
+        let passes = options.refreshes.max(options.stability.corrections);
+        let travel = crate::bar::shortest_travel_time(model.bars());
+        let mut cells = options.stability.cells_per_travel;
+        // The cost is about quadratic in the cells: a few shrinks settle it.
+        for _ in 0..8 {
+            let g = Grid::nearest_or_new(&model, travel / cells)?;
+            let (n, steps) = cost(&model, &g, longest, passes);
+            let shrink = (MAX_DIMENSION as f64 / n as f64).min((MAX_MARCH_STEPS / steps).sqrt());
+            if !(shrink < 1.0) || cells <= MIN_CELLS {
+                break;
+            }
+            cells = (0.95 * cells * shrink).floor().max(MIN_CELLS);
+        }
+        options.stability.cells_per_travel = cells;
+        Ok(options)
+    }
 }
 
 /// The exact branch over `grid`, seeded by the converged points of the harmonic-balance run
@@ -45,20 +84,21 @@ pub fn exact_branch_from(
     let problem = run.problem();
     let (system, basis) = (problem.system(), problem.basis());
     let model = Model::from_system(system)?;
-    let branch = super::grid::branch_grid(&model, &requested, options.stability.cells_per_travel)?;
+    let longest = requested.iter().fold(0.0f64, |m, t| m.max(*t));
+    let passes = options.refreshes.max(options.stability.corrections);
+    let fits = |grid: &Grid| affordable(cost(&model, grid, longest, passes));
+    let cells = options.stability.cells_per_travel;
+    let branch = branch_grid(&model, &requested, cells, &fits)?;
     let dt = branch.grid.dt();
     let coordinates = crate::stability::coordinates::Coordinates::new(&model, &branch.grid);
     crate::stability::check_dimension(&coordinates, options.stability.cells_per_travel)?;
     let longest = branch.periods.iter().fold(0.0f64, |m, t| m.max(*t));
-    let steps = 2.0
-        * coordinates.len() as f64
-        * (longest / dt).ceil()
-        * (2.0 + options.refreshes.max(options.stability.corrections) as f64);
+    let steps = cost(&model, &branch.grid, longest, passes).1;
     if steps.is_nan() || steps > MAX_MARCH_STEPS {
         return Err(StabilityError::TooCostly {
             steps,
             dimension: coordinates.len(),
-            corrections: options.refreshes.max(options.stability.corrections),
+            corrections: passes,
             limit: MAX_MARCH_STEPS,
         }
         .into());

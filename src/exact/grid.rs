@@ -1,7 +1,8 @@
 //! The one grid of a branch, on which every requested period is a whole number of steps.
 
 use crate::bar::shortest_travel_time;
-use crate::stability::StabilityError;
+use crate::stability::coordinates::Coordinates;
+use crate::stability::{StabilityError, MAX_DIMENSION, MAX_MARCH_STEPS};
 use crate::verify::{Grid, Model};
 
 /// A period more than this relative amount off a whole number of steps is rounded.
@@ -37,7 +38,23 @@ fn candidate(
     Ok((grid, rounded, distinct, miss))
 }
 
+/// The rows of the monodromy on `grid` and the time steps of marching one point's matrices
+/// over `longest` with `passes` monodromies: what the limits of
+/// [`stability`](crate::stability) bound.
+pub(crate) fn cost(model: &Model, grid: &Grid, longest: f64, passes: usize) -> (usize, f64) {
+    let n = Coordinates::new(model, grid).len();
+    let steps = 2.0 * n as f64 * (longest / grid.dt()).ceil() * (2.0 + passes as f64);
+    (n, steps)
+}
+
+/// Whether a cost is within [`MAX_DIMENSION`] and [`MAX_MARCH_STEPS`].
+pub(crate) fn affordable((n, steps): (usize, f64)) -> bool {
+    n <= MAX_DIMENSION && steps <= MAX_MARCH_STEPS
+}
+
 /// The grid of a branch over `periods`, with at least `cells` cells per shortest travel time.
+/// Only grids within `fits` are tried beyond the first (a grid of more cells that makes the
+/// periods whole is no use if its matrices are over the limits).
 ///
 /// One grid for the whole branch keeps the coordinates, so that the monodromy of one point
 /// is the corrector's matrix at the next; and a period of a whole number of steps keeps the
@@ -50,6 +67,7 @@ pub(crate) fn branch_grid(
     model: &Model,
     periods: &[f64],
     cells: f64,
+    fits: &dyn Fn(&Grid) -> bool,
 ) -> Result<BranchGrid, StabilityError> {
     let first = cells.ceil().max(1.0) as usize;
     let near = (1.25 * first as f64).ceil() as usize;
@@ -57,6 +75,9 @@ pub(crate) fn branch_grid(
     let mut far_distinct = None;
     for k in first..=2 * first {
         let c = candidate(model, periods, k)?;
+        if k > first && !fits(&c.0) {
+            continue;
+        }
         if c.2 && c.3 <= WHOLE {
             near_best = Some(c);
             break;
@@ -95,7 +116,7 @@ mod tests {
     fn whole_periods_are_found() {
         let model = Model::clamped_bar_with_obstacle(1e-3).unwrap();
         let periods: Vec<f64> = (0..181).map(|j| 3.95 - 0.005 * j as f64).collect();
-        let b = branch_grid(&model, &periods, 200.0).unwrap();
+        let b = branch_grid(&model, &periods, 200.0, &|_| true).unwrap();
         assert_eq!(b.grid.cells(0), 200);
         assert!(b
             .periods
@@ -103,7 +124,7 @@ mod tests {
             .zip(&periods)
             .all(|(a, t)| (a - t).abs() < 1e-12));
         let half: Vec<f64> = (0..181).map(|j| 1.975 - 0.0025 * j as f64).collect();
-        let b = branch_grid(&model, &half, 200.0).unwrap();
+        let b = branch_grid(&model, &half, 200.0, &|_| true).unwrap();
         assert_eq!(b.grid.cells(0), 400);
     }
 }

@@ -50,7 +50,10 @@
 //! waves onto the cells and blur the multipliers). Where no count makes them whole, the
 //! periods are rounded to whole steps ([`ExactPoint::requested_period`] keeps the grid's);
 //! the clamped bar's grid `3.95 -> 3.05` is whole at 200 cells, the free–free bar's
-//! `1.975 -> 1.525` at 400.
+//! `1.975 -> 1.525` at 400. A finer count is tried only where its matrices stay within the
+//! limits of [`stability`](crate::stability). [`ExactOptions::for_request`] chooses the
+//! minimum a system can afford: 200 cells per shortest travel time, or fewer where bars of
+//! longer travel times would make the matrices too large.
 //!
 //! # Predictor and corrector
 //!
