@@ -52,7 +52,7 @@ impl ExactOptions {
             let g = Grid::nearest_or_new(&model, travel / cells)?;
             let (n, steps) = cost(&model, &g, longest, passes);
             let shrink = (MAX_DIMENSION as f64 / n as f64).min((MAX_MARCH_STEPS / steps).sqrt());
-            if !(shrink < 1.0) || cells <= MIN_CELLS {
+            if shrink >= 1.0 || shrink.is_nan() || cells <= MIN_CELLS {
                 break;
             }
             cells = (0.95 * cells * shrink).floor().max(MIN_CELLS);
