@@ -45,7 +45,7 @@ use nonsmooth_modes::branches::{
     symmetry_instant, with_harmonics, BackboneOptions, BackbonePoint, FullBasisPoint, Method,
     Request, TimeDomainCheck,
 };
-use nonsmooth_modes::exact::{ExactBranch, ExactOptions};
+use nonsmooth_modes::exact::ExactOptions;
 use nonsmooth_modes::forced::{
     forced_response, Damping, Excitation, Forcing, ResponseMethod, ResponseRequest,
 };
@@ -57,7 +57,7 @@ use nonsmooth_modes::plot::{
     SpaceTimeField, FREQUENCY_LABEL, PALETTE,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFamily};
-use nonsmooth_modes::stability::{floquet, StabilityOptions};
+use nonsmooth_modes::stability::{floquet, Floquet, StabilityOptions};
 use nonsmooth_modes::system::{BarSystem, HarmonicBalanceSettings, RESONANCE_BAND};
 use std::error::Error;
 use std::path::PathBuf;
@@ -67,9 +67,14 @@ type Res<T> = Result<T, Box<dyn Error>>;
 
 const USAGE: &str = "usage: gallery [--out DIR] [--quick]";
 
+/// A point's multipliers, where they were computed.
+fn floquet_of(p: &BackbonePoint) -> Option<&Floquet> {
+    p.stability.as_ref()?.as_ref().ok()
+}
+
 /// Whether a point is stable, when its multipliers were computed and give a verdict.
 fn stable(p: &BackbonePoint) -> Option<bool> {
-    p.stability.as_ref()?.as_ref().ok()?.verdict.stable()
+    floquet_of(p)?.verdict.stable()
 }
 
 /// The clamped bar's first nonsmooth mode with the verdict of every point.
@@ -129,7 +134,7 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
     let moduli: Vec<(f64, f64, Option<bool>)> = points
         .iter()
         .filter_map(|p| {
-            let f = p.stability.as_ref()?.as_ref().ok()?;
+            let f = floquet_of(p)?;
             // An unresolved point's multipliers describe no motion: not drawn.
             let stable = f.verdict.stable()?;
             Some((p.omega / omega_1, f.max_modulus, Some(stable)))
@@ -150,56 +155,37 @@ fn stability_clamped(out: &std::path::Path, cells: f64) -> Res<()> {
         vec![backbone.into(), multipliers.into()],
     );
     render_svg(out.join("stability_clamped.svg"), &figure)?;
-    let column = |f: &dyn Fn(&BackbonePoint) -> f64| points.iter().map(|p| f(p)).collect();
-    let floquet = |p: &BackbonePoint| p.stability.clone().and_then(Result::ok);
-    let columns: [Vec<f64>; 6] = [
-        column(&|p| p.period),
-        column(&|p| p.omega / omega_1),
-        column(&|p| p.energy_normalized),
-        column(&|p| match stable(p) {
-            Some(true) => 1.0,
-            Some(false) => -1.0,
-            None => 0.0,
-        }),
-        // Without a verdict the largest modulus describes no motion: NaN.
-        column(&|p| {
-            let judged = floquet(p).filter(|f| f.verdict.stable().is_some());
-            judged.map_or(f64::NAN, |f| f.max_modulus)
-        }),
-        column(&|p| floquet(p).map_or(f64::NAN, |f| f.energy_correction)),
-    ];
-    let refs: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
-    let names = [
-        "period",
-        "omega_normalized",
-        "energy_normalized",
-        "verdict",
-        "max_multiplier",
-        "energy_correction",
-    ];
-    let file = std::fs::File::create(out.join("stability_clamped.csv"))?;
-    write_columns_csv(&names, &refs, std::io::BufWriter::new(file))?;
-    write_exact(out, &exact, omega_1)?;
-    let count = |v: f64| columns[3].iter().filter(|&&c| c == v).count();
-    println!(
-        "stability_clamped: {} points, {} stable, {} unstable, {} unresolved",
-        points.len(),
-        count(1.0),
-        count(-1.0),
-        count(0.0)
-    );
-    Ok(())
+    write_verdicts(
+        &out.join("stability_clamped.csv"),
+        "stability_clamped:",
+        &points,
+        omega_1,
+        ("energy_correction", &|f| f.energy_correction),
+    )?;
+    let exact_points: Vec<&BackbonePoint> = exact.points.iter().map(|p| &p.point).collect();
+    // The grid's damping, on periods of an odd number of steps (NaN elsewhere).
+    write_verdicts(
+        &out.join("stability_clamped_exact.csv"),
+        "stability_clamped: exact branch of",
+        &exact_points,
+        omega_1,
+        ("damping", &|f| f.damping.unwrap_or(f64::NAN)),
+    )
 }
 
-/// `stability_clamped_exact.csv`: the exact branch's points, with their verdicts, largest
-/// multipliers (NaN without a verdict) and the grid's damping (NaN where the pair is found).
-fn write_exact(out: &std::path::Path, exact: &ExactBranch, omega_1: f64) -> Res<()> {
-    let points: Vec<&BackbonePoint> = exact.points.iter().map(|p| &p.point).collect();
+/// A CSV of `points` with their verdicts: columns `period,omega_normalized,energy_normalized,
+/// verdict,max_multiplier` and `last` (its name and value; NaN without multipliers), with
+/// `verdict` 1 stable, -1 unstable, 0 unresolved and `max_multiplier` NaN without a verdict
+/// (the largest modulus of an unresolved point describes no motion). Prints the counts after
+/// `what`.
+fn write_verdicts(
+    path: &std::path::Path,
+    what: &str,
+    points: &[&BackbonePoint],
+    omega_1: f64,
+    (last, value): (&str, &dyn Fn(&Floquet) -> f64),
+) -> Res<()> {
     let column = |f: &dyn Fn(&BackbonePoint) -> f64| points.iter().map(|p| f(p)).collect();
-    let judged = |p: &BackbonePoint| {
-        let f = p.stability.as_ref()?.as_ref().ok()?;
-        f.verdict.stable().map(|_| f.clone())
-    };
     let columns: [Vec<f64>; 6] = [
         column(&|p| p.period),
         column(&|p| p.omega / omega_1),
@@ -209,8 +195,11 @@ fn write_exact(out: &std::path::Path, exact: &ExactBranch, omega_1: f64) -> Res<
             Some(false) => -1.0,
             None => 0.0,
         }),
-        column(&|p| judged(p).map_or(f64::NAN, |f| f.max_modulus)),
-        column(&|p| judged(p).and_then(|f| f.damping).unwrap_or(f64::NAN)),
+        column(&|p| {
+            let judged = floquet_of(p).filter(|f| f.verdict.stable().is_some());
+            judged.map_or(f64::NAN, |f| f.max_modulus)
+        }),
+        column(&|p| floquet_of(p).map_or(f64::NAN, value)),
     ];
     let refs: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
     let names = [
@@ -219,13 +208,13 @@ fn write_exact(out: &std::path::Path, exact: &ExactBranch, omega_1: f64) -> Res<
         "energy_normalized",
         "verdict",
         "max_multiplier",
-        "damping",
+        last,
     ];
-    let file = std::fs::File::create(out.join("stability_clamped_exact.csv"))?;
+    let file = std::fs::File::create(path)?;
     write_columns_csv(&names, &refs, std::io::BufWriter::new(file))?;
     let count = |v: f64| columns[3].iter().filter(|&&c| c == v).count();
     println!(
-        "stability_clamped: exact branch of {} points, {} stable, {} unstable, {} unresolved",
+        "{what} {} points, {} stable, {} unstable, {} unresolved",
         points.len(),
         count(1.0),
         count(-1.0),
