@@ -5,7 +5,7 @@
 use nonsmooth_modes::branches::{
     compute, BackboneOptions, Method, ModeBranches, PeriodGrid, Request,
 };
-use nonsmooth_modes::reference::clamped_bar_with_obstacle;
+use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
 use nonsmooth_modes::stability::{
     floquet, floquet_of_state, Floquet, HillOptions, StabilityError, StabilityOptions,
     UnresolvedReason, Verdict, MAX_DIMENSION, RESOLVED_DEFECT,
@@ -485,4 +485,47 @@ fn a_state_at_the_ends_of_f64_gives_a_typed_error_or_finite_numbers() {
         refused >= 1,
         "the scaled states were accepted with finite numbers"
     );
+}
+
+/// Where the grid's map has no periodic orbit because the motion's impacts fall between its
+/// steps, the reason says so with the energy the cell means remove: the Robin bar's points
+/// (a spring end makes the impact instants fall anywhere) are `OffGrid`, with a positive
+/// share removed whose energy-norm floor `1 - sqrt(1 - share)` is above the bound; the
+/// clamped bar's exact family, whose impacts fall on the steps, loses nothing.
+#[test]
+fn states_off_the_grid_say_what_the_cells_remove() {
+    let system = robin_bar_with_obstacle(0.5, 1e-3).unwrap();
+    let grid = PeriodGrid {
+        start: 8.0,
+        end: 7.0,
+        steps: 3,
+    };
+    let method = Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1));
+    let run = compute(&system, &Request::for_method(method).harmonics(20)).unwrap();
+    let basis = run.problem().basis();
+    let mut off_grid = 0;
+    for p in run.converged() {
+        let f = floquet(&system, basis, &p.x, p.omega, &options(50.0)).unwrap();
+        if let Some(UnresolvedReason::OffGrid {
+            defect,
+            projected,
+            bound,
+        }) = f.unresolved
+        {
+            assert!(defect > bound && bound == RESOLVED_DEFECT, "{f:?}");
+            assert!(1.0 - (1.0 - projected).sqrt() > bound, "{f:?}");
+            assert_eq!(f.verdict, Verdict::Unresolved);
+            off_grid += 1;
+        }
+    }
+    assert!(
+        off_grid >= 2,
+        "{off_grid} of {} points off the grid",
+        run.converged().count()
+    );
+    for period in [3.3, 3.7] {
+        let state = clamped_first_mode(1e-3, period, 1.0 / 100.0).unwrap();
+        let f = floquet_of_state(&state, period, &options(100.0)).unwrap();
+        assert!(f.unresolved.is_none(), "T = {period}: {f:?}");
+    }
 }

@@ -98,6 +98,22 @@
 //! next segment is sought after them. [`ExactBranch::end`] says why the last one ended
 //! ([`ExactEnd::Lost`], [`ExactEnd::NoSeed`]); every point found is kept.
 //!
+//! # Where the grid's map has no periodic orbit
+//!
+//! The march is exact for the cells' piecewise-constant waves, but an impact between two
+//! steps of the grid puts a breakpoint inside a cell, and the map returns the cell means of
+//! the state after the period: they remove the energy of what is finer than a cell (the
+//! march conserves it otherwise). An orbit of the map must then lose nothing, so its impacts
+//! must fall on the steps. The exact families of the clamped bar and of the free–free bar
+//! between walls do, on a grid that makes their period a whole number of steps. A spring end
+//! or bars of other travel times put the impacts anywhere, and the corrector stalls at a
+//! defect no step can lower: such a failure is
+//! [`UnresolvedReason::OffGrid`](crate::stability::UnresolvedReason::OffGrid), with the
+//! share of the energy the cell means remove (on the Robin bar's seeds, `4e-4`). This is
+//! what keeps the Robin bar and the paper's two-bar configuration without an exact branch:
+//! what would give them one is a section whose coordinates keep the breakpoints, not a
+//! better corrector.
+//!
 //! # The verdict
 //!
 //! One monodromy per point, at the corrected orbit: its eigenvalues give the verdict exactly

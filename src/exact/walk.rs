@@ -11,7 +11,7 @@ use crate::stability::coordinates::Coordinates;
 use crate::stability::monodromy::PeriodMap;
 use crate::stability::shooting::{Corrected, PseudoInverse};
 use crate::stability::{
-    correction_failure, open_section, Floquet, StabilityError, UnresolvedReason, Verdict,
+    correction_failure_on, open_section, Floquet, StabilityError, UnresolvedReason, Verdict,
     RESOLVED_DEFECT,
 };
 use crate::verify::State;
@@ -218,7 +218,8 @@ impl Walker<'_> {
         let corrected = self
             .corrected(&outcome, &base, energy)
             .map_err(LossReason::Error)?;
-        if let Some(reason) = correction_failure(&corrected, stability) {
+        let failure = correction_failure_on(&map, &corrected, stability);
+        if let Some(reason) = failure.map_err(LossReason::Error)? {
             return Err(LossReason::Correction(reason));
         }
         self.finish(j, outcome, (&base, energy), (seed.label, None, true))
@@ -324,7 +325,8 @@ impl Walker<'_> {
                 let corrected = self
                     .corrected(&outcome, &prediction, predicted_energy)
                     .map_err(LossReason::Error)?;
-                let reason = correction_failure(&corrected, &self.options.stability);
+                let reason = correction_failure_on(&map, &corrected, &self.options.stability)
+                    .map_err(LossReason::Error)?;
                 return Err(LossReason::Correction(reason.unwrap_or(
                     UnresolvedReason::NotPeriodic {
                         defect: outcome.defect,

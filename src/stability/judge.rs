@@ -44,6 +44,32 @@ pub(crate) fn correction_failure(
     }
 }
 
+/// [`correction_failure`], with a state that is not periodic because the grid cannot hold
+/// its period's waves named [`UnresolvedReason::OffGrid`]: where the share of the energy the
+/// cell means remove after one period of the best state puts its defect (energy norm) above
+/// [`RESOLVED_DEFECT`] whatever the correction does next. One march of `map`.
+pub(crate) fn correction_failure_on(
+    map: &PeriodMap,
+    corrected: &Corrected,
+    options: &StabilityOptions,
+) -> Result<Option<UnresolvedReason>, StabilityError> {
+    let failure = correction_failure(corrected, options);
+    let Some(UnresolvedReason::NotPeriodic { defect, bound, .. }) = failure else {
+        return Ok(failure);
+    };
+    let projected = map.projected_share(&corrected.x)?;
+    let floor = 1.0 - (1.0 - projected.min(1.0)).sqrt();
+    Ok(if floor > bound {
+        Some(UnresolvedReason::OffGrid {
+            defect,
+            projected,
+            bound,
+        })
+    } else {
+        failure
+    })
+}
+
 /// The multipliers and verdict of the state `corrected` of `map`, from `monodromy` (at the
 /// corrected state where `failure` is `None`, at the point's own state otherwise), without
 /// the `spurious` exact multipliers 1 of the coordinates. Where the trivial pair is missed,

@@ -75,6 +75,12 @@
 //! - [`UnresolvedReason::NotPeriodic`]: the correction ended above [`RESOLVED_DEFECT`]
 //!   (the defect, and the iterations taken of those allowed: fewer means it stalled, no
 //!   step along the Newton direction decreasing the defect);
+//! - [`UnresolvedReason::OffGrid`] instead where that state's period ends with waves finer
+//!   than a cell: its impacts fall between the grid's steps, the cell means the map returns
+//!   remove a share of the energy (given), and so its defect cannot reach the bound. The
+//!   clamped bar's and the free–free bar's families impact on the steps of a grid that makes
+//!   their period whole; a spring end, or bars of other travel times, put the impacts
+//!   anywhere (the Robin bar's points all end here);
 //! - [`UnresolvedReason::EnergyMoved`], [`UnresolvedReason::DisplacementMoved`]: the
 //!   periodic orbit reached is another motion (the change and the bound);
 //! - [`UnresolvedReason::TrivialPairMissing`]: the pair's distance from 1, the perturbation
@@ -164,7 +170,7 @@ use crate::verify::{
     SpringUpdate, State, VerifyError,
 };
 use coordinates::Coordinates;
-pub(crate) use judge::{correction_failure, judge};
+pub(crate) use judge::{correction_failure_on, judge};
 use monodromy::PeriodMap;
 
 /// The most rows of a monodromy matrix: its eigenvalues then take seconds and its storage
@@ -379,7 +385,7 @@ pub fn floquet_of_state(
         options.corrections,
         PERIODIC_DEFECT,
     )?;
-    let failure = correction_failure(&corrected, options);
+    let failure = correction_failure_on(&map, &corrected, options)?;
     // A point whose correction failed keeps the multipliers of its own state: those of a
     // partial correction depend on the path the iterations took.
     let monodromy = match at_corrected {

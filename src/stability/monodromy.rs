@@ -46,6 +46,32 @@ impl PeriodMap<'_> {
         Ok(())
     }
 
+    /// The share of the energy of `v` that the cell means of its state after one period
+    /// remove: zero where every breakpoint of the waves then lies on the cells' edges (the
+    /// march conserves the energy of its pieces exactly, up to the merges it reports).
+    pub(crate) fn projected_share(&self, v: &[f64]) -> Result<f64, StabilityError> {
+        let state = self
+            .coordinates
+            .to_state(self.template.model(), self.template.grid(), v)?;
+        let start = state.energy();
+        let end = advance(
+            &state,
+            self.period,
+            &MarchOptions {
+                spring: self.spring,
+                snapshot_every: 0,
+            },
+        )?;
+        let mut out = Vec::new();
+        self.coordinates.of_snapshot(&end.snapshot(), &mut out);
+        let means = self.coordinates.energy(self.template, &out)?;
+        Ok(if start > 0.0 {
+            ((end.energy() - means) / start).max(0.0)
+        } else {
+            0.0
+        })
+    }
+
     /// Column `j` of `dP/dX` at `base` by central differences of `step`, into `scratch[1]`.
     fn column(
         &self,

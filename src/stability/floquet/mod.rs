@@ -444,6 +444,21 @@ pub enum UnresolvedReason {
         /// taken means that no step along the Newton direction decreased the defect.
         corrections: usize,
     },
+    /// The correction ended above the bound at a state whose period ends with waves finer
+    /// than the grid's cells: impacts between the grid's instants put breakpoints inside
+    /// cells, and the cell means the map returns remove their energy (the march itself
+    /// conserves it). A state that loses the share `projected` of its energy over a period
+    /// has a defect of at least `1 - sqrt(1 - projected)` in the energy norm, so no correction
+    /// of it reaches the bound: the grid's map has no periodic orbit there, and finer cells
+    /// lower the loss (about in proportion to the step).
+    OffGrid {
+        /// The defect of the best state reached.
+        defect: f64,
+        /// The share of its energy the cell means at the end of its period remove.
+        projected: f64,
+        /// [`RESOLVED_DEFECT`](super::RESOLVED_DEFECT).
+        bound: f64,
+    },
     /// The periodic orbit reached has another energy than the point: another motion.
     EnergyMoved {
         /// `(E - E0) / E0`.
@@ -504,6 +519,16 @@ impl std::fmt::Display for UnresolvedReason {
                 f,
                 "no periodic orbit of the grid's map: defect {defect:.1e} after all \
                  {corrections} correction iterations (bound {bound:.0e})"
+            ),
+            UnresolvedReason::OffGrid {
+                defect,
+                projected,
+                bound,
+            } => write!(
+                f,
+                "no periodic orbit of the grid's map: impacts between its steps leave waves \
+                 finer than a cell whose means remove {projected:.1e} of the energy each period \
+                 (defect {defect:.1e} for a bound of {bound:.0e})"
             ),
             UnresolvedReason::EnergyMoved { change, bound } => write!(
                 f,

@@ -208,6 +208,14 @@ fn reasons_read_as_one_sentence_with_their_numbers() {
             &["4.0e-3", "all 8"][..],
         ),
         (
+            UnresolvedReason::OffGrid {
+                defect: 2.5e-5,
+                projected: 5e-8,
+                bound: 1e-8,
+            },
+            &["2.5e-5", "5.0e-8", "1e-8", "finer than a cell"][..],
+        ),
+        (
             UnresolvedReason::EnergyMoved {
                 change: -0.12,
                 bound: 0.05,
