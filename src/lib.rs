@@ -97,6 +97,7 @@ pub mod stability;
 pub mod strategies;
 pub mod sweep;
 pub mod system;
+mod verdict;
 /// Exact time-domain integration of bar assemblies (d'Alembert on a grid with `dx = c dt`,
 /// impacts resolved inside the step) and the periodicity check of computed modes.
 pub mod verify;

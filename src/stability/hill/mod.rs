@@ -60,7 +60,7 @@
 
 mod matrix;
 
-use super::floquet::{Crossing, Multiplier, Verdict};
+use super::floquet::Multiplier;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError, StabilityError};
 use crate::forced::ForcedSystem;
@@ -68,6 +68,8 @@ use crate::fourier::{period_of_frequency, Basis};
 use crate::modal::inputs::{check_finite, check_frequency_of};
 use crate::solve::{Problem, Structured};
 use crate::system::{shift_of, BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
+use crate::verdict::Crossing;
+use crate::verdict::Verdict;
 use faer::linalg::solvers::Solve;
 use faer::{c64, Col};
 use matrix::HillMatrix;
