@@ -15,8 +15,8 @@ use crate::continuation::{
 use crate::error::{BadRange, ContinuationError, Error};
 use crate::fourier::frequency_of_period;
 use crate::modal::energy::energy;
-use crate::modal::inputs::check_frequency_of;
 use crate::solve::NonlinearSolver;
+use crate::system::inputs::check_frequency_of;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
 use std::ops::ControlFlow;

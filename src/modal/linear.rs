@@ -11,7 +11,7 @@ use crate::error::{Error, SettingsError, SolveError};
 use crate::fourier::{Basis, CosineBasis};
 use crate::linalg::{determinant_sign_small, singular_values_small, svd_small, DenseMatrix, Lu};
 use crate::modal::energy::{energy_of, Conditions};
-use crate::modal::inputs::check_frequency_of;
+use crate::system::inputs::check_frequency_of;
 use crate::system::rows::{dot, HarmonicRows, RowsScratch};
 use crate::system::spectra::ScanKey;
 use crate::system::{BarSystem, NonsmoothSystem};

@@ -10,6 +10,7 @@
 pub mod assembly;
 mod condense;
 pub mod family;
+pub(crate) mod inputs;
 mod layout;
 mod phase;
 pub(crate) use phase::shift_of;

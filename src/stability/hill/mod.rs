@@ -61,12 +61,13 @@
 mod matrix;
 
 use super::floquet::Multiplier;
+use crate::check::check_finite;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError, StabilityError};
 use crate::forced::ForcedSystem;
 use crate::fourier::{period_of_frequency, Basis};
-use crate::modal::inputs::{check_finite, check_frequency_of};
 use crate::solve::{Problem, Structured};
+use crate::system::inputs::check_frequency_of;
 use crate::system::{shift_of, BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use crate::verdict::Crossing;
 use crate::verdict::Verdict;
