@@ -12,6 +12,7 @@ mod condense;
 pub mod family;
 pub(crate) mod inputs;
 mod layout;
+pub(crate) mod linear;
 mod phase;
 pub(crate) use phase::shift_of;
 pub mod problem;
