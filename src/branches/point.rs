@@ -228,7 +228,7 @@ pub enum CheckOutcome {
     /// The march could not run or complete (its cost or memory bound, a state it cannot
     /// build): the error.
     NotRun(
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] VerifyError,
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::error::display"))] VerifyError,
     ),
 }
 
