@@ -8,6 +8,7 @@ pub mod diagnostics;
 pub(crate) mod drift;
 pub mod energy;
 pub mod field;
+pub(crate) mod full_basis;
 pub mod linear;
 pub mod signature;
 

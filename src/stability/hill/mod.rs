@@ -399,7 +399,7 @@ fn full_state(x: &[f64], m: usize, dimension: usize) -> Result<Vec<f64>, Setting
     let state = if x.len() == dimension {
         x.to_vec()
     } else if x.len() == per * (m + 1) {
-        crate::branches::to_full_basis(x, m)?
+        crate::modal::full_basis::to_full_basis(x, m)?
     } else {
         return Err(SettingsError::Length {
             what: "state (cosine or full basis)",
