@@ -91,6 +91,7 @@ pub mod reference;
 pub mod solution;
 pub mod solve;
 pub mod stability;
+mod status;
 /// Proptest strategies for bars, frequencies, Helmholtz coefficients, the paper's systems and
 /// periods, for property tests of the crate's identities (feature `proptest`).
 #[cfg(feature = "proptest")]
