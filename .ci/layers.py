@@ -36,6 +36,8 @@ USE = re.compile(r"\b((?:pub(?:\s*\([^)]*\))?\s+)?)use\s+([^;]*);")
 QUALIFIED = re.compile(r"(?<![\w:])((?:crate|super|self)(?:\s*::\s*\w+)+)")
 SERDE_PATH = re.compile(r"\b(?:serialize_with|deserialize_with|with)\s*=\s*\"([\w:]+)\"")
 CFG_TEST = re.compile(r"#\[cfg\(test\)\]")
+RAW = re.compile(r'b?r(#*)"')
+CHAR = re.compile(r"'(?:\\(?:u\{[0-9a-fA-F]+\}|x[0-9a-fA-F]{2}|.)|[^\\'\n])'")
 
 
 def blank(text):
@@ -69,12 +71,14 @@ def blank(text):
                     j += 1
             wipe(i, j)
             i = j
-        elif re.match(r'b?r(#*)"', text[i : i + 40]) and (i == 0 or not (text[i - 1].isalnum() or text[i - 1] == "_")):
-            m = re.match(r'b?r(#*)"', text[i:])
+        elif c in "br" and not (i and (text[i - 1].isalnum() or text[i - 1] == "_")) and RAW.match(
+            text, i
+        ):
+            m = RAW.match(text, i)
             close = '"' + m.group(1)
-            j = text.find(close, i + m.end())
+            j = text.find(close, m.end())
             j = n if j < 0 else j + len(close)
-            wipe(i + m.end(), j - len(close))
+            wipe(m.end(), j - len(close))
             i = j
         elif c == '"':
             j = i + 1
@@ -83,10 +87,10 @@ def blank(text):
             wipe(i + 1, j)
             i = j + 1
         elif c == "'":
-            m = re.match(r"'(?:\\(?:u\{[0-9a-fA-F]+\}|x[0-9a-fA-F]{2}|.)|[^\\'\n])'", text[i:])
+            m = CHAR.match(text, i)
             if m:
-                wipe(i + 1, i + m.end() - 1)
-                i += m.end()
+                wipe(i + 1, m.end() - 1)
+                i = m.end()
             else:
                 i += 1  # a lifetime or a label
         else:
@@ -144,7 +148,8 @@ def matching_bracket(text, i):
 
 
 def split_tree(tree):
-    """`a::{b, c::{d as e, *}}` -> [(['a','b'], 'b'), (['a','c','d'], 'e'), (['a','c','*'], None)]."""
+    """A use tree as (path, bound name) pairs: `a::{b, c::{d as e, *}}` ->
+    [(['a', 'b'], 'b'), (['a', 'c', 'd'], 'e'), (['a', 'c', '*'], None)]."""
     tree = re.sub(r"\s+", " ", tree).strip()
     m = re.match(r"^(.*?)\{(.*)\}$", tree)
     if not m:
@@ -198,7 +203,8 @@ class File:
                 depth -= 1
             elif depth == 0:
                 self.defs.add(m.group(1) or m.group(2))
-        # Names bound by `use`: name -> (absolute path, line, is a re-export); globs apart.
+        # Every `use` path with its line and whether it is a re-export; the names it binds
+        # (name -> absolute path) and its globs, for resolving paths through this file.
         self.bound, self.globs, self.uses = {}, [], []
         for m in USE.finditer(self.code):
             spans.append((m.start(), m.end()))
@@ -222,9 +228,11 @@ class File:
             path = [s.strip() for s in m.group(1).split("::")]
             self.paths.append((self.absolute(path), self.line_of(m.start())))
         if self.children:
-            child = re.compile(r"(?<![\w:])(" + "|".join(sorted(self.children)) + r")\s*::\s*(\w+)")
+            names = "|".join(sorted(self.children))
+            child = re.compile(r"(?<![\w:])(" + names + r")\s*::\s*(\w+)")
             for m in child.finditer(outside):
-                self.paths.append((list(module) + [m.group(1), m.group(2)], self.line_of(m.start())))
+                path = list(module) + [m.group(1), m.group(2)]
+                self.paths.append((path, self.line_of(m.start())))
         for offset, text_path in self.serde:
             self.paths.append((self.absolute(text_path.split("::")), self.line_of(offset)))
 
