@@ -6,6 +6,15 @@
 use crate::end::{BarId, EndRef};
 use thiserror::Error;
 
+/// Serialises a value by its `Display` text (an error inside a serialised end reason).
+#[cfg(feature = "serde")]
+pub(crate) fn display<T: std::fmt::Display, S: serde::Serializer>(
+    value: &T,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    serializer.collect_str(value)
+}
+
 /// Errors raised while describing a bar system (bars, boundary conditions, assembly).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]

@@ -8,15 +8,6 @@ use crate::branches::BackbonePoint;
 use crate::continuation::Event;
 use std::io::{self, Write};
 
-/// Serialises a value by its `Display` text (an error inside a serialised end reason).
-#[cfg(feature = "serde")]
-pub(crate) fn display<T: std::fmt::Display, S: serde::Serializer>(
-    value: &T,
-    serializer: S,
-) -> Result<S::Ok, S::Error> {
-    serializer.collect_str(value)
-}
-
 /// Header of [`write_backbone_csv`].
 pub const BACKBONE_CSV_HEADER: &str =
     "step,period,omega,energy,energy_normalized,converged,status,residual_norm,iterations,step_size,event";

@@ -91,12 +91,14 @@ pub mod reference;
 pub mod solution;
 pub mod solve;
 pub mod stability;
+mod status;
 /// Proptest strategies for bars, frequencies, Helmholtz coefficients, the paper's systems and
 /// periods, for property tests of the crate's identities (feature `proptest`).
 #[cfg(feature = "proptest")]
 pub mod strategies;
 pub mod sweep;
 pub mod system;
+mod verdict;
 /// Exact time-domain integration of bar assemblies (d'Alembert on a grid with `dx = c dt`,
 /// impacts resolved inside the step) and the periodicity check of computed modes.
 pub mod verify;

@@ -25,6 +25,7 @@
 //! ```
 
 use crate::bar::EndRef;
+use crate::check::check_finite;
 use crate::error::SettingsError;
 use crate::fourier::{period_of_frequency, Basis, CosineBasis};
 use crate::modal::diagnostics::{
@@ -33,9 +34,9 @@ use crate::modal::diagnostics::{
 };
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
-use crate::modal::inputs::{check_finite, check_motion};
 use crate::modal::linear::grazing_energy;
 use crate::modal::signature::{contact_intervals, subharmonic_share};
+use crate::system::inputs::check_motion;
 use crate::system::{BarSystem, NonsmoothSystem};
 use crate::verify::{periodicity_check, PeriodicityOptions, PeriodicityReport, VerifyError};
 

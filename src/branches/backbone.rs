@@ -1,6 +1,8 @@
 //! Backbone curves: a nonsmooth-mode branch computed by sequential continuation in the
 //! period, with energies normalised by the first grazing energy.
 
+pub use crate::status::MAX_CONSECUTIVE_FAILURES;
+
 use crate::branches::escape::{EscapingArclength, StallEscape};
 use crate::branches::point::{Backbone, BackbonePoint, PointStatus, Timescale};
 use crate::branches::start::{
@@ -15,8 +17,8 @@ use crate::continuation::{
 use crate::error::{BadRange, ContinuationError, Error};
 use crate::fourier::frequency_of_period;
 use crate::modal::energy::energy;
-use crate::modal::inputs::check_frequency_of;
 use crate::solve::NonlinearSolver;
+use crate::system::inputs::check_frequency_of;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 use std::cell::RefCell;
 use std::ops::ControlFlow;
@@ -104,10 +106,6 @@ impl BackboneOptions {
 /// The energy below which a converged point counts as the state of rest, as a fraction of
 /// `E_g` (the default [`BackboneOptions::trivial_energy`]).
 pub const TRIVIAL_ENERGY: f64 = 1e-6;
-
-/// Consecutive failed steps after which a period grid stops, stalled (the default
-/// [`BackboneOptions::max_consecutive_failures`]).
-pub const MAX_CONSECUTIVE_FAILURES: usize = 40;
 
 impl BackboneOptions {
     /// The library's settings of a period grid `grid` for NSM `mode` sub `subharmonic`:

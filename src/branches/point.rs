@@ -1,9 +1,11 @@
 //! The points of a backbone and what a backbone run returns: every point it computed, each
 //! with its status, and the reason it ended. A run that stalls or is stopped keeps its points.
 
+pub use crate::status::PointStatus;
+
 use crate::branches::continuity::OnBranch;
 use crate::continuation::{EndReason, Event, Point};
-use crate::error::{ContinuationError, Error, SettingsError, SolveError};
+use crate::error::{ContinuationError, Error, SettingsError};
 use crate::fourier::{frequency_of_period, period_of_frequency, Basis};
 use crate::modal::{Character, Label};
 use crate::solution::Solution;
@@ -228,7 +230,7 @@ pub enum CheckOutcome {
     /// The march could not run or complete (its cost or memory bound, a state it cannot
     /// build): the error.
     NotRun(
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] VerifyError,
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::error::display"))] VerifyError,
     ),
 }
 
@@ -314,74 +316,6 @@ impl Timescale {
     pub(crate) fn of_frequency(omega: f64) -> Self {
         let period = period_of_frequency(omega);
         Self { period, omega }
-    }
-}
-
-/// What became of one step of a backbone.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-#[non_exhaustive]
-pub enum PointStatus {
-    /// The solver converged to a motion of the branch.
-    Converged,
-    /// The solver failed; the point holds its last iterate.
-    SolverFailed(SolveError),
-    /// The solver converged to a motion whose energy is below the backbone's trivial-energy
-    /// floor ([`BackboneOptions::trivial_energy`](crate::branches::BackboneOptions::trivial_energy)
-    /// times `E_g`): the state of rest, which is not a point of the branch.
-    CollapsedToRest,
-    /// The solver converged to a motion the backbone's acceptance test refuses (an
-    /// energy-level backbone refuses a frequency that is not positive or beyond the
-    /// problem's [`max_frequency`](crate::system::Discretization::max_frequency)).
-    Rejected,
-    /// The solver converged, but the motion's energy `E` or its normalisation `E / E_g` is
-    /// not finite (NaN or infinite, left in the point): the energy of the motion leaves the
-    /// range of `f64` (a bar length or frequency near the limits of what the constructors
-    /// accept), or the system at a parameter value of
-    /// [`parameter_branch`](crate::branches::parameter_branch) has no grazing energy `E_g`
-    /// ([`SettingsError::GrazingEnergyOutOfRange`]). A point without a finite energy is not
-    /// a point of the backbone.
-    NonFiniteEnergy,
-}
-
-impl PointStatus {
-    /// The status of a point of energy `energy` and `E / E_g` `energy_normalized`: a
-    /// converged one whose energy is not finite is [`PointStatus::NonFiniteEnergy`].
-    pub(crate) fn with_energy(self, energy: f64, energy_normalized: f64) -> Self {
-        match self {
-            Self::Converged if !(energy.is_finite() && energy_normalized.is_finite()) => {
-                Self::NonFiniteEnergy
-            }
-            status => status,
-        }
-    }
-
-    /// The status of a continuation point of a backbone, whose acceptance test is the
-    /// trivial-energy floor.
-    pub fn of(point: &Point) -> Self {
-        Self::refused_as(point, Self::CollapsedToRest)
-    }
-
-    /// The status of a continuation point, `refused` where the acceptance test refused a
-    /// converged solution.
-    pub(crate) fn refused_as(point: &Point, refused: Self) -> Self {
-        match (&point.error, point.converged) {
-            (_, true) => Self::Converged,
-            (Some(e), false) => Self::SolverFailed(e.clone()),
-            (None, false) => refused,
-        }
-    }
-
-    /// A short label for tables: `converged`, `solver-failed`, `collapsed-to-rest`,
-    /// `rejected` or `non-finite-energy`.
-    pub fn label(&self) -> &'static str {
-        match self {
-            Self::Converged => "converged",
-            Self::SolverFailed(_) => "solver-failed",
-            Self::CollapsedToRest => "collapsed-to-rest",
-            Self::Rejected => "rejected",
-            Self::NonFiniteEnergy => "non-finite-energy",
-        }
     }
 }
 

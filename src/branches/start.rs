@@ -349,7 +349,7 @@ pub(crate) fn backbone_start<S: NonlinearSolver>(
 ) -> Result<BackboneStart, Error> {
     let mut problem = NonsmoothSystem::new(system, settings)?;
     check_trivial_energy(trivial_energy)?;
-    crate::modal::inputs::check_frequency_of(&problem, omega)?;
+    crate::system::inputs::check_frequency_of(&problem, omega)?;
     let (e_g, seed) = grazing_and_seed(&mut problem, mode, subharmonic, omega)?;
     let (x, omega) = usable_start(
         &mut problem,

@@ -120,7 +120,7 @@ pub enum EndReason {
     /// ([`Arclength::switch_branch`](crate::continuation::Arclength::switch_branch)).
     SwitchFailed {
         /// Why.
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))]
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::error::display"))]
         error: Box<ContinuationError>,
     },
 }

@@ -41,8 +41,8 @@ use crate::error::SolveError;
 use crate::fourier::{frequency_of_period, period_of_frequency};
 use crate::linalg::DenseMatrix;
 use crate::solve::{Problem, Structured};
-use crate::stability::Crossing;
-use crate::stability::Verdict;
+use crate::verdict::Crossing;
+use crate::verdict::Verdict;
 
 /// A family of square systems `F(x, lambda) = 0` in one scalar parameter: a [`Problem`] at
 /// its current parameter, plus the parameter and the derivative in it.

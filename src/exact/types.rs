@@ -48,7 +48,8 @@ pub enum LossReason {
     Unreached,
     /// The map could not be marched or its matrices decomposed.
     Error(
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::io::display"))] StabilityError,
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::error::display"))]
+        StabilityError,
     ),
 }
 

@@ -1,8 +1,8 @@
 //! One point of a response curve, measured on the forced system.
 
-use crate::branches::PointStatus;
 use crate::continuation::{ContinuationProblem, Point};
 use crate::forced::ForcedSystem;
+use crate::status::PointStatus;
 
 /// One point of a response curve.
 #[derive(Debug, Clone, PartialEq)]

@@ -2,7 +2,6 @@
 //! natural-parameter or pseudo-arclength (through folds), from the open-contact linear
 //! response at the first frequency.
 
-use crate::branches::MAX_CONSECUTIVE_FAILURES;
 use crate::continuation::{
     linspace, ArclengthOptions, ArclengthScale, Branch, ContinuationProblem, Direction, EndReason,
     Ends, Predictor, Range, Sequential, SequentialOptions, Step,
@@ -14,6 +13,7 @@ use crate::forced::{ForcedSystem, Forcing};
 use crate::fourier::check_memory;
 use crate::modal::grazing_energy;
 use crate::solve::{norm, Problem, Solver};
+use crate::status::MAX_CONSECUTIVE_FAILURES;
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use std::ops::ControlFlow;
 

@@ -1,13 +1,13 @@
 //! The forced, damped harmonic-balance system `F(x; Omega) = 0` in the full Fourier basis.
 
 use crate::bc::{LawSamples, Observable};
+use crate::check::check_frequency_named;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError, SolveError};
 use crate::forced::excitation::{Damping, Driven, Excitation};
 use crate::forced::rows::{real_form, DampedRows};
 use crate::fourier::{check_memory, Basis, SineCosineBasis};
 use crate::linalg::{DenseMatrix, Lu};
-use crate::modal::inputs::check_frequency_named;
 use crate::solve::{Problem, Structured};
 use crate::system::problem::selection::{Selection, Shape};
 use crate::system::problem::{

@@ -6,9 +6,10 @@
 //! Both are post-processing of one point, like [`mod@crate::modal::signature`] which they
 //! build on: one law history per law and `O(m)` flops for the energies.
 
+use crate::check::check_finite;
+use crate::check::check_frequency;
 use crate::error::SettingsError;
 use crate::fourier::Basis;
-use crate::modal::inputs::{check_finite, check_frequency};
 use crate::modal::signature::{contact_and_gap_samples, harmonic_energies_by_bar, periodic_runs};
 use crate::system::NonsmoothSystem;
 use std::fmt;

@@ -6,11 +6,12 @@
 //! instants too.
 
 use crate::bar::{End, EndRef};
+use crate::check::check_finite;
 use crate::error::SettingsError;
 use crate::fourier::{check_memory, period_of_frequency, Basis};
 use crate::modal::energy::energy_at;
 use crate::modal::field::FieldEvaluator;
-use crate::modal::inputs::{check_finite, check_motion};
+use crate::system::inputs::check_motion;
 use crate::system::rows::{dot, HarmonicRows};
 use crate::system::{BarSystem, NonsmoothSystem};
 use std::f64::consts::PI;

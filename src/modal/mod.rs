@@ -8,16 +8,16 @@ pub mod diagnostics;
 pub(crate) mod drift;
 pub mod energy;
 pub mod field;
-pub(crate) mod inputs;
+pub(crate) mod full_basis;
 pub mod linear;
 pub mod signature;
 
+pub use crate::check::MIN_FREQUENCY;
 pub use character::{character, label, nearest_mode, Character, Label, GRAZING_TOLERANCE};
 pub use diagnostics::{diagnose, displacement_grid, end_history, law_history, PointDiagnostics};
 pub use drift::{check_held, drifting_bars};
 pub use energy::{energy, energy_at, energy_gradient};
 pub use field::{FieldEvaluator, FieldValue};
-pub use inputs::MIN_FREQUENCY;
 pub use linear::{
     branch_seed, grazing_energy, grazing_energy_of, natural_frequencies, open_mode,
     rigid_body_modes, seed_from_mode, ContactState, LinearMode,

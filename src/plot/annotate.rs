@@ -3,9 +3,9 @@
 //! where it stays in the plot and covers no earlier label nor the legend. A label set farther
 //! than the first ring is tied to its point by a thin leader line.
 
+use super::canvas::{draw_err, Area, PlotError, FONT};
 use super::place::{text_width, PixelBox};
 use super::types::Annotation;
-use super::{draw_err, Area, PlotError, FONT};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 

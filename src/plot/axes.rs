@@ -1,7 +1,7 @@
 //! Axes: data ranges and their padding, tick values and labels of linear and logarithmic
 //! axes, and the splitting of series into runs of points the axes can show.
 
-use super::PlotError;
+use super::canvas::PlotError;
 use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 

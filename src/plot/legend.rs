@@ -6,9 +6,9 @@
 //! covers data only when its caller fixed its position, or when it is too large for a strip
 //! beside or below the plot ([`least_covered_box`]).
 
+use super::canvas::{draw_err, Area, PlotError, FONT};
 use super::place::{text_width, Drawn, PixelBox};
 use super::types::{LegendPosition, LineKind, Marker, Series};
-use super::{draw_err, Area, PlotError, FONT};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 

@@ -4,12 +4,12 @@
 
 use super::annotate;
 use super::axes::{axis_range, axis_tick, clip_segments, finite_range, log_axis, segments, shown};
+use super::canvas::{draw_err, panel_builder, Area, PlotError, FONT};
 use super::legend::{
     draw_legend, fixed_box, free_box, least_covered_box, legend_size, Entry, INSET,
 };
 use super::place::{Drawn, PixelBox};
 use super::types::{LegendPosition, LineKind, LinePanel, Marker, Series, PALETTE};
-use super::{draw_err, panel_builder, Area, PlotError, FONT};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::CoordTranslate;
 use plotters::prelude::*;

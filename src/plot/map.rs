@@ -2,9 +2,9 @@
 //! curves, and the colour bar beside it.
 
 use super::axes::{clip_segments, finite_range, padded, segments, tick};
+use super::canvas::{draw_err, panel_builder, Area, PlotError, FONT};
 use super::lines::draw_run;
 use super::types::{MapPanel, Rgb, PALETTE};
-use super::{draw_err, panel_builder, Area, PlotError, FONT};
 use plotters::prelude::*;
 
 /// Colour of a normalised value: diverging blue–white–red on `s in [-1, 1]`, or a sequential

@@ -29,11 +29,13 @@
 //! # Ok::<(), nonsmooth_modes::plot::PlotError>(())
 //! ```
 
-// Split by plot kind: the data types (`types`), axis ranges and ticks (`axes`), line panels
-// (`lines`), colour maps (`map`), bar snapshots (`snapshots`), and the panel builders with the
-// one-call helpers (`helpers`). Everything public is re-exported here.
+// Split by plot kind: the error and what every panel draws on (`canvas`), the data types
+// (`types`), axis ranges and ticks (`axes`), line panels (`lines`), colour maps (`map`), bar
+// snapshots (`snapshots`), and the panel builders with the one-call helpers (`helpers`).
+// Everything public is re-exported here.
 mod annotate;
 mod axes;
+mod canvas;
 mod helpers;
 mod legend;
 mod lines;
@@ -44,6 +46,7 @@ mod stability;
 mod svg;
 mod types;
 
+pub use canvas::PlotError;
 pub use helpers::{
     backbone_panel, histories_panel, plot_backbone, plot_histories, plot_snapshots,
     plot_space_time, plot_xy, space_time_panel, ENERGY_LABEL, FREQUENCY_LABEL,
@@ -55,54 +58,10 @@ pub use types::{
     SpaceTimeField, PALETTE,
 };
 
+use canvas::draw_err;
+use canvas::FONT;
 use plotters::prelude::*;
 use std::path::Path;
-use thiserror::Error;
-
-/// Errors of the plotting functions.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum PlotError {
-    /// The drawing backend failed (typically an I/O error writing the file).
-    #[error("drawing failed: {0}")]
-    Draw(String),
-    /// The data cannot be drawn as asked (mismatched lengths, empty grids, bad layout).
-    #[error("invalid plot data: {what}: {reason}")]
-    InvalidData {
-        /// Which input.
-        what: &'static str,
-        /// What is wrong with it.
-        reason: String,
-    },
-}
-
-fn draw_err<E: std::fmt::Display>(e: E) -> PlotError {
-    PlotError::Draw(e.to_string())
-}
-
-/// A drawing area of the SVG backend: the whole figure or one panel of it.
-type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
-
-/// Font family of every text element.
-const FONT: &str = "sans-serif";
-
-/// The chart builder of a panel on `area`: 12-pixel margins, 46 pixels of labels under the
-/// horizontal axis and `y_label_area` pixels left of the vertical one, and `title` (if not
-/// empty) above.
-fn panel_builder<'a, 'b>(
-    area: &'a Area<'b>,
-    title: &str,
-    y_label_area: u32,
-) -> ChartBuilder<'a, 'static, SVGBackend<'b>> {
-    let mut builder = ChartBuilder::on(area);
-    builder
-        .margin(12)
-        .x_label_area_size(46)
-        .y_label_area_size(y_label_area);
-    if !title.is_empty() {
-        builder.caption(title, (FONT, 20));
-    }
-    builder
-}
 
 /// Writes `figure` as an SVG file at `path`.
 ///

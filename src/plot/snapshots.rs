@@ -2,8 +2,8 @@
 //! ([`Placement`], [`PlacedBar`]) and the line panel of its profiles at a few instants.
 
 use super::axes::tick;
+use super::canvas::PlotError;
 use super::types::{LegendPosition, LinePanel, Rgb, Series, SpaceTimeField};
-use super::PlotError;
 
 /// How a bar is drawn in the common frame of a snapshot plot.
 #[derive(Debug, Clone, Copy, PartialEq)]

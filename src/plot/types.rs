@@ -1,7 +1,7 @@
 //! The data a figure is made of: colours, series of points and how they are drawn, line and
 //! map panels, the figure that lays them out, and the space-time field of one bar.
 
-use super::PlotError;
+use super::canvas::PlotError;
 use plotters::style::RGBColor;
 
 /// An RGB colour.

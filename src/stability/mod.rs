@@ -156,7 +156,8 @@ pub(crate) mod monodromy;
 pub(crate) mod shooting;
 
 pub use crate::error::StabilityError;
-pub use floquet::{Crossing, Floquet, Multiplier, UnresolvedReason, Verdict};
+pub use crate::verdict::{Crossing, Verdict};
+pub use floquet::{Floquet, Multiplier, UnresolvedReason};
 pub use hill::{
     hill, Exponent, HillOptions, HillSpectrum, HillUnresolved, HILL_RESIDUAL, MAX_HILL_DIMENSION,
     MIN_ALIGNMENT,

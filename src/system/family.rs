@@ -17,8 +17,8 @@
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, ModelError};
 use crate::linalg::DenseMatrix;
-use crate::modal::inputs::check_frequency_of;
 use crate::solve::{Problem, Structured};
+use crate::system::inputs::check_frequency_of;
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
 
 /// A one-parameter family of bar systems.

@@ -10,7 +10,9 @@
 pub mod assembly;
 mod condense;
 pub mod family;
+pub(crate) mod inputs;
 mod layout;
+pub(crate) mod linear;
 mod phase;
 pub(crate) use phase::shift_of;
 pub mod problem;

@@ -4,8 +4,8 @@
 use super::wave::{distance_squared, Resolution, Wave};
 use super::{Condition, Grid, Model, VerifyError};
 use crate::bar::{End, EndRef};
+use crate::check::check_frequency;
 use crate::fourier::Basis;
-use crate::modal::inputs::check_frequency;
 use crate::modal::FieldEvaluator;
 use crate::system::BarSystem;
 use std::cell::RefCell;

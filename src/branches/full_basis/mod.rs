@@ -17,15 +17,16 @@ use crate::continuation::{
 };
 use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, Basis, SineCosineBasis};
+use crate::modal::full_basis::share_about;
+use crate::modal::full_basis::symmetry_instant_of;
 use crate::modal::{branch_seed, energy, grazing_energy, open_mode};
 use crate::system::{BarSystem, HarmonicBalanceSettings, NonsmoothSystem, PhaseLocked};
-use state::{share_about, symmetry_instant_of};
 use std::cell::RefCell;
 use std::ops::ControlFlow;
 
-mod state;
-
-pub use state::{asymmetry, shift_origin, symmetry_instant, to_full_basis, with_harmonics};
+pub use crate::modal::full_basis::{
+    asymmetry, shift_origin, symmetry_instant, to_full_basis, with_harmonics,
+};
 
 /// Energies below this fraction of `E_g` are the state of rest, which is no point of a
 /// backbone (it solves the equations at every period).

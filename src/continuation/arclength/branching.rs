@@ -8,8 +8,9 @@
 //! small eigenvalue whose eigenvector is close to `phi`; inverse iteration finds it.
 
 use super::bordered::Bordered;
-use super::{Arclength, Point};
+use super::Arclength;
 use crate::continuation::ContinuationProblem;
+use crate::continuation::Point;
 use crate::error::ContinuationError;
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::{NonlinearSolver, Problem};
@@ -17,25 +18,6 @@ use crate::solve::{NonlinearSolver, Problem};
 /// Inverse iterations for the crossing branch's direction: the bordered matrix's smallest
 /// eigenvalue is much smaller than the others near a branch point, so a few suffice.
 const INVERSE_ITERATIONS: usize = 8;
-
-/// The two accepted points between which the sign of the determinant changed, and the
-/// tangent at the second.
-#[derive(Debug, Clone)]
-pub(super) struct Bracket {
-    before: Vec<f64>,
-    after: Vec<f64>,
-    tangent: Vec<f64>,
-}
-
-impl Bracket {
-    pub(super) fn new(before: &[f64], after: &[f64], tangent: &[f64]) -> Self {
-        Self {
-            before: before.to_vec(),
-            after: after.to_vec(),
-            tangent: tangent.to_vec(),
-        }
-    }
-}
 
 impl<P: ContinuationProblem, S: NonlinearSolver> Arclength<'_, P, S> {
     /// The dense bordered matrix `[J, F_lambda; s t^T W]` at `y` (`s > 0` the residual scale).

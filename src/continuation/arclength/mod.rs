@@ -30,6 +30,7 @@
 //! SIAM Classics in Applied Mathematics 45 (2003), chapter 2.
 
 mod bordered;
+mod bracket;
 mod branching;
 mod options;
 mod resume;
@@ -45,7 +46,7 @@ use crate::error::{ContinuationError, SolveError};
 use crate::linalg::{DenseMatrix, Lu};
 use crate::solve::{NonlinearSolver, Problem, SolveInfo, Structured, PIVOT_TOLERANCE};
 use bordered::{BorderScratch, Bordered, Metric};
-use branching::Bracket;
+use bracket::Bracket;
 
 /// Pseudo-arclength continuation driver, generic over the problem and the corrector.
 pub struct Arclength<'a, P, S> {

@@ -2,17 +2,16 @@
 //! file meets exactly the checks a Rust caller meets; the file only adds what the builder
 //! cannot know: names.
 
+use super::error::AssemblyFileError;
+use super::named::Assembly;
+use super::schema::end_name;
+use super::schema::END;
+use super::schema::START;
 use super::schema::{AssemblyFile, ConditionEntry};
-use super::{Assembly, AssemblyFileError};
 use crate::bar::{Bar, BarId, EndRef};
 use crate::error::ModelError;
 use crate::system::AssemblyBuilder;
 use std::collections::BTreeMap;
-
-/// Suffix of the end at `x = 0` in an end string.
-pub(super) const START: &str = "start";
-/// Suffix of the end at `x = l`.
-pub(super) const END: &str = "end";
 
 /// Builds the assembly `file` describes.
 pub(super) fn build(file: &AssemblyFile) -> Result<Assembly, AssemblyFileError> {
@@ -136,14 +135,4 @@ fn add(
     }
     .map(|_| ())
     .map_err(Rejected::Model)
-}
-
-/// `NAME.start` or `NAME.end` for `end`, with the bar names `names` (by bar index).
-pub(super) fn end_name(names: &[String], end: EndRef) -> String {
-    let side = match end.end {
-        crate::bar::End::Left => START,
-        crate::bar::End::Right => END,
-    };
-    let bar = names.get(end.bar.index()).map_or("?", String::as_str);
-    format!("{bar}.{side}")
 }

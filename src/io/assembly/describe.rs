@@ -7,9 +7,9 @@
 //! compared with it (name, rows, observables): a condition is written as built-in only if it
 //! gives the same equations as the built-in one.
 
-use super::build::end_name;
+use super::error::AssemblyFileError;
+use super::schema::end_name;
 use super::schema::{AssemblyFile, BarEntry, ConditionEntry};
-use super::AssemblyFileError;
 use crate::bar::EndRef;
 use crate::bc::{
     BoundaryCondition, Contact, Dirichlet, LinearRows, Neumann, Quantity, Robin, Signorini,

@@ -6,7 +6,7 @@
 //! into typed variants so that a program (a GUI, a test) can tell them apart without parsing
 //! text itself, and every variant keeps the line the parser pointed at.
 
-use super::FileFormat;
+use super::format::FileFormat;
 use crate::error::ModelError;
 use std::fmt;
 use thiserror::Error;

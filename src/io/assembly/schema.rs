@@ -1,10 +1,18 @@
-//! The file's structure as serde types: exactly the keys of the schema, nothing else.
+//! The file's structure as serde types: exactly the keys of the schema, nothing else; and
+//! how an end is written (`NAME.start`, `NAME.end`).
 //!
 //! `deny_unknown_fields` makes a misspelt key an error instead of a silently ignored line
 //! (a `stifness = 0.5` that leaves a Robin spring at its default would be a wrong model, not a
 //! typo); the `type` tag picks the condition and, with it, which keys that condition takes.
 
+use crate::bar::End;
+use crate::bar::EndRef;
 use serde::{Deserialize, Serialize};
+
+/// Suffix of the end at `x = 0` in an end string.
+pub(super) const START: &str = "start";
+/// Suffix of the end at `x = l`.
+pub(super) const END: &str = "end";
 
 /// A whole assembly file: its `[[bar]]` and `[[condition]]` tables, in file order.
 ///
@@ -98,4 +106,14 @@ impl ConditionEntry {
             ConditionEntry::Contact { ends, .. } => ends.iter().map(String::as_str).collect(),
         }
     }
+}
+
+/// `NAME.start` or `NAME.end` for `end`, with the bar names `names` (by bar index).
+pub(super) fn end_name(names: &[String], end: EndRef) -> String {
+    let side = match end.end {
+        End::Left => START,
+        End::Right => END,
+    };
+    let bar = names.get(end.bar.index()).map_or("?", String::as_str);
+    format!("{bar}.{side}")
 }

@@ -7,12 +7,14 @@
 //! law history per law.
 
 use crate::bc::LawSamples;
+use crate::check::check_finite;
+use crate::check::check_frequency;
+use crate::check::check_length;
+use crate::check::check_unknowns_finite;
 use crate::error::SettingsError;
 use crate::fourier::Basis;
 use crate::modal::energy::Diagonal;
-use crate::modal::inputs::{
-    check_finite, check_frequency, check_length, check_motion, check_unknowns_finite,
-};
+use crate::system::inputs::check_motion;
 use crate::system::{BarSystem, Layout, NonsmoothSystem};
 use std::cell::Cell;
 

@@ -60,14 +60,17 @@
 
 mod matrix;
 
-use super::floquet::{Crossing, Multiplier, Verdict};
+use super::floquet::Multiplier;
+use crate::check::check_finite;
 use crate::continuation::ContinuationProblem;
 use crate::error::{Error, SettingsError, StabilityError};
 use crate::forced::ForcedSystem;
 use crate::fourier::{period_of_frequency, Basis};
-use crate::modal::inputs::{check_finite, check_frequency_of};
 use crate::solve::{Problem, Structured};
+use crate::system::inputs::check_frequency_of;
 use crate::system::{shift_of, BarSystem, HarmonicBalanceSettings, NonsmoothSystem};
+use crate::verdict::Crossing;
+use crate::verdict::Verdict;
 use faer::linalg::solvers::Solve;
 use faer::{c64, Col};
 use matrix::HillMatrix;
@@ -396,7 +399,7 @@ fn full_state(x: &[f64], m: usize, dimension: usize) -> Result<Vec<f64>, Setting
     let state = if x.len() == dimension {
         x.to_vec()
     } else if x.len() == per * (m + 1) {
-        crate::branches::to_full_basis(x, m)?
+        crate::modal::full_basis::to_full_basis(x, m)?
     } else {
         return Err(SettingsError::Length {
             what: "state (cosine or full basis)",

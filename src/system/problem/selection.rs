@@ -23,7 +23,7 @@
 //! # What
 //! At the fundamental frequency `Omega`, harmonic `n >= 2` with `n^2 >= m` is *dropped* when
 //! `|n Omega / omega_k - 1| < c / m` for a natural frequency `omega_k > 0` of the system with
-//! every contact open or every contact closed ([`crate::modal::ContactState`]). A dropped
+//! every contact open or every contact closed ([`ContactState`]). A dropped
 //! harmonic's unknowns are held at zero: its equations (linear rows and law projections) are
 //! replaced by the rows `x_i = 0`, and the other equations see it as zero. The constant and
 //! the fundamental are never dropped. The set changes with `Omega`; the problem keeps its
@@ -36,8 +36,9 @@ use super::discretization::Discretization;
 use crate::error::SettingsError;
 use crate::fourier::Basis;
 use crate::linalg::DenseMatrix;
-use crate::modal::linear::{natural_frequencies_covering, Resolution};
-use crate::modal::ContactState;
+use crate::system::linear::natural_frequencies_covering;
+use crate::system::linear::ContactState;
+use crate::system::linear::Resolution;
 use crate::system::BarSystem;
 
 /// The layout of a harmonic-balance problem that a selection edits: unknowns per

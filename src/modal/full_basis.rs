@@ -1,5 +1,6 @@
 //! States of the full Fourier basis: checks of their layout, the cosine state lifted into
-//! it, more harmonics, and how far a state is from even in time.
+//! it, more harmonics, and how far a state is from even in time. They only read
+//! coefficients; [`crate::branches`] re-exports them beside the full-basis branch.
 
 use crate::error::SettingsError;
 use crate::fourier::check_memory;
@@ -122,7 +123,7 @@ fn rotate(c: f64, s: f64, (sin, cos): (f64, f64)) -> (f64, f64) {
 /// `c cos(n theta) + s sin(n theta)`, has the sine `s cos(n theta0) - c sin(n theta0)` about
 /// `theta0`. The values are divided by the largest first, so that the squares of a state
 /// near the ends of the range of `f64` neither overflow nor underflow.
-pub(super) fn share_about(x: &[f64], harmonics: usize, theta0: f64) -> f64 {
+pub(crate) fn share_about(x: &[f64], harmonics: usize, theta0: f64) -> f64 {
     let per = x.len() / (2 * harmonics + 1);
     let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(scale > 0.0 && scale.is_finite()) {
@@ -174,7 +175,7 @@ pub fn symmetry_instant(x: &[f64], harmonics: usize) -> Result<(f64, f64), Setti
 }
 
 /// [`symmetry_instant`] of a state whose layout is known to fit `harmonics`.
-pub(super) fn symmetry_instant_of(x: &[f64], harmonics: usize) -> (f64, f64) {
+pub(crate) fn symmetry_instant_of(x: &[f64], harmonics: usize) -> (f64, f64) {
     let scan = 8 * harmonics;
     let h = std::f64::consts::PI / scan as f64;
     let share = |t: f64| share_about(x, harmonics, t);
