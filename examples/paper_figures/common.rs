@@ -453,12 +453,18 @@ pub fn frame_on_branches(panel: &mut LinePanel) {
     let margin = (hi - lo) / 20.0;
     let (lo, hi) = (lo - margin, hi + margin);
     panel.x_range = Some((lo, hi));
-    let mut left_out = 0;
+    // A point drawn by two series (an isolated point that is also a landing) counts once.
+    let mut left_out = std::collections::BTreeSet::new();
     for s in panel.series.iter_mut().filter(|s| apart(s)) {
-        let before = s.points.len();
-        s.points.retain(|p| (lo..=hi).contains(&p.0));
-        left_out += before - s.points.len();
+        s.points.retain(|p| {
+            let inside = (lo..=hi).contains(&p.0);
+            if !inside {
+                left_out.insert((p.0.to_bits(), p.1.to_bits()));
+            }
+            inside
+        });
     }
+    let left_out = left_out.len();
     // Said under the axis: a series left empty has no legend entry to say it.
     if left_out > 0 {
         panel.x_label = format!(
