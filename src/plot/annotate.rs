@@ -1,7 +1,8 @@
 //! Labels of points on a line panel (the lettered points of a paper's figure): each is set
 //! beside its point, on a white ground, in the first of a ring of places around the point
-//! where it stays in the plot and covers no earlier label nor the legend. A label set farther
-//! than the first ring is tied to its point by a thin leader line.
+//! where it stays in the plot, covers no earlier label nor the legend, and lies nearer its own
+//! point than any other labelled point (two close points' labels must not read swapped). A
+//! label set farther than the first ring is tied to its point by a thin leader line.
 
 use super::canvas::{draw_err, Area, PlotError, FONT};
 use super::place::{text_width, PixelBox};
@@ -34,9 +35,16 @@ pub(super) fn place<'a>(
     taken: &mut Vec<PixelBox>,
 ) -> Vec<Placed<'a>> {
     let mut out = Vec::with_capacity(notes.len());
+    let points: Vec<(f64, f64)> = (notes.iter())
+        .filter_map(|n| pixel(n.at).filter(|&p| plot.contains(p)))
+        .collect();
     for n in notes {
         let Some(p) = pixel(n.at).filter(|&p| plot.contains(p)) else {
             continue;
+        };
+        let own = |b: &PixelBox| {
+            let d = distance(b, p);
+            points.iter().all(|&q| q == p || distance(b, q) >= d)
         };
         let w = text_width(&n.text, TEXT) + 6.0;
         let candidates = (1..=4).flat_map(|ring| {
@@ -53,19 +61,20 @@ pub(super) fn place<'a>(
             ]
             .map(move |(dx, dy)| (ring, PixelBox::at(p.0 + dx, p.1 + dy, w, HEIGHT)))
         });
-        let mut first_inside = None;
-        let mut chosen = None;
-        for (ring, b) in candidates {
-            if !b.within(plot) {
-                continue;
-            }
+        // The first place that is free and nearest its own point; failing that, the first
+        // free one; failing that, the first inside the plot.
+        let (mut first_inside, mut first_free, mut chosen) = (None, None, None);
+        for (ring, b) in candidates.filter(|(_, b)| b.within(plot)) {
             first_inside.get_or_insert((ring, b));
             if !taken.iter().any(|t| t.meets(&b)) {
-                chosen = Some((ring, b));
-                break;
+                first_free.get_or_insert((ring, b));
+                if own(&b) {
+                    chosen = Some((ring, b));
+                    break;
+                }
             }
         }
-        if let Some((ring, at)) = chosen.or(first_inside) {
+        if let Some((ring, at)) = chosen.or(first_free).or(first_inside) {
             taken.push(at);
             out.push(Placed {
                 text: &n.text,
@@ -76,6 +85,13 @@ pub(super) fn place<'a>(
         }
     }
     out
+}
+
+/// The distance from `point` to the nearest point of the box `b`.
+fn distance(b: &PixelBox, point: (f64, f64)) -> f64 {
+    let dx = (b.x0 - point.0).max(point.0 - b.x1).max(0.0);
+    let dy = (b.y0 - point.1).max(point.1 - b.y1).max(0.0);
+    dx.hypot(dy)
 }
 
 /// Draws placed labels on `area` (screen coordinates): leader line, white ground, bold text.
@@ -141,6 +157,27 @@ mod tests {
             for b in &placed[i + 1..] {
                 assert!(!a.at.meets(&b.at), "{} and {} overlap", a.text, b.text);
             }
+        }
+    }
+
+    /// Two points a few pixels apart on a line: each label lies nearer its own point than
+    /// the other's, so that they do not read swapped.
+    #[test]
+    fn labels_of_neighbours_lie_nearer_their_own_points() {
+        let plot = PixelBox::at(0.0, 0.0, 400.0, 300.0);
+        for gap in [4.0, 8.0, 15.0, 30.0] {
+            let notes = [note(200.0, 150.0, "g"), note(200.0 + gap, 148.0, "f")];
+            let placed = place(&notes, Some, &plot, &mut Vec::new());
+            assert_eq!(placed.len(), 2);
+            for (a, b) in [(&placed[0], &placed[1]), (&placed[1], &placed[0])] {
+                assert!(
+                    distance(&a.at, a.point) <= distance(&a.at, b.point),
+                    "gap {gap}: {} lies nearer {}",
+                    a.text,
+                    b.text
+                );
+            }
+            assert!(!placed[0].at.meets(&placed[1].at));
         }
     }
 
