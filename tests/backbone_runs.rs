@@ -293,3 +293,101 @@ fn auto_keeps_its_arclength_within_the_grids_steps() {
         run.points.len()
     );
 }
+
+/// Records every call of an arclength backbone's observer, which stops the run at the first
+/// rejected step.
+#[derive(Default)]
+struct StopAtFirstRejection {
+    calls: Vec<&'static str>,
+    points: Vec<nonsmooth_modes::branches::BackbonePoint>,
+}
+
+impl nonsmooth_modes::branches::BackboneObserver for &mut StopAtFirstRejection {
+    fn point(&mut self, p: &nonsmooth_modes::branches::BackbonePoint) -> std::ops::ControlFlow<()> {
+        self.calls.push("point");
+        self.points.push(p.clone());
+        std::ops::ControlFlow::Continue(())
+    }
+    fn rejected(
+        &mut self,
+        _: &nonsmooth_modes::continuation::Rejection,
+    ) -> std::ops::ControlFlow<()> {
+        self.calls.push("rejected");
+        std::ops::ControlFlow::Break(())
+    }
+}
+
+/// The stress suite's finding (case 4941 of the default seed, inputs as drawn): an observer
+/// that stops an arclength backbone at its first rejected step, while a point was held as a
+/// possible spike, was then shown that point; the run said `StoppedByObserver` although the
+/// observer's last answer was to go on. An observer that has stopped is not called again,
+/// and the run's points are those it saw.
+#[test]
+fn an_observer_that_stops_on_a_rejection_is_not_called_again() {
+    use nonsmooth_modes::branches::{compute_observed, ArclengthBackboneOptions, StallEscape};
+    use nonsmooth_modes::continuation::{ArclengthOptions, ArclengthScale, TangentPredictor};
+    use nonsmooth_modes::solve::{Dogleg, DoglegOptions};
+    let system = clamped_bar_with_obstacle(0.00010811265993992226).unwrap();
+    let ds_max = 0.3836144297016708;
+    let arclength = ArclengthOptions {
+        ds: 0.03367528456678734_f64.min(ds_max),
+        ds_min: 2.8896994861669082e-5,
+        ds_max,
+        max_steps: 7,
+        parameter_range: (1.1087981864354337, 2.5563170360189047),
+        direction: -1.0,
+        predictor: TangentPredictor::Tangent,
+        scale: ArclengthScale::Automatic,
+        fast_iterations: 2,
+        growth: 1.3670840591659206,
+        shrink: 0.9,
+        jump_ratio: 0.5123090625699462,
+        max_turn: 2.760804042368901,
+        max_rejections: 20,
+        branch_points: true,
+    };
+    let options = ArclengthBackboneOptions {
+        start_period: 3.4926567040475662,
+        omega_range: (1.5314368229206208, 2.2996806013633053),
+        mode: 2,
+        subharmonic: 1,
+        arclength,
+        escape: Some(StallEscape {
+            window: 6,
+            min_progress: 0.04370157627158541,
+            jump: 0.005414569756419893,
+            max_attempts: 1,
+            max_norm_ratio: 3.972210294899639,
+        }),
+        trivial_energy: 0.0008283180787236014,
+        switch: None,
+    };
+    let solver = Dogleg::new(DoglegOptions {
+        tolerance: 2.56777836333579e-10,
+        max_iterations: usize::MAX,
+        initial_radius: 2.006106841075849,
+        min_radius: 3.1042709275971484e-5,
+    })
+    .unwrap();
+    let request = Request {
+        settings: HarmonicBalanceSettings {
+            harmonics: 3,
+            samples_per_harmonic: 4,
+            complementarity: 0.13369673726781137,
+            ..Default::default()
+        },
+        method: Method::Arclength(options),
+        solver: Some(Solver::Dogleg(solver)),
+        ..Request::new(2).subharmonic(1)
+    };
+    let mut observer = StopAtFirstRejection::default();
+    let run = compute_observed(&system, &request, &mut observer).unwrap();
+    eprintln!("{:?}; end {:?}", observer.calls, run.end);
+    if let Some(k) = observer.calls.iter().position(|c| *c == "rejected") {
+        assert_eq!(k + 1, observer.calls.len(), "{:?}", observer.calls);
+        assert_eq!(run.end, EndReason::StoppedByObserver);
+    } else {
+        assert_ne!(run.end, EndReason::StoppedByObserver);
+    }
+    assert_eq!(observer.points, run.points);
+}

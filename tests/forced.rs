@@ -8,7 +8,9 @@ use nonsmooth_modes::forced::{
     forced_response, Damping, Excitation, ForcedSystem, Forcing, ResponseMethod, ResponseRequest,
 };
 use nonsmooth_modes::linalg::DenseMatrix;
-use nonsmooth_modes::reference::{clamped_bar_with_obstacle, robin_bar_with_obstacle};
+use nonsmooth_modes::reference::{
+    clamped_bar_with_obstacle, robin_bar_with_obstacle, two_bars_in_contact,
+};
 use nonsmooth_modes::solve::Problem;
 use nonsmooth_modes::system::{AssemblyBuilder, BarSystem, HarmonicBalanceSettings};
 use nonsmooth_modes::{Error, ForcingError};
@@ -505,12 +507,31 @@ fn a_force_whose_residual_overflows_when_squared_ends_the_dogleg() {
         method: ResponseMethod::Sequential,
         solver: Solver::Dogleg(Dogleg::default()),
     };
-    match forced_response(&system, &request) {
-        Ok(response) => assert!(response
-            .points
-            .iter()
-            .all(|p| !p.converged || p.energy.is_finite())),
-        Err(e) => assert!(!e.to_string().is_empty()),
+    // Both methods: the reproducer's method was not recorded, and both call the dogleg. The
+    // call runs on a thread of its own, so that a loop that never ends fails the test
+    // instead of hanging it.
+    for method in [ResponseMethod::Sequential, ResponseMethod::Arclength] {
+        let request = ResponseRequest {
+            method,
+            ..request.clone()
+        };
+        let system = system.clone();
+        let (send, receive) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let outcome = forced_response(&system, &request).map(|response| {
+                response
+                    .points
+                    .iter()
+                    .all(|p| !p.converged || p.energy.is_finite())
+            });
+            let _ = send.send(outcome);
+        });
+        // The loop never ended; Newton refuses the same call in milliseconds.
+        match receive.recv_timeout(std::time::Duration::from_secs(60)) {
+            Ok(Ok(finite)) => assert!(finite, "{method:?}: a converged point with NaN energy"),
+            Ok(Err(e)) => assert!(!e.to_string().is_empty()),
+            Err(e) => panic!("{method:?}: no answer within 60 s ({e})"),
+        }
     }
 }
 
@@ -539,11 +560,13 @@ fn the_forced_systems_calls_refuse_what_they_cannot_use() {
         .unwrap()
         .iter()
         .all(|g| g.is_finite()));
-    match problem.gap_history(&x, 1) {
-        Err(nonsmooth_modes::SettingsError::IndexOutOfRange {
-            index: 1, count: 1, ..
-        }) => {}
-        other => panic!("{other:?}"),
+    for index in [1, usize::MAX] {
+        match problem.gap_history(&x, index) {
+            Err(nonsmooth_modes::SettingsError::IndexOutOfRange {
+                index: i, count: 1, ..
+            }) => assert_eq!(i, index),
+            other => panic!("{index}: {other:?}"),
+        }
     }
     match problem.gap_history(&x[1..], 0) {
         Err(nonsmooth_modes::SettingsError::Length { got, expected, .. }) => {
@@ -562,6 +585,34 @@ fn the_forced_systems_calls_refuse_what_they_cannot_use() {
     let x = big.open_response().unwrap();
     let defect = big.contact_defect(&x);
     assert!(defect.is_finite() && defect >= 0.0, "{defect}");
+}
+
+/// The reliability reproducer of an open response asked for before any frequency: the
+/// two-bar system of a second bar `(0.95, 1, 1)` at gap `1e-3`, 3 harmonics, indexed the
+/// rows of a frequency not yet set. It is a typed error naming the forcing frequency.
+#[test]
+fn an_open_response_before_a_frequency_is_a_typed_error() {
+    let system = two_bars_in_contact(Bar::new(0.95, 1.0, 1.0).unwrap(), 1e-3).unwrap();
+    let forcing = Forcing {
+        damping: Damping::Uniform(0.02),
+        excitations: vec![Excitation::base_motion(
+            system.bar_id(0).unwrap().left(),
+            1e-6,
+        )],
+    };
+    let mut problem = ForcedSystem::new(&system, settings(3), &forcing).unwrap();
+    match problem.open_response() {
+        Err(Error::Settings(nonsmooth_modes::SettingsError::NotFinite { what, value })) => {
+            assert!(
+                what.contains("forcing frequency") && value.is_nan(),
+                "{what}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    problem.set_parameter(1.2);
+    let x = problem.open_response().unwrap();
+    assert!(x.iter().all(|v| v.is_finite()), "{x:?}");
 }
 
 /// The reliability reproducers of an open response that was NaN in `Ok`: a frequency of

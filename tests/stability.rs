@@ -485,6 +485,44 @@ fn a_state_at_the_ends_of_f64_gives_a_typed_error_or_finite_numbers() {
         refused >= 1,
         "the scaled states were accepted with finite numbers"
     );
+    // The same states given to `floquet_of_state` directly, on a grid of 50 cells over the
+    // unit bar (175 steps make the period).
+    let model = Model::from_system(&system).unwrap();
+    let grid = Grid::nearest_or_new(&model, 1.0 / 50.0).unwrap();
+    let mut refused = 0;
+    for scale in [1e300, 1e-300] {
+        let scaled: Vec<f64> = x.iter().map(|v| v * scale).collect();
+        let state =
+            State::from_harmonic_balance(&system, problem.basis(), &scaled, omega, 0.0, grid.dt())
+                .unwrap();
+        match floquet_of_state(&state, 3.5, &options(50.0)) {
+            Ok(f) => {
+                for v in [
+                    f.initial_defect,
+                    f.periodicity_defect,
+                    f.correction,
+                    f.displacement_correction,
+                    f.energy_correction,
+                    f.max_modulus,
+                ] {
+                    assert!(v.is_finite(), "scale {scale:e}: {f:?}");
+                }
+                assert!(f
+                    .multipliers
+                    .iter()
+                    .all(|m| m.re.is_finite() && m.im.is_finite()));
+            }
+            Err(StabilityError::NonFiniteResult { what, value }) => {
+                assert!(!value.is_finite() && !what.is_empty(), "{what} {value}");
+                refused += 1;
+            }
+            Err(e) => panic!("of state, scale {scale:e}: {e}"),
+        }
+    }
+    assert!(
+        refused >= 1,
+        "the scaled states were accepted by floquet_of_state with finite numbers"
+    );
 }
 
 /// Where the grid's map has no periodic orbit because the motion's impacts fall between its

@@ -424,7 +424,9 @@ impl ArclengthBackboneOptions {
 /// branch's secant (a possible one-point spike, [`SPIKE_ENERGY`](crate::branches::SPIKE_ENERGY))
 /// is shown, with the failed steps after it, once the next converged point has said whether
 /// it came back: an observer that stops the run there stops it one point later, and the
-/// result ends at the point where it stopped.
+/// result ends at the point where it stopped. An observer that stops the run on a rejected
+/// step while a point is held is not shown that point (nor anything else): the result ends
+/// at the last point it saw.
 pub trait BackboneObserver {
     /// Called with every accepted point.
     fn point(&mut self, point: &BackbonePoint) -> ControlFlow<()>;

@@ -189,9 +189,19 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         .is_break()
     }
 
-    /// Shows a rejected step to the observer.
+    /// Shows a rejected step to the observer. A rejection may come while a point is held as
+    /// a possible spike: an observer that stops the run on it has stopped it there, so the
+    /// held point is not shown afterwards (nor kept), and an observer that has stopped is
+    /// not called again.
     pub(crate) fn rejected(&mut self, rejection: &Rejection) -> ControlFlow<()> {
-        self.observer.rejected(rejection)
+        if !self.stopped {
+            self.stopped = self.observer.rejected(rejection).is_break();
+        }
+        if self.stopped {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
     }
 
     /// Shows points annotated by another annotator of the same request to the observer and
