@@ -3,14 +3,18 @@
 
 #[cfg(feature = "serde")]
 pub mod assembly;
+pub mod columns;
 
 use crate::branches::BackbonePoint;
-use crate::continuation::Event;
+use columns::{Digits, Group, Row};
 use std::io::{self, Write};
 
-/// Header of [`write_backbone_csv`].
+/// Header of [`write_backbone_csv`]: the [`Group::Point`] columns of [`columns::COLUMNS`].
 pub const BACKBONE_CSV_HEADER: &str =
     "step,period,omega,energy,energy_normalized,converged,status,residual_norm,iterations,step_size,event";
+
+/// The groups of [`write_backbone_csv`].
+const BACKBONE_GROUPS: &[Group] = &[Group::Point];
 
 /// Writes a backbone as CSV: [`BACKBONE_CSV_HEADER`], then one row per point (events joined
 /// with `;`).
@@ -18,45 +22,45 @@ pub const BACKBONE_CSV_HEADER: &str =
 /// The `backbone` example's columns `contacts_per_period` and `subharmonic_share` are not
 /// here: a [`BackbonePoint`] does not carry the system and basis they are computed with
 /// ([`crate::modal::contact_intervals`], [`crate::modal::subharmonic_share`]); compute them
-/// per point and write them with [`write_columns_csv`].
+/// per point and write them with [`columns::write_row`] (in a [`Row`]) or
+/// [`write_columns_csv`].
 ///
 /// # Errors
 /// Any I/O error of `out`.
-pub fn write_backbone_csv(points: &[BackbonePoint], mut out: impl Write) -> io::Result<()> {
-    writeln!(out, "{BACKBONE_CSV_HEADER}")?;
-    for p in points {
-        write_point_cells(p, &mut out)?;
-        writeln!(out)?;
+pub fn write_backbone_csv(points: &[BackbonePoint], out: impl Write) -> io::Result<()> {
+    write_table(
+        BACKBONE_GROUPS,
+        points.iter().map(|p| Row::new(p, Digits::FULL)),
+        out,
+    )
+}
+
+/// Writes the header of `groups`, then the line of each row.
+fn write_table<'a>(
+    groups: &[Group],
+    rows: impl IntoIterator<Item = Row<'a>>,
+    mut out: impl Write,
+) -> io::Result<()> {
+    writeln!(out, "{}", columns::header(groups))?;
+    let mut line = String::new();
+    for row in rows {
+        line.clear();
+        columns::write_row(groups, &row, &mut line);
+        writeln!(out, "{line}")?;
     }
     Ok(())
 }
 
-/// The cells of [`BACKBONE_CSV_HEADER`] for one point, without the line end.
-fn write_point_cells(p: &BackbonePoint, mut out: impl Write) -> io::Result<()> {
-    let events: Vec<&str> = p.events.iter().map(Event::label).collect();
-    write!(
-        out,
-        "{},{:.12},{:.12},{:.12e},{:.12e},{},{},{:.4e},{},{:.6e},{}",
-        p.step,
-        p.period,
-        p.omega,
-        p.energy,
-        p.energy_normalized,
-        p.converged,
-        p.status.label(),
-        p.residual_norm,
-        p.iterations,
-        p.step_size,
-        events.join(";")
-    )
-}
-
 /// Header of [`write_branches_csv`]: `branch,harmonics`, the columns of
-/// [`BACKBONE_CSV_HEADER`], then `omega_ratio,exact_energy_normalized,label`.
+/// [`BACKBONE_CSV_HEADER`], then `omega_ratio,exact_energy_normalized,label` (the
+/// [`Group::Branch`], [`Group::Point`] and [`Group::Comparison`] columns of
+/// [`columns::COLUMNS`]).
 pub const BRANCHES_CSV_HEADER: &str = "branch,harmonics,step,period,omega,energy,\
      energy_normalized,converged,status,residual_norm,iterations,step_size,event,omega_ratio,\
      exact_energy_normalized,label";
 
+/// The groups of [`write_branches_csv`].
+const BRANCHES_GROUPS: &[Group] = &[Group::Branch, Group::Point, Group::Comparison];
 /// One branch of a table written by [`write_branches_csv`].
 #[derive(Clone, Copy)]
 pub struct LabelledBranch<'a> {
@@ -94,26 +98,17 @@ impl std::fmt::Debug for LabelledBranch<'_> {
 pub fn write_branches_csv(
     branches: &[LabelledBranch<'_>],
     omega_1: f64,
-    mut out: impl Write,
+    out: impl Write,
 ) -> io::Result<()> {
-    writeln!(out, "{BRANCHES_CSV_HEADER}")?;
-    for b in branches {
-        let label = b.label.replace(',', ";");
-        for p in b.points {
-            write!(out, "{label},{},", b.harmonics)?;
-            write_point_cells(p, &mut out)?;
-            write!(out, ",{:.12},", p.omega / omega_1)?;
-            if let Some(exact) = b.exact {
-                write!(out, "{:.12e}", exact(p.period))?;
-            }
-            write!(out, ",")?;
-            if let Some(label) = &p.label {
-                write!(out, "{label}")?;
-            }
-            writeln!(out)?;
-        }
-    }
-    Ok(())
+    let rows = branches.iter().flat_map(|b| {
+        b.points.iter().map(move |p| Row {
+            branch: Some((b.label, b.harmonics)),
+            exact: b.exact.map(|exact| exact(p.period)),
+            reference_omega: Some(omega_1),
+            ..Row::new(p, Digits::FULL)
+        })
+    });
+    write_table(BRANCHES_GROUPS, rows, out)
 }
 
 /// Writes columns of equal length as CSV with the given header names.
@@ -153,6 +148,13 @@ pub fn to_json<T: serde::Serialize + ?Sized>(value: &T) -> Result<String, serde_
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::continuation::Event;
+
+    #[test]
+    fn headers_are_those_of_the_column_table() {
+        assert_eq!(columns::header(BACKBONE_GROUPS), BACKBONE_CSV_HEADER);
+        assert_eq!(columns::header(BRANCHES_GROUPS), BRANCHES_CSV_HEADER);
+    }
 
     fn point() -> BackbonePoint {
         BackbonePoint {
@@ -247,6 +249,41 @@ mod tests {
         assert_eq!(cells[..2], ["NSM2", "40"]);
         assert_eq!(cells[k + 1], "");
         assert!(format!("{:?}", branches[0]).contains("points: 2"));
+    }
+
+    #[test]
+    fn csv_bytes_are_those_of_the_column_table() {
+        let mut resonant = point();
+        resonant.label = Some(crate::modal::Label::Skeleton);
+        let points = [point(), resonant];
+        let exact = |t: f64| 2.0 * t;
+        let branches = [
+            LabelledBranch {
+                label: "NSM1, m = 20",
+                harmonics: 20,
+                points: &points,
+                exact: Some(&exact),
+            },
+            LabelledBranch {
+                label: "NSM2",
+                harmonics: 40,
+                points: &points[..1],
+                exact: None,
+            },
+        ];
+        let mut out = Vec::new();
+        write_branches_csv(&branches, 0.5, &mut out).unwrap();
+        write_backbone_csv(&points, &mut out).unwrap();
+        let row = "3,3.500000000000,1.795195802051,1.000000000000e-6,2.250000000000e0,true,\
+                   converged,1.0000e-15,2,-5.000000e-3,fold";
+        let expected = format!(
+            "{BRANCHES_CSV_HEADER}\n\
+             NSM1; m = 20,20,{row},3.590391604103,7.000000000000e0,\n\
+             NSM1; m = 20,20,{row},3.590391604103,7.000000000000e0,skeleton\n\
+             NSM2,40,{row},3.590391604103,,\n\
+             {BACKBONE_CSV_HEADER}\n{row}\n{row}\n"
+        );
+        assert_eq!(String::from_utf8(out).unwrap(), expected);
     }
 
     #[cfg(feature = "serde")]

@@ -2,14 +2,12 @@
 //! basis (`branches::full_basis_branch`) from the cosine run's first converged point.
 
 use crate::args::Args;
-use crate::output::{
-    hill_cells, stability_cells, verification_cells, HILL_COLUMNS, STABILITY_COLUMNS,
-    VERIFY_COLUMNS,
-};
+use crate::output::{say_check, say_outcomes};
 use nonsmooth_modes::branches::{
     compute, full_basis_branch, to_full_basis, Method, Request, TimeDomainCheck,
 };
 use nonsmooth_modes::continuation::linspace;
+use nonsmooth_modes::io::columns::{self, Digits, Group, Row};
 use nonsmooth_modes::stability::{HillOptions, StabilityOptions};
 use nonsmooth_modes::system::BarSystem;
 use std::io::Write;
@@ -28,10 +26,15 @@ pub fn run_full_basis(
     (t0, t1): (f64, f64),
     out: &mut dyn Write,
 ) -> Result<(usize, usize), Box<dyn std::error::Error>> {
-    let verify = if a.verify { VERIFY_COLUMNS } else { "" };
-    let stability = if a.stability { STABILITY_COLUMNS } else { "" };
-    let hill = if a.hill { HILL_COLUMNS } else { "" };
-    writeln!(out, "{HEADER}{verify}{stability}{hill}")?;
+    // After its own columns, those of the library's table that the flags ask for.
+    let asked = [
+        (Group::Verify, a.verify),
+        (Group::Stability, a.stability),
+        (Group::Hill, a.hill),
+    ];
+    let groups: Vec<Group> = asked.iter().filter(|g| g.1).map(|g| g.0).collect();
+    let comma = if groups.is_empty() { "" } else { "," };
+    writeln!(out, "{HEADER}{comma}{}", columns::header(&groups))?;
     if !matches!(request.method, Method::PeriodGrid(_)) {
         return Err("--basis full continues the period grid".into());
     }
@@ -63,8 +66,9 @@ pub fn run_full_basis(
                 "rejected"
             };
             let omega = 2.0 * std::f64::consts::PI / period;
-            let columns = |on: bool, names: &str| usize::from(on) * names.matches(',').count();
-            let verdicts = columns(a.stability, STABILITY_COLUMNS) + columns(a.hill, HILL_COLUMNS);
+            let verdicts = columns::columns(&groups)
+                .filter(|c| c.group != Group::Verify)
+                .count();
             let empty = ",".repeat(6 + 3 * usize::from(a.verify) + verdicts);
             writeln!(out, "{step},{period},{omega},,,false,{status}{empty}")?;
             continue;
@@ -90,15 +94,12 @@ pub fn run_full_basis(
             q.iterations
         )?;
         if a.verify {
-            write!(out, "{}", verification_cells(q))?;
+            say_check(q);
         }
-        if a.stability {
-            write!(out, "{}", stability_cells(q))?;
-        }
-        if a.hill {
-            write!(out, "{}", hill_cells(q))?;
-        }
-        writeln!(out)?;
+        say_outcomes(q, a.stability, a.hill);
+        let mut cells = String::new();
+        columns::write_row(&groups, &Row::new(q, Digits::SHORT), &mut cells);
+        writeln!(out, "{comma}{cells}")?;
     }
     eprintln!(
         "backbone: full basis from step {} ended: {:?}; {} rejected steps",
