@@ -849,3 +849,40 @@ fn backbone_stability_columns_say_why_there_is_no_verdict() {
     }
     assert!(verdicts >= 1 && reasons >= 1, "{text}");
 }
+
+/// `backbone --basis full --verify --stability` writes as many cells as the header on every
+/// row, the rejected steps too (the Robin bar over `T = 9.5 -> 6.0` in 15 steps rejects its
+/// last ones).
+#[test]
+fn full_basis_rows_have_every_column() {
+    let binary = example_binary("backbone", "examples/backbone");
+    let dir = TempDir::new("full-basis-columns");
+    let csv = dir.0.join("f.csv");
+    let args = [
+        "--system",
+        "rs",
+        "--steps",
+        "15",
+        "--basis",
+        "full",
+        "--verify",
+        "--stability",
+        "--out",
+    ];
+    let output = Command::new(&binary)
+        .args(args)
+        .arg(&csv)
+        .output()
+        .expect("spawn the backbone example");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    let text = std::fs::read_to_string(&csv).expect("the CSV");
+    let mut lines = text.lines();
+    let columns = lines.next().expect("a header").split(',').count();
+    let mut rejected = 0;
+    for line in lines {
+        assert_eq!(line.split(',').count(), columns, "{line}");
+        rejected += usize::from(line.contains(",rejected,") || line.contains(",before-start,"));
+    }
+    assert!(rejected >= 1, "no rejected row to check:\n{text}");
+}

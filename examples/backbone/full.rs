@@ -66,10 +66,8 @@ pub fn run_full_basis(
                 "rejected"
             };
             let omega = 2.0 * std::f64::consts::PI / period;
-            let verdicts = columns::columns(&groups)
-                .filter(|c| c.group != Group::Verify)
-                .count();
-            let empty = ",".repeat(6 + 3 * usize::from(a.verify) + verdicts);
+            // One empty cell per column after the status: six of its own, then the table's.
+            let empty = ",".repeat(6 + columns::columns(&groups).count());
             writeln!(out, "{step},{period},{omega},,,false,{status}{empty}")?;
             continue;
         };
