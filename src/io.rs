@@ -194,6 +194,28 @@ mod tests {
         assert!(write_columns_csv(&["a", "b"], &[&[1.0], &[1.0, 2.0]], &mut bad).is_err());
     }
 
+    /// "NSM1, m = 20" over all of `points` with the exact values `exact`, and "NSM2" over
+    /// the first point without them.
+    fn two_branches<'a>(
+        points: &'a [BackbonePoint],
+        exact: &'a dyn Fn(f64) -> f64,
+    ) -> [LabelledBranch<'a>; 2] {
+        [
+            LabelledBranch {
+                label: "NSM1, m = 20",
+                harmonics: 20,
+                points,
+                exact: Some(exact),
+            },
+            LabelledBranch {
+                label: "NSM2",
+                harmonics: 40,
+                points: &points[..1],
+                exact: None,
+            },
+        ]
+    }
+
     #[test]
     fn branches_csv_labels_rows_and_leaves_missing_exact_values_empty() {
         let mut resonant = point();
@@ -204,20 +226,7 @@ mod tests {
         });
         let points = [point(), resonant];
         let exact = |t: f64| 2.0 * t;
-        let branches = [
-            LabelledBranch {
-                label: "NSM1, m = 20",
-                harmonics: 20,
-                points: &points,
-                exact: Some(&exact),
-            },
-            LabelledBranch {
-                label: "NSM2",
-                harmonics: 40,
-                points: &points[..1],
-                exact: None,
-            },
-        ];
+        let branches = two_branches(&points, &exact);
         let mut out = Vec::new();
         write_branches_csv(&branches, 0.5, &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();
@@ -257,20 +266,7 @@ mod tests {
         resonant.label = Some(crate::modal::Label::Skeleton);
         let points = [point(), resonant];
         let exact = |t: f64| 2.0 * t;
-        let branches = [
-            LabelledBranch {
-                label: "NSM1, m = 20",
-                harmonics: 20,
-                points: &points,
-                exact: Some(&exact),
-            },
-            LabelledBranch {
-                label: "NSM2",
-                harmonics: 40,
-                points: &points[..1],
-                exact: None,
-            },
-        ];
+        let branches = two_branches(&points, &exact);
         let mut out = Vec::new();
         write_branches_csv(&branches, 0.5, &mut out).unwrap();
         write_backbone_csv(&points, &mut out).unwrap();

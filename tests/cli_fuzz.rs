@@ -797,9 +797,6 @@ fn exact_refuses_bad_arguments() {
 /// a reason where there is none (the clamped bar at `T = 3.95 ... 3.94`, where both occur).
 #[test]
 fn backbone_stability_columns_say_why_there_is_no_verdict() {
-    let binary = example_binary("backbone", "examples/backbone");
-    let dir = TempDir::new("stability-columns");
-    let csv = dir.0.join("s.csv");
     let args = [
         "--system",
         "ds",
@@ -810,16 +807,8 @@ fn backbone_stability_columns_say_why_there_is_no_verdict() {
         "--steps",
         "3",
         "--stability",
-        "--out",
     ];
-    let output = Command::new(&binary)
-        .args(args)
-        .arg(&csv)
-        .output()
-        .expect("spawn the backbone example");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(0), "{stderr}");
-    let text = std::fs::read_to_string(&csv).expect("the CSV");
+    let text = backbone_csv("stability-columns", &args);
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     assert_eq!(
@@ -855,9 +844,6 @@ fn backbone_stability_columns_say_why_there_is_no_verdict() {
 /// last ones).
 #[test]
 fn full_basis_rows_have_every_column() {
-    let binary = example_binary("backbone", "examples/backbone");
-    let dir = TempDir::new("full-basis-columns");
-    let csv = dir.0.join("f.csv");
     let args = [
         "--system",
         "rs",
@@ -867,16 +853,8 @@ fn full_basis_rows_have_every_column() {
         "full",
         "--verify",
         "--stability",
-        "--out",
     ];
-    let output = Command::new(&binary)
-        .args(args)
-        .arg(&csv)
-        .output()
-        .expect("spawn the backbone example");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(0), "{stderr}");
-    let text = std::fs::read_to_string(&csv).expect("the CSV");
+    let text = backbone_csv("full-basis-columns", &args);
     let mut lines = text.lines();
     let columns = lines.next().expect("a header").split(',').count();
     let mut rejected = 0;
@@ -885,4 +863,21 @@ fn full_basis_rows_have_every_column() {
         rejected += usize::from(line.contains(",rejected,") || line.contains(",before-start,"));
     }
     assert!(rejected >= 1, "no rejected row to check:\n{text}");
+}
+
+/// The CSV `backbone ARGS --out FILE` writes, in a temporary directory named `name`; the run
+/// must succeed.
+fn backbone_csv(name: &str, args: &[&str]) -> String {
+    let binary = example_binary("backbone", "examples/backbone");
+    let dir = TempDir::new(name);
+    let csv = dir.0.join("out.csv");
+    let output = Command::new(&binary)
+        .args(args)
+        .arg("--out")
+        .arg(&csv)
+        .output()
+        .expect("spawn the backbone example");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    std::fs::read_to_string(&csv).expect("the CSV")
 }

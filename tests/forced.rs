@@ -544,17 +544,7 @@ fn a_force_whose_residual_overflows_when_squared_ends_the_dogleg() {
 fn the_forced_systems_calls_refuse_what_they_cannot_use() {
     let (system, forcing) = clamped_base(1e-3, 0.02, 1e-6);
     let mut problem = ForcedSystem::new(&system, settings(3), &forcing).unwrap();
-    match problem.open_response() {
-        Err(Error::Settings(nonsmooth_modes::SettingsError::NotFinite { what, value })) => {
-            assert!(
-                what.contains("forcing frequency") && value.is_nan(),
-                "{what}"
-            )
-        }
-        other => panic!("{other:?}"),
-    }
-    problem.set_parameter(1.2);
-    let x = problem.open_response().unwrap();
+    let x = open_response_once_a_frequency_is_set(&mut problem);
     assert!(problem
         .gap_history(&x, 0)
         .unwrap()
@@ -601,17 +591,7 @@ fn an_open_response_before_a_frequency_is_a_typed_error() {
         )],
     };
     let mut problem = ForcedSystem::new(&system, settings(3), &forcing).unwrap();
-    match problem.open_response() {
-        Err(Error::Settings(nonsmooth_modes::SettingsError::NotFinite { what, value })) => {
-            assert!(
-                what.contains("forcing frequency") && value.is_nan(),
-                "{what}"
-            )
-        }
-        other => panic!("{other:?}"),
-    }
-    problem.set_parameter(1.2);
-    let x = problem.open_response().unwrap();
+    let x = open_response_once_a_frequency_is_set(&mut problem);
     assert!(x.iter().all(|v| v.is_finite()), "{x:?}");
 }
 
@@ -742,4 +722,20 @@ fn a_gap_history_that_overflows_is_a_typed_error() {
         Err(SettingsError::NonFiniteResult { what, .. }) => assert_eq!(what, "gap history"),
         other => panic!("{other:?}"),
     }
+}
+
+/// Asks `problem` for its open response before any frequency (a typed error naming the
+/// forcing frequency, NaN), then at `Omega = 1.2`, which it returns.
+fn open_response_once_a_frequency_is_set(problem: &mut ForcedSystem) -> Vec<f64> {
+    match problem.open_response() {
+        Err(Error::Settings(nonsmooth_modes::SettingsError::NotFinite { what, value })) => {
+            assert!(
+                what.contains("forcing frequency") && value.is_nan(),
+                "{what}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    problem.set_parameter(1.2);
+    problem.open_response().unwrap()
 }

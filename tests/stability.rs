@@ -461,25 +461,10 @@ fn a_state_at_the_ends_of_f64_gives_a_typed_error_or_finite_numbers() {
     let mut refused = 0;
     for scale in [1e300, 1e-300] {
         let scaled: Vec<f64> = x.iter().map(|v| v * scale).collect();
-        match floquet(&system, problem.basis(), &scaled, omega, &options(50.0)) {
-            Ok(f) => {
-                for v in [
-                    f.initial_defect,
-                    f.periodicity_defect,
-                    f.correction,
-                    f.displacement_correction,
-                    f.energy_correction,
-                    f.max_modulus,
-                ] {
-                    assert!(v.is_finite(), "scale {scale:e}: {f:?}");
-                }
-            }
-            Err(StabilityError::NonFiniteResult { what, value }) => {
-                assert!(!value.is_finite() && !what.is_empty(), "{what} {value}");
-                refused += 1;
-            }
-            Err(e) => panic!("scale {scale:e}: {e}"),
-        }
+        refused += finite_or_refused(
+            floquet(&system, problem.basis(), &scaled, omega, &options(50.0)),
+            scale,
+        );
     }
     assert!(
         refused >= 1,
@@ -495,29 +480,7 @@ fn a_state_at_the_ends_of_f64_gives_a_typed_error_or_finite_numbers() {
         let state =
             State::from_harmonic_balance(&system, problem.basis(), &scaled, omega, 0.0, grid.dt())
                 .unwrap();
-        match floquet_of_state(&state, 3.5, &options(50.0)) {
-            Ok(f) => {
-                for v in [
-                    f.initial_defect,
-                    f.periodicity_defect,
-                    f.correction,
-                    f.displacement_correction,
-                    f.energy_correction,
-                    f.max_modulus,
-                ] {
-                    assert!(v.is_finite(), "scale {scale:e}: {f:?}");
-                }
-                assert!(f
-                    .multipliers
-                    .iter()
-                    .all(|m| m.re.is_finite() && m.im.is_finite()));
-            }
-            Err(StabilityError::NonFiniteResult { what, value }) => {
-                assert!(!value.is_finite() && !what.is_empty(), "{what} {value}");
-                refused += 1;
-            }
-            Err(e) => panic!("of state, scale {scale:e}: {e}"),
-        }
+        refused += finite_or_refused(floquet_of_state(&state, 3.5, &options(50.0)), scale);
     }
     assert!(
         refused >= 1,
@@ -565,5 +528,34 @@ fn states_off_the_grid_say_what_the_cells_remove() {
         let state = clamped_first_mode(1e-3, period, 1.0 / 100.0).unwrap();
         let f = floquet_of_state(&state, period, &options(100.0)).unwrap();
         assert!(f.unresolved.is_none(), "T = {period}: {f:?}");
+    }
+}
+
+/// 1 for a `NonFiniteResult` naming a non-finite value, 0 for multipliers with every number
+/// finite; any other error fails (`scale`: the state's scale, for the message).
+fn finite_or_refused(result: Result<Floquet, StabilityError>, scale: f64) -> usize {
+    match result {
+        Ok(f) => {
+            for v in [
+                f.initial_defect,
+                f.periodicity_defect,
+                f.correction,
+                f.displacement_correction,
+                f.energy_correction,
+                f.max_modulus,
+            ] {
+                assert!(v.is_finite(), "scale {scale:e}: {f:?}");
+            }
+            assert!(f
+                .multipliers
+                .iter()
+                .all(|m| m.re.is_finite() && m.im.is_finite()));
+            0
+        }
+        Err(StabilityError::NonFiniteResult { what, value }) => {
+            assert!(!value.is_finite() && !what.is_empty(), "{what} {value}");
+            1
+        }
+        Err(e) => panic!("scale {scale:e}: {e}"),
     }
 }

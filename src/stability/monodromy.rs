@@ -31,37 +31,31 @@ impl PeriodMap<'_> {
         duration: f64,
         out: &mut Vec<f64>,
     ) -> Result<(), StabilityError> {
+        let (_, end) = self.march(v, duration)?;
+        self.coordinates.of_snapshot(&end.snapshot(), out);
+        Ok(())
+    }
+
+    /// The state of the coordinates `v` and the state of its motion after `duration`, its
+    /// waves exact (before the cell means the coordinates take).
+    fn march(&self, v: &[f64], duration: f64) -> Result<(State, State), StabilityError> {
         let state = self
             .coordinates
             .to_state(self.template.model(), self.template.grid(), v)?;
-        let end = advance(
-            &state,
-            duration,
-            &MarchOptions {
-                spring: self.spring,
-                snapshot_every: 0,
-            },
-        )?;
-        self.coordinates.of_snapshot(&end.snapshot(), out);
-        Ok(())
+        let options = MarchOptions {
+            spring: self.spring,
+            snapshot_every: 0,
+        };
+        let end = advance(&state, duration, &options)?;
+        Ok((state, end))
     }
 
     /// The share of the energy of `v` that the cell means of its state after one period
     /// remove: zero where every breakpoint of the waves then lies on the cells' edges (the
     /// march conserves the energy of its pieces exactly, up to the merges it reports).
     pub(crate) fn projected_share(&self, v: &[f64]) -> Result<f64, StabilityError> {
-        let state = self
-            .coordinates
-            .to_state(self.template.model(), self.template.grid(), v)?;
+        let (state, end) = self.march(v, self.period)?;
         let start = state.energy();
-        let end = advance(
-            &state,
-            self.period,
-            &MarchOptions {
-                spring: self.spring,
-                snapshot_every: 0,
-            },
-        )?;
         let mut out = Vec::new();
         self.coordinates.of_snapshot(&end.snapshot(), &mut out);
         let means = self.coordinates.energy(self.template, &out)?;
