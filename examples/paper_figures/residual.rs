@@ -6,14 +6,16 @@ use crate::common::{
     over_gap, reference_line, right_end, settings, Ctx, Res, Stats, Table, BLUE, GAP, GREEN, RED,
 };
 use crate::runs::{run, solved_point, Branch, Run};
-use nonsmooth_modes::branches::{convergence_study, BackbonePoint, PeriodGrid};
+use nonsmooth_modes::branches::{
+    convergence_study, BackboneOptions, BackbonePoint, Method, PeriodGrid, Request,
+};
 use nonsmooth_modes::continuation::ContinuationProblem;
 use nonsmooth_modes::modal::{diagnose, law_history};
 use nonsmooth_modes::plot::{
     histories_panel, Figure, LinePanel, MapPanel, Marker, Panel, Rgb, Series,
 };
 use nonsmooth_modes::reference::{clamped_bar_with_obstacle, ClampedFirstMode};
-use nonsmooth_modes::solve::{NonlinearSolver, Problem, SemismoothNewton};
+use nonsmooth_modes::solve::{NonlinearSolver, Problem, SemismoothNewton, Solver};
 use nonsmooth_modes::system::{HarmonicBalanceSettings, NonsmoothSystem, RESONANCE_BAND};
 use std::f64::consts::PI;
 
@@ -441,17 +443,18 @@ pub fn fig05(ctx: &Ctx) -> Res<Stats> {
             end: period,
             steps: ctx.steps(91),
         };
-        let study = convergence_study(
-            &system,
-            settings(m),
-            grid,
-            &[m],
-            SemismoothNewton::default(),
-        )?;
+        let request = Request::for_method(Method::PeriodGrid(BackboneOptions::on_grid(grid, 1, 1)))
+            .settings(settings(m))
+            .solver(Solver::Newton(SemismoothNewton::default()));
+        let study = convergence_study(&system, &request, &[m])?;
         stats.points += 1;
-        let (rs, es) = match study.first().map(|e| (&e.point, &e.diagnostics)) {
-            Some((Some(p), Some(d))) if (p.period - period).abs() < 1e-9 => {
+        let last = study
+            .first()
+            .and_then(|run| Some((run, run.converged().last()?)));
+        let (rs, es) = match last {
+            Some((run, p)) if (p.period - period).abs() < 1e-9 => {
                 stats.converged += 1;
+                let d = diagnose(run.problem(), &p.x, p.omega, 8)?;
                 (d.residual_norm[0], p.energy_normalized)
             }
             _ => (nan, nan),

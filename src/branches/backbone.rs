@@ -4,7 +4,7 @@
 pub use crate::status::MAX_CONSECUTIVE_FAILURES;
 
 use crate::branches::escape::{EscapingArclength, StallEscape};
-use crate::branches::point::{Backbone, BackbonePoint, PointStatus, Timescale};
+use crate::branches::point::{BackbonePoint, PointStatus, Timescale};
 use crate::branches::start::{
     check_trivial_energy, grazing_and_seed, usable_start, walk_back, BackboneStart,
 };
@@ -329,20 +329,6 @@ impl Taken {
     fn energy_of(&self, x: &[f64], period: f64) -> Option<f64> {
         self.time_and_energy(x, period).map(|(_, e)| e)
     }
-}
-
-/// [`backbone_with`] collecting every point: a run that stalls returns what it computed, with
-/// its end reason ([`Backbone::error`]).
-///
-/// # Errors
-/// See [`backbone_with`].
-pub(crate) fn backbone<S: NonlinearSolver>(
-    system: &BarSystem,
-    settings: HarmonicBalanceSettings,
-    options: &BackboneOptions,
-    solver: S,
-) -> Result<Backbone, Error> {
-    Backbone::collect(|see| backbone_with(system, settings, options, solver, see))
 }
 
 /// Options of an arclength backbone ([`Method::Arclength`](crate::branches::Method::Arclength)).

@@ -34,7 +34,7 @@ pub use backbone::{
 };
 pub use compute::{compute, compute_observed};
 pub use continuity::{JUMP_RATIO, SPIKE_ENERGY, SPIKE_SPREAD};
-pub use convergence::{convergence_study, ConvergenceEntry};
+pub use convergence::convergence_study;
 pub use defaults::{linear_period, FLOATING_RETRY_DEPTH};
 pub use energy_backbone::{
     EnergyBackboneOptions, EnergyGrid, CALM_STEPS, ESCAPE_AFTER, ESCAPE_PERIODS, MARGINAL_SHARE,
@@ -50,7 +50,7 @@ pub use judge::{JUDGE_CELLS_PER_TRAVEL, JUDGE_SAMPLES};
 pub use level::EnergyLevel;
 pub use lift::lift;
 pub use parameter::{parameter_branch, ParameterSteps};
-pub use point::{Backbone, BackbonePoint, CheckOutcome, PointStatus};
+pub use point::{BackbonePoint, CheckOutcome, PointStatus};
 pub use request::{AutoChoice, Method, Request, SelectionJudgement, TimeDomainCheck};
 pub use result::ModeBranches;
 pub use start::{

@@ -4,8 +4,8 @@
 pub use crate::status::PointStatus;
 
 use crate::branches::continuity::OnBranch;
-use crate::continuation::{EndReason, Event, Point};
-use crate::error::{ContinuationError, Error, SettingsError};
+use crate::continuation::{Event, Point};
+use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, period_of_frequency, Basis};
 use crate::modal::{Character, Label};
 use crate::solution::Solution;
@@ -13,7 +13,6 @@ use crate::stability::{Floquet, HillSpectrum, StabilityError};
 use crate::system::NonsmoothSystem;
 use crate::verify::{PeriodicityReport, VerifyError};
 use std::fmt;
-use std::ops::ControlFlow;
 
 /// One point of a backbone.
 #[derive(Debug, Clone, PartialEq)]
@@ -316,74 +315,5 @@ impl Timescale {
     pub(crate) fn of_frequency(omega: f64) -> Self {
         let period = period_of_frequency(omega);
         Self { period, omega }
-    }
-}
-
-/// A backbone run: the grazing energy `E_g` its energies are normalised by, every point it
-/// computed (converged or not, in step order) and why it ended. It derefs to its points.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct Backbone {
-    /// The first grazing energy `E_g`.
-    pub grazing_energy: f64,
-    /// Every point, converged or not.
-    pub points: Vec<BackbonePoint>,
-    /// Why the run ended.
-    pub end: EndReason,
-}
-
-impl Backbone {
-    /// Collects every point a backbone driver hands to its observer: `run` is called with
-    /// an observer that keeps them all (moved in, not copied) and returns the driver's
-    /// `(E_g, end reason)`.
-    pub(crate) fn collect<E>(
-        run: impl FnOnce(
-            &mut dyn FnMut(BackbonePoint) -> ControlFlow<()>,
-        ) -> Result<(f64, EndReason), E>,
-    ) -> Result<Self, E> {
-        let mut points = Vec::new();
-        let (grazing_energy, end) = run(&mut |p: BackbonePoint| {
-            points.push(p);
-            ControlFlow::Continue(())
-        })?;
-        Ok(Self {
-            grazing_energy,
-            points,
-            end,
-        })
-    }
-
-    /// The converged points.
-    pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
-        self.points.iter().filter(|p| p.converged)
-    }
-
-    /// The error of a run that ended on one (a stall, too many rejections, a step below the
-    /// minimum), `None` for a run that completed or was stopped by its observer.
-    pub fn error(&self) -> Option<ContinuationError> {
-        self.end.error()
-    }
-}
-
-impl std::ops::Deref for Backbone {
-    type Target = [BackbonePoint];
-    fn deref(&self) -> &[BackbonePoint] {
-        &self.points
-    }
-}
-
-impl IntoIterator for Backbone {
-    type Item = BackbonePoint;
-    type IntoIter = std::vec::IntoIter<BackbonePoint>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.points.into_iter()
-    }
-}
-
-impl<'a> IntoIterator for &'a Backbone {
-    type Item = &'a BackbonePoint;
-    type IntoIter = std::slice::Iter<'a, BackbonePoint>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.points.iter()
     }
 }
