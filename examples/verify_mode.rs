@@ -90,7 +90,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         match periodicity_check(&system, &basis, &p.x, p.omega, &check) {
             Ok(r) => {
-                if p.converged {
+                if p.converged() {
                     defects.push((r.defect, r.displacement_defect));
                 }
                 println!(
@@ -98,7 +98,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     p.period,
                     p.energy_normalized,
                     exact,
-                    p.converged,
+                    p.converged(),
                     p.residual_norm,
                     r.defect,
                     r.displacement_defect,

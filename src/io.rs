@@ -163,7 +163,6 @@ mod tests {
             omega: 2.0 * std::f64::consts::PI / 3.5,
             energy: 1e-6,
             energy_normalized: 2.25,
-            converged: true,
             status: crate::branches::PointStatus::Converged,
             residual_norm: 1e-15,
             iterations: 2,

@@ -121,7 +121,7 @@ mod tests {
                 (Ok(a), Ok(b)) => {
                     assert_eq!(a.points.len(), b.points.len(), "job {k}");
                     for (p, q) in a.points.iter().zip(&b.points) {
-                        assert_eq!(p.converged, q.converged, "job {k} step {}", p.step);
+                        assert_eq!(p.converged(), q.converged(), "job {k} step {}", p.step);
                         assert_eq!(p.energy.to_bits(), q.energy.to_bits(), "job {k}");
                         assert_eq!(p.residual_norm.to_bits(), q.residual_norm.to_bits());
                         assert!(p

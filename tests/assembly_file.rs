@@ -112,7 +112,7 @@ fn a_short_backbone_from_the_clamped_file_equals_the_reference_bit_for_bit() {
     let from_file = run(load("clamped.toml").system());
     let reference = run(&clamped_bar_with_obstacle(1e-3).unwrap());
     assert_eq!(from_file.points.len(), 10);
-    assert!(from_file.points.iter().all(|p| p.converged));
+    assert!(from_file.points.iter().all(|p| p.converged()));
     // `{:?}` of an f64 identifies it uniquely: equal text is equal bits.
     let text = |run: &nonsmooth_modes::branches::ModeBranches| {
         format!("{:?}", (run.grazing_energy, &run.points, &run.end))
@@ -581,7 +581,7 @@ fn a_backbone_from_a_json_round_trip_equals_the_original_bit_for_bit() {
     };
     let run = |s: &BarSystem| compute(s, &request).unwrap().points;
     let (a, b) = (run(&system), run(back.system()));
-    assert!(a.iter().any(|p| p.converged));
+    assert!(a.iter().any(|p| p.converged()));
     assert_eq!(a, b);
     let bits = |p: &[nonsmooth_modes::branches::BackbonePoint]| -> Vec<u64> {
         p.iter()

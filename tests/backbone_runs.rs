@@ -95,11 +95,11 @@ fn a_stalled_run_keeps_its_points_and_says_why() {
     assert!(run.converged().count() >= 5);
     assert!(run.points.len() < 41);
     for p in &run.points {
-        assert_eq!(p.converged, p.status == PointStatus::Converged);
+        assert_eq!(p.converged(), p.status == PointStatus::Converged);
         assert!(p.x.iter().all(|v| v.is_finite()));
     }
     // The last points are the failures that stalled it.
-    assert!(run.points.iter().rev().take(6).all(|p| !p.converged));
+    assert!(run.points.iter().rev().take(6).all(|p| !p.converged()));
     assert!(run.grazing_energy > 0.0);
 }
 
@@ -118,7 +118,7 @@ fn a_completed_run_reports_each_step_status() {
     assert_eq!(run.error(), None);
     assert_eq!(run.points.len(), 181);
     for p in &run.points {
-        assert_eq!(p.converged, p.status == PointStatus::Converged);
+        assert_eq!(p.converged(), p.status == PointStatus::Converged);
         if let PointStatus::SolverFailed(e) = &p.status {
             assert!(!e.to_string().is_empty());
         }

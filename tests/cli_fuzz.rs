@@ -881,3 +881,46 @@ fn backbone_csv(name: &str, args: &[&str]) -> String {
     assert_eq!(output.status.code(), Some(0), "{stderr}");
     std::fs::read_to_string(&csv).expect("the CSV")
 }
+
+/// `backbone --exact` writes `harmonic_balance_distance,seeded` last: one point is the seed,
+/// the others are continued from it, and each is within a few per cent of the
+/// harmonic-balance point at its period (the clamped bar at `T = 3.95 ... 3.94`, where the
+/// two agree).
+#[test]
+fn backbone_exact_columns_compare_with_harmonic_balance() {
+    let args = [
+        "--system",
+        "ds",
+        "--period-start",
+        "3.95",
+        "--period-end",
+        "3.94",
+        "--steps",
+        "3",
+        "--exact",
+    ];
+    let text = backbone_csv("exact-columns", &args);
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    assert_eq!(
+        header[header.len() - 2..],
+        ["harmonic_balance_distance", "seeded"]
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3, "{text}");
+    let mut seeds = 0;
+    for cells in &rows {
+        assert_eq!(cells.len(), header.len(), "{cells:?}");
+        let [distance, seeded] = cells[cells.len() - 2..] else {
+            unreachable!()
+        };
+        let distance: f64 = distance.parse().expect("a distance");
+        assert!(distance.abs() < 0.05, "{cells:?}");
+        seeds += match seeded {
+            "true" => 1,
+            "false" => 0,
+            other => panic!("seeded is `{other}`: {text}"),
+        };
+    }
+    assert_eq!(seeds, 1, "{text}");
+}

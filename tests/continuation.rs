@@ -44,7 +44,7 @@ fn assert_all_converged(
     let tolerance = 1e-9 * residual_scale(&mut problem);
     let mut f = vec![0.0; problem.dimension()];
     for p in points {
-        assert!(p.converged);
+        assert!(p.converged());
         problem.set_parameter(p.omega);
         problem.residual(&p.x, &mut f);
         let r = f.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -115,7 +115,7 @@ fn gap_continuation_reproduces_the_quadratic_energy_scaling() {
     };
     let start = walk
         .iter()
-        .filter(|p| p.converged && p.period < 3.7)
+        .filter(|p| p.converged() && p.period < 3.7)
         .min_by(|a, b| gap_to_exact(a).total_cmp(&gap_to_exact(b)))
         .unwrap();
     let (omega, period, x) = (start.omega, start.period, start.x.clone());
@@ -431,7 +431,7 @@ fn speculative_backbone_is_the_serial_backbone() {
     let options = BackboneOptions::on_grid(PAPER_GRID, 1, 1);
     let serial = clamped_backbone_m40(&options, None);
     assert_eq!(serial.len(), 181);
-    assert!(serial.iter().filter(|p| !p.converged).count() > 0);
+    assert!(serial.iter().filter(|p| !p.converged()).count() > 0);
     for after_evaluations in [0, 10] {
         let speculation = Some(Speculation { after_evaluations });
         assert_eq!(clamped_backbone_m40(&options, speculation), serial);

@@ -54,7 +54,7 @@ fn one_call_gives_a_checked_labelled_backbone() {
     assert!(last.period < first.period && last.energy > first.energy);
 
     // A point asks its own questions without a rebuilt problem.
-    let index = run.points.iter().position(|p| p.converged).unwrap();
+    let index = run.points.iter().position(|p| p.converged()).unwrap();
     let solution = run.solution(index).unwrap();
     let energy = solution.energy().unwrap();
     assert!((energy / run.points[index].energy - 1.0).abs() < 1e-12);

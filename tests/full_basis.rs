@@ -36,7 +36,7 @@ fn both(system: &BarSystem) -> (Vec<BackbonePoint>, FullBasisBranch) {
         .settings(settings())
         .solver(Solver::default());
     let run = compute(system, &request).unwrap();
-    let first = run.points.iter().find(|p| p.converged).unwrap().clone();
+    let first = run.points.iter().find(|p| p.converged()).unwrap().clone();
     let periods = (run.points.iter())
         .filter(|p| p.step >= first.step)
         .map(|p| p.period)
@@ -64,12 +64,12 @@ fn the_full_basis_reproduces_the_papers_cosine_backbones() {
     ];
     for (name, system) in systems {
         let (cosine, full) = both(&system);
-        let converged = cosine.iter().filter(|p| p.converged).count();
+        let converged = cosine.iter().filter(|p| p.converged()).count();
         let mut common = 0;
         for q in &full.points {
             let Some(p) = cosine
                 .iter()
-                .find(|p| p.converged && p.period == q.point.period)
+                .find(|p| p.converged() && p.period == q.point.period)
             else {
                 continue;
             };
@@ -103,7 +103,7 @@ fn a_shifted_motion_is_the_same_motion() {
     let (cosine, _) = both(&system);
     let p = cosine
         .iter()
-        .find(|p| p.converged && p.period < 3.6)
+        .find(|p| p.converged() && p.period < 3.6)
         .unwrap();
     let even = to_full_basis(&p.x, M).unwrap();
     let samples = settings().samples_per_harmonic * M;
@@ -250,7 +250,7 @@ fn full_basis_points_are_checked_and_labelled_as_the_cosine_ones() {
         .solver(Solver::default())
         .checked(TimeDomainCheck::for_system(&system));
     let cosine = compute(&system, &request).unwrap();
-    let first = cosine.points.iter().find(|p| p.converged).unwrap();
+    let first = cosine.points.iter().find(|p| p.converged()).unwrap();
     let periods = (cosine.points.iter())
         .filter(|p| p.step >= first.step)
         .map(|p| p.period)

@@ -528,9 +528,13 @@ fn points_without_a_finite_energy_are_not_converged() {
     let start = ClampedFirstMode::new(1e-150, 3.6).unknowns(HARMONICS);
     let gaps = branch_points(clamped_bar_with_obstacle, values, start);
     for (value, p) in lengths.iter().chain(&gaps) {
-        assert_eq!(p.converged, p.status == PointStatus::Converged, "{value:e}");
+        assert_eq!(
+            p.converged(),
+            p.status == PointStatus::Converged,
+            "{value:e}"
+        );
         let finite = p.energy.is_finite() && p.energy_normalized.is_finite();
-        if p.converged {
+        if p.converged() {
             assert!(finite, "{value:e}: {p:?}");
         }
         if p.status == PointStatus::NonFiniteEnergy {

@@ -316,7 +316,7 @@ fn jacobian_matches_finite_differences_near_converged_points() {
             };
             let branch = compute(&sys, &request).unwrap().points;
             let mut problem = NonsmoothSystem::new(&sys, settings).unwrap();
-            for (k, p) in branch.iter().filter(|p| p.converged).enumerate() {
+            for (k, p) in branch.iter().filter(|p| p.converged()).enumerate() {
                 let x: Vec<f64> =
                     p.x.iter()
                         .enumerate()

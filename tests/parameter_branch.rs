@@ -33,7 +33,7 @@ fn start(settings: HarmonicBalanceSettings) -> BackbonePoint {
         steps: 31,
     };
     let points = grid_points(settings, grid);
-    points.into_iter().rev().find(|p| p.converged).unwrap()
+    points.into_iter().rev().find(|p| p.converged()).unwrap()
 }
 
 #[test]
@@ -75,7 +75,7 @@ fn gap_branches_keep_the_normalised_energy() {
             branch.points.len() + branch.rejections * usize::from(!arclength)
         );
         for (gap, p) in &seen {
-            assert!(p.converged);
+            assert!(p.converged());
             assert_eq!(p.omega, from.omega);
             assert!(
                 (p.energy_normalized / from.energy_normalized - 1.0).abs() < 1e-8,
@@ -149,7 +149,7 @@ fn a_gap_branch_that_slides_to_rest_reports_it() {
     let from = grid_points(settings, grid)
         .into_iter()
         .rev()
-        .find(|p| p.converged)
+        .find(|p| p.converged())
         .unwrap();
     let values: Vec<f64> = (0..5).map(|i| 1e-3 + 2.25e-3 * i as f64).collect();
     let mut seen = Vec::new();
@@ -177,8 +177,8 @@ fn a_gap_branch_that_slides_to_rest_reports_it() {
         seen.iter().map(|p| p.energy_normalized).collect::<Vec<_>>()
     );
     for p in &seen {
-        assert_eq!(p.converged, p.status == PointStatus::Converged);
-        if p.converged {
+        assert_eq!(p.converged(), p.status == PointStatus::Converged);
+        if p.converged() {
             assert!(p.energy_normalized > 1e-6, "{}", p.energy_normalized);
         }
     }

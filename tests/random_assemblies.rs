@@ -314,13 +314,13 @@ fn asking_for_the_check_does_not_change_the_answer() {
         assert_eq!((a.auto, a.selection), (b.auto, b.selection), "{d}");
         for (p, q) in a.points.iter().zip(&b.points) {
             assert_eq!(
-                (p.period, p.energy, p.converged),
-                (q.period, q.energy, q.converged)
+                (p.period, p.energy, p.converged()),
+                (q.period, q.energy, q.converged())
             );
             assert!(p.check.is_none(), "{d}: the plain request checks nothing");
             assert_eq!(
                 q.check.is_some(),
-                q.converged && q.character.is_some(),
+                q.converged() && q.character.is_some(),
                 "{d}"
             );
         }

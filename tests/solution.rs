@@ -35,7 +35,7 @@ fn points(system: &BarSystem) -> Vec<BackbonePoint> {
         ..Request::new(1)
     };
     let all = compute(system, &request).unwrap().points;
-    all.into_iter().filter(|p| p.converged).collect()
+    all.into_iter().filter(|p| p.converged()).collect()
 }
 
 #[test]

@@ -114,12 +114,12 @@ fn nsm2_sub3_of_the_robin_bar_leaves_the_repeated_branch() {
         .position(|p| share(p) >= GENUINE_SHARE)
         .unwrap();
     for p in &points[first..] {
-        if p.converged {
+        if p.converged() {
             assert!(share(p) >= GENUINE_SHARE, "step {}: {}", p.step, share(p));
         }
     }
     // Before the switch, the branch is the repeated one.
-    for p in points[..first].iter().filter(|p| p.converged) {
+    for p in points[..first].iter().filter(|p| p.converged()) {
         assert!(share(p) < 1e-10, "step {}: {}", p.step, share(p));
     }
 }

@@ -345,7 +345,7 @@ fn harmonic_balance_point_with_incommensurate_bars_is_checked() {
         };
         let points = compute(&system, &request).unwrap().points;
         let point = points.first().unwrap();
-        assert!(point.converged);
+        assert!(point.converged());
         let mut reports = Vec::new();
         for dt in [1.0 / 200.0, 1.0 / 400.0] {
             let check = PeriodicityOptions {

@@ -40,7 +40,7 @@ pub fn run_full_basis(
     }
     let cosine = compute(system, request)?;
     let periods = linspace(t0, t1, a.steps)?;
-    let Some(first) = cosine.points.iter().find(|p| p.converged) else {
+    let Some(first) = cosine.points.iter().find(|p| p.converged()) else {
         return Err("--basis full: the cosine run found no start on the grid".into());
     };
     let full_request = Request {

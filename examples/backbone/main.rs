@@ -82,7 +82,12 @@
 //! exact point, in the same columns with the stability columns always present: `iterations`
 //! and `residual_norm` are the corrector's steps and the orbit's periodicity defect, `label`
 //! that of the harmonic-balance point the segment was seeded from, `branch` one more after
-//! each reseed, `contacts_per_period` counted on the orbit, `dominant_harmonic` empty.
+//! each reseed, `contacts_per_period` counted on the orbit, `dominant_harmonic` empty; then,
+//! last, `harmonic_balance_distance` (`(E - E_hb) / E_hb` against the converged
+//! harmonic-balance point at the same period, empty where there is none) and `seeded`
+//! (`true` for a point corrected from a harmonic-balance point, `false` for one continued
+//! from the orbit before it). A distance that grows step after step while the harmonic-balance
+//! points stay put is a branch that has left their family (`docs/validation.md`).
 //! `--cells-per-travel N` (at most 1000) is the map's smallest grid, in cells per shortest
 //! travel time; the grid used may be finer, so that every period is a whole number of steps.
 //! Without it, `ExactOptions::for_request`: 200, or fewer where the system's other bars

@@ -14,8 +14,14 @@ use std::ops::ControlFlow;
 
 /// The groups of the table: the point's and the run's columns, then [`Group::Verify`] if
 /// `verify`, [`Group::Subharmonic`] for a subharmonic order `K > 1`, [`Group::Stability`] if
-/// `stability` and [`Group::Hill`] if `hill`.
-pub fn groups(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> Vec<Group> {
+/// `stability`, [`Group::Hill`] if `hill` and [`Group::ExactBranch`] if `exact_branch`.
+pub fn groups(
+    verify: bool,
+    subharmonic: usize,
+    stability: bool,
+    hill: bool,
+    exact_branch: bool,
+) -> Vec<Group> {
     let asked = [
         (Group::Point, true),
         (Group::Run, true),
@@ -23,6 +29,7 @@ pub fn groups(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> 
         (Group::Subharmonic, subharmonic > 1),
         (Group::Stability, stability),
         (Group::Hill, hill),
+        (Group::ExactBranch, exact_branch),
     ];
     asked
         .into_iter()
@@ -32,8 +39,14 @@ pub fn groups(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> 
 }
 
 /// The header of the table of [`groups`].
-pub fn header(verify: bool, subharmonic: usize, stability: bool, hill: bool) -> String {
-    columns::header(&groups(verify, subharmonic, stability, hill))
+pub fn header(
+    verify: bool,
+    subharmonic: usize,
+    stability: bool,
+    hill: bool,
+    exact_branch: bool,
+) -> String {
+    columns::header(&groups(verify, subharmonic, stability, hill, exact_branch))
 }
 
 /// Says on stderr why a point was not checked in the time domain, where it says why.
@@ -73,6 +86,8 @@ pub struct Sink<'a> {
     pub stability: bool,
     /// `--hill`: write `hill_stable,hill_max_multiplier,hill_reason`.
     pub hill: bool,
+    /// `--exact`: write `harmonic_balance_distance,seeded`.
+    pub exact_branch: bool,
 }
 
 impl Sink<'_> {
@@ -122,25 +137,28 @@ impl Sink<'_> {
         p: &BackbonePoint,
         parameter: f64,
     ) -> ControlFlow<()> {
-        self.row_counted(problem, p, parameter, None)
+        self.row_counted(problem, p, parameter, None, None)
     }
 
     /// Writes the row of a point of an exact branch, whose contacts were counted on its
     /// orbit (it has no harmonic-balance unknowns to count them on).
     pub fn exact_row(&mut self, problem: &mut NonsmoothSystem, e: &ExactPoint) -> ControlFlow<()> {
-        self.row_counted(problem, &e.point, f64::NAN, Some(e.contacts.iter().sum()))
+        let counted = Some(e.contacts.iter().sum());
+        self.row_counted(problem, &e.point, f64::NAN, counted, Some(e))
     }
 
-    /// [`Sink::row`], with the contacts per period `counted` where they are known.
+    /// [`Sink::row`], with the contacts per period `counted` where they are known, and the
+    /// exact point `exact_point` the point is of, for an exact branch.
     fn row_counted(
         &mut self,
         problem: &mut NonsmoothSystem,
         p: &BackbonePoint,
         parameter: f64,
         counted: Option<usize>,
+        exact_point: Option<&ExactPoint>,
     ) -> ControlFlow<()> {
         self.total += 1;
-        self.converged += usize::from(p.converged);
+        self.converged += usize::from(p.converged());
         let exact = self
             .exact
             .map(|gap| ClampedFirstMode::new(gap, p.period).energy_normalized());
@@ -160,9 +178,12 @@ impl Sink<'_> {
             parameter: (!parameter.is_nan()).then_some(parameter),
             contacts,
             subharmonic_share,
+            harmonic_balance_distance: exact_point.and_then(|e| e.harmonic_balance_distance),
+            seeded: exact_point.map(|e| e.seeded),
             ..Row::new(p, Digits::SHORT)
         };
-        let groups = groups(self.verify, self.subharmonic, self.stability, self.hill);
+        let (verify, stability, hill) = (self.verify, self.stability, self.hill);
+        let groups = groups(verify, self.subharmonic, stability, hill, self.exact_branch);
         let mut line = String::new();
         columns::write_row(&groups, &row, &mut line);
         match writeln!(self.out, "{line}") {

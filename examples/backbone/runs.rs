@@ -31,7 +31,13 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
     writeln!(
         out,
         "{}",
-        header(a.verify, a.subharmonic, a.stability || a.exact, a.hill)
+        header(
+            a.verify,
+            a.subharmonic,
+            a.stability || a.exact,
+            a.hill,
+            a.exact
+        )
     )?;
     let mut sink = Sink {
         out,
@@ -46,6 +52,7 @@ pub fn run(a: &Args, out: &mut dyn Write) -> Result<(usize, usize), Box<dyn std:
         subharmonic: a.subharmonic,
         stability: a.stability || a.exact,
         hill: a.hill,
+        exact_branch: a.exact,
     };
     if a.exact {
         run_exact(a, &system, &request(a, &system, (t0, t1))?, &mut sink)?;
@@ -320,7 +327,7 @@ fn run_parameter(
         .points
         .iter()
         .rev()
-        .find(|p| p.converged)
+        .find(|p| p.converged())
         .ok_or("no converged point on the way to the starting period")?
         .clone();
     let family = move |v: f64| build_system(a, parameter, v);

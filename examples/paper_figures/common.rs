@@ -274,7 +274,7 @@ pub fn labelled_series(runs: &[(&Run, Rgb, Marker)], omega_1: f64) -> Vec<Series
 fn pieces(run: &Run, keep: impl Fn(&BackbonePoint) -> bool) -> Vec<Vec<&BackbonePoint>> {
     let mut pieces: Vec<Vec<&BackbonePoint>> = vec![Vec::new()];
     for p in &run.points {
-        let joins = p.converged && keep(p);
+        let joins = p.converged() && keep(p);
         let last = pieces.last_mut().expect("one piece at least");
         let same_branch = last.last().is_none_or(|q| q.branch == p.branch);
         if joins && same_branch {

@@ -147,7 +147,7 @@ fn median_with<'a>(
     mut has: impl FnMut(&BackbonePoint) -> Res<bool>,
 ) -> Res<Option<&'a BackbonePoint>> {
     let mut kept = Vec::new();
-    for p in points.filter(|p| p.converged) {
+    for p in points.filter(|p| p.converged()) {
         if has(p)? {
             kept.push(p);
         }

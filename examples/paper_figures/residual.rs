@@ -207,7 +207,7 @@ fn clamped_point(ctx: &Ctx, m: usize, period: f64) -> Res<(Run, BackbonePoint)> 
         .points
         .iter()
         .rev()
-        .find(|p| p.converged && (p.period - period).abs() < 1e-9)
+        .find(|p| p.converged() && (p.period - period).abs() < 1e-9)
         .cloned()
         .ok_or_else(|| format!("m = {m}: no converged point at T = {period}"))?;
     Ok((r, p))

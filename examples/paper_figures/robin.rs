@@ -168,7 +168,7 @@ pub fn fig12(ctx: &Ctx) -> Res<Stats> {
     // an open-contact natural frequency holds at least `MIN_RESONANT_SHARE` of the energy),
     // the largest local excess over its neighbours along the first unbroken run of converged
     // steps, below the blow-up.
-    let conv: Vec<&BackbonePoint> = branch.points.iter().take_while(|p| p.converged).collect();
+    let conv: Vec<&BackbonePoint> = branch.points.iter().take_while(|p| p.converged()).collect();
     let e = conv
         .iter()
         .find(|p| p.period < 1.86 && labelled(p, &Label::Skeleton))
@@ -304,14 +304,9 @@ fn one_contact_off_the_repeated_branch(
                 continue;
             }
             let e = energy(system, &basis, &y, p.omega);
-            let point = BackbonePoint {
-                x: y,
-                energy: e,
-                energy_normalized: e / e_g,
-                residual_norm: info.residual_norm,
-                iterations: info.iterations,
-                ..p.clone()
-            };
+            let mut point = p.clone();
+            (point.x, point.energy, point.energy_normalized) = (y, e, e / e_g);
+            (point.residual_norm, point.iterations) = (info.residual_norm, info.iterations);
             if contacts_and_grazings(&problem, &point)? == Some((1, 2)) {
                 return Ok(Some(point));
             }

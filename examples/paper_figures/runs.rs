@@ -5,7 +5,7 @@
 use crate::common::{settings, Ctx, Res, GAP};
 use nonsmooth_modes::branches::{
     compute, ArclengthBackboneOptions, BackboneOptions, BackbonePoint, EnergyBackboneOptions,
-    Method, PeriodGrid, PointStatus, Request, TRIVIAL_ENERGY,
+    Method, PeriodGrid, Request, TRIVIAL_ENERGY,
 };
 use nonsmooth_modes::continuation::{
     ArclengthOptions, EndReason, PeriodParametrised, Sequential, SequentialOptions, Step,
@@ -78,7 +78,7 @@ impl Run {
 
     /// Its converged points.
     pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
-        self.points.iter().filter(|p| p.converged)
+        self.points.iter().filter(|p| p.converged())
     }
 
     /// The run up to the end of its branch, and the rest labelled `beyond`: the branch ends
@@ -88,7 +88,7 @@ impl Run {
         let mut end = self.points.len();
         let mut misses = 0;
         for (i, p) in self.points.iter().enumerate() {
-            misses = if p.converged { 0 } else { misses + 1 };
+            misses = if p.converged() { 0 } else { misses + 1 };
             if misses == gap {
                 end = i + 1 - gap;
                 break;
@@ -266,27 +266,7 @@ pub fn solved_point(
 ) -> Res<BackbonePoint> {
     let e_g = grazing_energy(system)?.0;
     let e = energy(system, basis, &x, omega);
-    Ok(BackbonePoint {
-        step: 0,
-        period: 2.0 * PI / omega,
-        omega,
-        energy: e,
-        energy_normalized: e / e_g,
-        converged: true,
-        status: PointStatus::Converged,
-        residual_norm: info.residual_norm,
-        iterations: info.iterations,
-        x,
-        step_size: 0.0,
-        events: Vec::new(),
-        branch: 0,
-        time_domain: None,
-        check: None,
-        character: None,
-        label: None,
-        stability: None,
-        hill: None,
-    })
+    Ok(BackbonePoint::solved(x, omega, e, e_g, info))
 }
 
 /// The branch through the converged point `p` of `system` with `m` harmonics: sequential
@@ -326,7 +306,7 @@ pub fn continued_from(
                     let omega = 2.0 * PI / q.parameter;
                     let e = energy(system, &basis, &q.x, omega);
                     let point = BackbonePoint::from_point(&q, omega, e, e_g);
-                    if point.converged && point.energy_normalized > TRIVIAL_ENERGY {
+                    if point.converged() && point.energy_normalized > TRIVIAL_ENERGY {
                         points.push(point);
                     }
                 }

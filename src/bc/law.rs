@@ -278,7 +278,7 @@ pub fn complementarity_samples(
 ///         .checked(TimeDomainCheck::for_system(&system))
 /// };
 /// let points = compute(&system, &request)?.points;
-/// assert!(points.iter().all(|p| p.converged));
+/// assert!(points.iter().all(|p| p.converged()));
 /// assert!(points.windows(2).all(|w| w[1].energy_normalized > w[0].energy_normalized));
 /// assert!(points.iter().all(|p| p.check == Some(CheckOutcome::Passed)));
 /// # Ok::<(), nonsmooth_modes::Error>(())

@@ -38,7 +38,7 @@ impl PointGroup<'_> {
 /// without a label (a run that did not label, or not converged) is in none.
 pub fn group_by_label(points: &[BackbonePoint]) -> Vec<PointGroup<'_>> {
     let mut groups: Vec<PointGroup<'_>> = Vec::new();
-    for p in points.iter().filter(|p| p.converged) {
+    for p in points.iter().filter(|p| p.converged()) {
         let Some(label) = &p.label else {
             continue;
         };

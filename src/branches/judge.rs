@@ -134,7 +134,9 @@ pub(crate) struct Judge {
 impl Judge {
     /// The judge of the run of `points` on `problem`, nothing marched yet.
     pub(crate) fn new(points: &[BackbonePoint], problem: &NonsmoothSystem) -> Self {
-        let converged: Vec<usize> = (0..points.len()).filter(|&i| points[i].converged).collect();
+        let converged: Vec<usize> = (0..points.len())
+            .filter(|&i| points[i].converged())
+            .collect();
         let (n, s) = (converged.len(), converged.len().min(JUDGE_SAMPLES));
         Self {
             system: problem.system().clone(),

@@ -114,7 +114,7 @@ pub(crate) fn lifted_points(
     let solvers: [&dyn NonlinearSolver; 2] = [solver, &homotopy];
     let mut before: Option<(usize, Vec<f64>)> = None;
     let mut lifted = Vec::new();
-    for coarse in points.iter().filter(|p| p.converged) {
+    for coarse in points.iter().filter(|p| p.converged()) {
         let mut guess = vec![0.0; problem.dimension()];
         let shared = coarse.x.len().min(guess.len());
         guess[..shared].copy_from_slice(&coarse.x[..shared]);
@@ -150,7 +150,6 @@ pub(crate) fn lifted_points(
             omega: coarse.omega,
             energy,
             energy_normalized: energy / e_g,
-            converged,
             status,
             residual_norm,
             iterations,
@@ -215,7 +214,7 @@ mod tests {
 
     impl Run {
         fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
-            self.points.iter().filter(|p| p.converged)
+            self.points.iter().filter(|p| p.converged())
         }
     }
 
@@ -260,7 +259,7 @@ mod tests {
         points[2].events = vec![Event::Jump { ratio: 9.0 }, Event::Fold { parameter: 1.0 }];
         points[2].branch = 1;
         let mut failed = points[4].clone();
-        failed.converged = false;
+        failed.status = PointStatus::Rejected;
         points.push(failed);
         let mut problem = fine.problem.clone();
         let e_g = coarse.grazing_energy;
@@ -269,7 +268,7 @@ mod tests {
         assert_eq!(lifted.len(), 5);
         assert_eq!(fine.converged().count(), 5);
         for (l, f) in lifted.iter().zip(fine.converged()) {
-            assert!(l.converged, "step {} converged", l.step);
+            assert!(l.converged(), "step {} converged", l.step);
             assert_eq!((l.period, l.omega), (f.period, f.omega));
             assert!((l.energy - f.energy).abs() <= 1e-8 * f.energy);
             assert!((l.energy_normalized - l.energy / e_g).abs() <= 1e-15 * l.energy_normalized);
@@ -294,7 +293,7 @@ mod tests {
         let points = &coarse.points[..1];
         let lifted = lifted_points(points, &mut problem, &Solver::default(), (e_g, f64::MAX));
         assert_eq!(lifted[0].status, PointStatus::CollapsedToRest);
-        assert!(!lifted[0].converged);
+        assert!(!lifted[0].converged());
         let n = points[0].x.len();
         assert_eq!(lifted[0].x[..n], points[0].x[..]);
         assert!(lifted[0].x[n..].iter().all(|&v| v == 0.0));

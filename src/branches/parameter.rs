@@ -24,7 +24,7 @@ use std::ops::ControlFlow;
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParameterSteps {
     /// Natural-parameter continuation over `values` (the first is solved from the start
-    /// point); failed steps reach the observer as points with `converged == false`.
+    /// point); failed steps reach the observer as points that are not [`BackbonePoint::converged`].
     Values(Vec<f64>, SequentialOptions),
     /// Pseudo-arclength continuation from the start value inside
     /// [`ArclengthOptions::parameter_range`], in [`ArclengthOptions::direction`].
@@ -40,7 +40,7 @@ pub enum ParameterSteps {
 /// [`EndReason::Stalled`](crate::continuation::EndReason::Stalled).
 ///
 /// A converged point whose energy `E` or `E / E_g` is not finite reaches the observer as
-/// [`PointStatus::NonFiniteEnergy`] with `converged == false`, the non-finite number left in
+/// [`PointStatus::NonFiniteEnergy`] (not converged), the non-finite number left in
 /// it: a parameter value whose system has no grazing energy (a gap whose `E_g` underflows or
 /// overflows,
 /// [`SettingsError::GrazingEnergyOutOfRange`](crate::SettingsError::GrazingEnergyOutOfRange),
@@ -48,7 +48,7 @@ pub enum ParameterSteps {
 /// (a bar length near `f64::MAX`). A converged point below the backbones' trivial-energy floor
 /// ([`BackboneOptions::trivial_energy`](crate::branches::BackboneOptions::trivial_energy) times
 /// `E_g` at its parameter) is the state of rest, not a point of the branch: it reaches the
-/// observer as [`PointStatus::CollapsedToRest`] with `converged == false`.
+/// observer as [`PointStatus::CollapsedToRest`] (not converged).
 ///
 /// Branches are continuous or split, as in [`compute`](crate::branches::compute)'s runs
 /// ([`JUMP_RATIO`](crate::branches::JUMP_RATIO),
@@ -120,12 +120,11 @@ where
         let e = energy(&system, &basis, &p.x, omega);
         let e_g = grazing_energy(&system).map_or(f64::NAN, |g| g.0);
         let mut point = BackbonePoint::from_point(p, omega, e, e_g);
-        if point.converged && e_g.is_finite() && e <= floor * e_g {
-            point.converged = false;
+        if point.converged() && e_g.is_finite() && e <= floor * e_g {
             point.status = PointStatus::CollapsedToRest;
         }
         splitter.enter(&mut point);
-        if point.converged {
+        if point.converged() {
             let sample = Sample {
                 period: p.parameter,
                 energy: point.energy_normalized,

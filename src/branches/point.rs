@@ -9,6 +9,7 @@ use crate::error::{Error, SettingsError};
 use crate::fourier::{frequency_of_period, period_of_frequency, Basis};
 use crate::modal::{Character, Label};
 use crate::solution::Solution;
+use crate::solve::SolveInfo;
 use crate::stability::{Floquet, HillSpectrum, StabilityError};
 use crate::system::NonsmoothSystem;
 use crate::verify::{PeriodicityReport, VerifyError};
@@ -17,6 +18,7 @@ use std::fmt;
 /// One point of a backbone.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub struct BackbonePoint {
     /// Step number.
     pub step: usize,
@@ -28,9 +30,6 @@ pub struct BackbonePoint {
     pub energy: f64,
     /// `E / E_g`.
     pub energy_normalized: f64,
-    /// The solver converged to a motion that touches (not the state of rest), with a finite
-    /// energy: `status == PointStatus::Converged`.
-    pub converged: bool,
     /// What became of the step: converged, solver failed (with its error), or collapsed to
     /// the state of rest.
     pub status: PointStatus,
@@ -79,6 +78,41 @@ pub struct BackbonePoint {
 }
 
 impl BackbonePoint {
+    /// Whether the solver converged to a motion that touches (not the state of rest), with a
+    /// finite energy: `status == PointStatus::Converged`. Derived from
+    /// [`BackbonePoint::status`], so that the two cannot disagree.
+    pub fn converged(&self) -> bool {
+        self.status == PointStatus::Converged
+    }
+
+    /// A motion `x` solved at the fixed frequency `omega` (not continued: step 0, no step
+    /// size, no events, branch 0, nothing annotated), as a converged point with its energy
+    /// `energy` normalised by the grazing energy `e_g`, and the solver's report `solved`. A
+    /// point whose energy or `E / E_g` is not finite is [`PointStatus::NonFiniteEnergy`].
+    pub fn solved(x: Vec<f64>, omega: f64, energy: f64, e_g: f64, solved: &SolveInfo) -> Self {
+        let energy_normalized = energy / e_g;
+        Self {
+            step: 0,
+            period: period_of_frequency(omega),
+            omega,
+            energy,
+            energy_normalized,
+            status: PointStatus::Converged.with_energy(energy, energy_normalized),
+            residual_norm: solved.residual_norm,
+            iterations: solved.iterations,
+            x,
+            step_size: 0.0,
+            events: Vec::new(),
+            branch: 0,
+            time_domain: None,
+            check: None,
+            character: None,
+            label: None,
+            stability: None,
+            hill: None,
+        }
+    }
+
     /// The point as a [`Solution`] of `problem` (the problem the backbone was computed for),
     /// to ask it for fields, histories, diagnostics and the time-domain check.
     ///
@@ -119,7 +153,6 @@ impl BackbonePoint {
             omega: time.omega,
             energy,
             energy_normalized,
-            converged: status == PointStatus::Converged,
             status,
             residual_norm: p.residual_norm,
             iterations: p.iterations,
@@ -177,7 +210,6 @@ impl BackbonePoint {
             x: vec![0.0],
             energy: 1.0,
             energy_normalized: 1.0,
-            converged,
             status: if converged {
                 PointStatus::Converged
             } else {
@@ -278,7 +310,7 @@ impl BackbonePoint {
     /// (a condition without a time-domain form) counts: there is no law in time to hold it
     /// against.
     pub(crate) fn is_good(&self) -> bool {
-        self.converged
+        self.converged()
             && !matches!(
                 self.check,
                 Some(

@@ -58,7 +58,7 @@ impl ModeBranches {
 
     /// The converged points.
     pub fn converged(&self) -> impl Iterator<Item = &BackbonePoint> {
-        self.points.iter().filter(|p| p.converged)
+        self.points.iter().filter(|p| p.converged())
     }
 
     /// The points of branch `index` ([`BackbonePoint::branch`]).
@@ -164,7 +164,7 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
     /// converged point of the mode's own content has said whether it left the branch.
     pub(crate) fn point(&mut self, mut point: BackbonePoint) -> ControlFlow<()> {
         self.splitter.enter(&mut point);
-        if point.converged {
+        if point.converged() {
             self.converged += 1;
             self.describe(&mut point);
         }
@@ -211,8 +211,8 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
     /// left without them.
     pub(crate) fn replay(&mut self, points: Vec<BackbonePoint>, end: EndReason) -> EndReason {
         for mut point in points {
-            self.converged += usize::from(point.converged);
-            if point.converged && point.character.is_some() {
+            self.converged += usize::from(point.converged());
+            if point.converged() && point.character.is_some() {
                 self.check(&mut point);
                 self.assess(&mut point);
             }

@@ -187,7 +187,7 @@ pub(crate) fn genuine_subharmonic_backbone_with<S: NonlinearSolver>(
         // A converged point is tried off the subspace before it is moved to the observer
         // (the observer keeps it; its unknowns are not copied). If the observer stops the
         // run, the switch found is not taken.
-        let left = p.converged.then(|| {
+        let left = p.converged().then(|| {
             floor = options.trivial_energy * p.energy / p.energy_normalized;
             leave_subspace(&mut problem, &solver, (&p.x, p.omega), k, floor).map(|y| (y, p.step))
         });

@@ -109,7 +109,7 @@ pub fn exact_branch_from(
         .map(|t| {
             run.points
                 .iter()
-                .filter(|p| p.converged && (p.period - t).abs() <= half_step)
+                .filter(|p| p.converged() && (p.period - t).abs() <= half_step)
                 .min_by(|a, b| (a.period - t).abs().total_cmp(&(b.period - t).abs()))
         })
         .collect();

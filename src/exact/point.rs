@@ -113,7 +113,6 @@ impl Walker<'_> {
             omega: frequency_of_period(period),
             energy,
             energy_normalized: normalized,
-            converged: status == PointStatus::Converged,
             status,
             residual_norm: outcome.defect,
             iterations: outcome.iterations,

@@ -30,6 +30,10 @@ pub enum Group {
     Stability,
     /// Hill's verdict: `hill_stable,hill_max_multiplier,hill_reason`.
     Hill,
+    /// A point of an exact branch: `harmonic_balance_distance,seeded`, how far its energy is
+    /// from the harmonic-balance point at its period and whether it was corrected from one
+    /// (a seed) rather than continued.
+    ExactBranch,
     /// `omega_ratio,exact_energy_normalized,label`, last in
     /// [`write_branches_csv`](super::write_branches_csv).
     Comparison,
@@ -79,6 +83,10 @@ pub struct Row<'a> {
     pub subharmonic_share: Option<f64>,
     /// The frequency `Omega` is divided by in `omega_ratio` (`omega_1`).
     pub reference_omega: Option<f64>,
+    /// An exact point's `(E - E_hb) / E_hb` against the harmonic-balance point at its period.
+    pub harmonic_balance_distance: Option<f64>,
+    /// Whether an exact point was corrected from a harmonic-balance point.
+    pub seeded: Option<bool>,
 }
 
 impl<'a> Row<'a> {
@@ -93,6 +101,8 @@ impl<'a> Row<'a> {
             contacts: None,
             subharmonic_share: None,
             reference_omega: None,
+            harmonic_balance_distance: None,
+            seeded: None,
         }
     }
 }
@@ -140,7 +150,9 @@ pub static COLUMNS: &[Column] = {
             exp(s, r.digits.values, r.point.energy_normalized);
         }),
         column("exact_energy_normalized", Run, exact_energy_normalized),
-        column("converged", Point, |r, s| shown(s, Some(r.point.converged))),
+        column("converged", Point, |r, s| {
+            shown(s, Some(r.point.converged()))
+        }),
         column("status", Point, |r, s| s.push_str(r.point.status.label())),
         column("residual_norm", Point, |r, s| {
             exp(s, r.digits.residual, r.point.residual_norm);
@@ -197,6 +209,12 @@ pub static COLUMNS: &[Column] = {
             multiplier(r, s, hill(r))
         }),
         column("hill_reason", Hill, |r, s| reason(s, hill(r))),
+        column("harmonic_balance_distance", ExactBranch, |r, s| {
+            if let Some(d) = r.harmonic_balance_distance {
+                exp(s, 6, d);
+            }
+        }),
+        column("seeded", ExactBranch, |r, s| shown(s, r.seeded)),
         column("omega_ratio", Comparison, |r, s| {
             if let Some(omega_1) = r.reference_omega {
                 fixed(s, r.digits.values, r.point.omega / omega_1);
@@ -336,7 +354,15 @@ mod tests {
         let tables: [&[Group]; 4] = [
             &[Point],
             &[Branch, Point, Comparison],
-            &[Point, Run, Verify, Subharmonic, Stability, Hill],
+            &[
+                Point,
+                Run,
+                Verify,
+                Subharmonic,
+                Stability,
+                Hill,
+                ExactBranch,
+            ],
             &[Verify, Stability, Hill],
         ];
         for groups in tables {
@@ -347,6 +373,23 @@ mod tests {
             assert_eq!(unique.len(), names.len(), "{names:?}");
             assert_eq!(header(groups).split(',').collect::<Vec<_>>(), names);
         }
+    }
+
+    /// An exact point's columns are empty on other rows, and say what its row is given.
+    #[test]
+    fn exact_branch_cells_are_written_where_given() {
+        let point = BackbonePoint::for_test(0, 3.5, None, true);
+        let mut line = String::new();
+        write_row(&[ExactBranch], &Row::new(&point, Digits::SHORT), &mut line);
+        assert_eq!(line, ",");
+        let row = Row {
+            harmonic_balance_distance: Some(-0.25),
+            seeded: Some(true),
+            ..Row::new(&point, Digits::SHORT)
+        };
+        line.clear();
+        write_row(&[ExactBranch], &row, &mut line);
+        assert_eq!(line, "-2.500000e-1,true");
     }
 
     #[test]

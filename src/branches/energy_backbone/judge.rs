@@ -276,7 +276,6 @@ impl Judge {
                 omega,
                 energy: level * self.grazing_energy,
                 energy_normalized: level,
-                converged: verdict.is_some(),
                 status,
                 residual_norm,
                 iterations: solved.as_ref().map_or(0, |i| i.iterations),

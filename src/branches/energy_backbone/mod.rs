@@ -275,7 +275,7 @@ struct Segment {
 impl Segment {
     fn see(&mut self, point: &BackbonePoint) {
         self.points += 1;
-        if point.converged {
+        if point.converged() {
             self.misses = 0;
             self.last_accepted = Some((point.x.clone(), point.omega));
         } else {

@@ -206,7 +206,7 @@ fn the_clamped_bar_touches_once_per_period() {
         ..Request::new(1)
     };
     let run = compute(&system, &request).unwrap();
-    let p = run.points.iter().rev().find(|p| p.converged).unwrap();
+    let p = run.points.iter().rev().find(|p| p.converged()).unwrap();
     let mut problem = NonsmoothSystem::new(&system, settings).unwrap();
     assert_eq!(
         contact_intervals(&mut problem, &p.x, p.omega).unwrap(),

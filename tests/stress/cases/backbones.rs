@@ -453,7 +453,7 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
     // not finite (a system without grazing energy, a motion whose energy overflows) is
     // `NonFiniteEnergy`, not converged. Failed points hold the solver's last iterate.
     for (_, p) in &points {
-        if p.converged || p.status == PointStatus::NonFiniteEnergy {
+        if p.converged() || p.status == PointStatus::NonFiniteEnergy {
             c.backbone_point("parameter point", p);
         }
     }
@@ -465,7 +465,7 @@ pub(crate) fn parameter_case(d: &mut Draw, c: &mut Checks) -> CaseResult {
 fn stops_at(stop: Stop, seen: usize, p: &BackbonePoint) -> bool {
     match stop {
         Stop::FirstPoint => true,
-        Stop::FirstRejection => !p.converged,
+        Stop::FirstRejection => !p.converged(),
         Stop::After(n) => seen >= n,
         Stop::Never => false,
     }
