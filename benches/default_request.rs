@@ -5,7 +5,9 @@
 //! - `whole`: `branches::compute` of the example's request, with the second equation set on
 //!   a second thread (`speculation`, as the example runs it on two cores) and serial;
 //! - `sequential`: the paper's algorithm alone (`Method::PeriodGrid`, the example's
-//!   `--method sequential`), labels included;
+//!   `--method sequential`), labels included, on one thread; `sequential_two_threads` as
+//!   the example runs it on two cores (speculative retries, and the points annotated on the
+//!   calling thread while the driver steps on another);
 //! - `selected`: `Method::Auto` under harmonic selection alone (the second equation set);
 //! - `labels`: the character and label of each converged point of the kept run, with the
 //!   open-contact natural frequencies the labels name;
@@ -98,10 +100,12 @@ fn bench_runs(c: &mut Criterion) {
     let options = grid(&system);
     let mut group = group(c, "runs");
     for m in HARMONICS {
-        let sequential = request(m, Method::PeriodGrid(options), false);
-        group.bench_with_input(BenchmarkId::new("sequential", m), &sequential, |b, r| {
-            b.iter(|| run(&fresh(), black_box(r)))
-        });
+        for (name, threads) in [("sequential", false), ("sequential_two_threads", true)] {
+            let sequential = request(m, Method::PeriodGrid(options), threads);
+            group.bench_with_input(BenchmarkId::new(name, m), &sequential, |b, r| {
+                b.iter(|| run(&fresh(), black_box(r)))
+            });
+        }
         let selected =
             request(m, Method::Auto(Some(options)), false).resonance_band(RESONANCE_BAND);
         group.bench_with_input(BenchmarkId::new("selected", m), &selected, |b, r| {

@@ -1,7 +1,8 @@
 //! The one call: a branch of a system's nonsmooth mode from a [`Request`], whatever the method.
 
 use crate::branches::backbone::BackboneObserver;
-use crate::branches::plan::{asked, run_plan};
+use crate::branches::beside::run_plan_beside;
+use crate::branches::plan::asked;
 use crate::branches::point::BackbonePoint;
 use crate::branches::request::Request;
 use crate::branches::result::{Annotator, ModeBranches};
@@ -144,7 +145,7 @@ pub fn compute_observed(
     };
     let mut annotator = Annotator::new(problem, request, observer);
     let solver = request.solver_for(&method)?;
-    let (e_g, end, rejected) = run_plan(system, request, plan, solver, &mut annotator)?;
+    let (e_g, end, rejected) = run_plan_beside(system, request, (plan, solver), &mut annotator)?;
     let result = annotator.finish((method, None), e_g, end, rejected);
     Ok(with_exact(system, request, result))
 }

@@ -5,6 +5,7 @@
 
 mod auto;
 pub(crate) mod backbone;
+mod beside;
 pub(crate) mod compute;
 mod continuity;
 mod convergence;

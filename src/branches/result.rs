@@ -235,6 +235,11 @@ impl<O: BackboneObserver, B: Basis> Annotator<O, B> {
         self.converged
     }
 
+    /// Whether the observer stopped the run.
+    pub(crate) fn stopped(&self) -> bool {
+        self.stopped
+    }
+
     /// The character, time-domain check and label of a converged point. A point whose
     /// character cannot be computed (its motion overflows) keeps none and no label. Only a
     /// check that ran and failed labels the point unverified; a check that did not run (a

@@ -179,6 +179,12 @@ pub trait Basis: Debug + Clone + Send + Sync {
         1
     }
 
+    /// The folded sample whose value instant `k` of the full grid (`k < N`) takes, for
+    /// every signal of the basis: `k` itself by default.
+    fn folded_index(&self, k: usize) -> usize {
+        k
+    }
+
     /// [`Basis::synthesize`] at the `S` folded samples only.
     ///
     /// # Panics
@@ -522,6 +528,10 @@ impl Basis for CosineBasis {
         } else {
             2
         }
+    }
+    /// The mirror image `N - k` of an instant past the middle.
+    fn folded_index(&self, k: usize) -> usize {
+        k.min(self.samples - k)
     }
     fn synthesize_folded(&self, coefficients: &[f64], samples: &mut [f64]) {
         self.assert_coefficients(coefficients.len());

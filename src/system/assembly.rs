@@ -8,7 +8,7 @@ use crate::error::ModelError;
 use crate::system::spectra::Spectra;
 use std::cell::Cell;
 use std::collections::BTreeMap;
-use std::sync::Arc;
+use std::sync::{Arc, Weak};
 
 /// Collects bars and boundary conditions; [`AssemblyBuilder::build`] validates them.
 ///
@@ -315,6 +315,13 @@ impl BarSystem {
     /// The natural-frequency scans of this system ([`Spectra`]).
     pub(crate) fn spectra(&self) -> &Spectra {
         &self.spectra
+    }
+
+    /// What identifies the bars and conditions of this system among those built: the same
+    /// handle ([`Weak::ptr_eq`]) for its clones, another for any other system, even one built
+    /// after this one is dropped while the handle lives.
+    pub(crate) fn identity(&self) -> Weak<Spectra> {
+        Arc::downgrade(&self.spectra)
     }
 
     /// The bars, in the order they were added.

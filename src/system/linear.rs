@@ -256,7 +256,9 @@ pub(crate) fn natural_frequencies_covering(
 }
 
 /// The scan of [`natural_frequency_values`] up to `omega_max` with step `h`, its arguments
-/// checked.
+/// checked. What earlier scans of the system at this resolution computed is read from its
+/// [`ScanMemo`](crate::system::spectra::ScanMemo) and what this one adds is kept there: a scan that extends an earlier one
+/// (the labels' scans, as a run's frequency grows) samples and refines only beyond it.
 fn scan(
     system: &BarSystem,
     state: ContactState,
@@ -265,15 +267,24 @@ fn scan(
 ) -> Vec<f64> {
     let samples = omega_max / h;
     let steps = samples.ceil() as usize + 1;
+    let key = resolution.key(state);
+    let mut memo = system.spectra().memo(key);
     let mut matrix = StateMatrix::new(system, state);
     let at = |i: usize| (i as f64 + 0.5) * h;
-    let (values, signs): (Vec<f64>, Vec<f64>) = (0..=steps).map(|i| matrix.sample(at(i))).unzip();
+    for i in memo.samples.len()..=steps {
+        memo.samples.push(matrix.sample(at(i)));
+    }
+    let (values, signs): (Vec<f64>, Vec<f64>) = memo.samples[..=steps].iter().copied().unzip();
     let mut modes = Vec::new();
     for i in 1..values.len() - 1 {
         if values[i] <= values[i - 1] && values[i] < values[i + 1] {
-            let (lo, hi) = ((i as f64 - 0.5) * h, (i as f64 + 1.5) * h);
-            let omega = golden_minimum(|w| matrix.singularity(w), (lo, hi), resolution.tolerance);
-            if omega > omega_max || matrix.singularity(omega) > 1e-8 {
+            let (omega, ratio) = *memo.minima.entry(i).or_insert_with(|| {
+                let (lo, hi) = ((i as f64 - 0.5) * h, (i as f64 + 1.5) * h);
+                let tolerance = resolution.tolerance;
+                let omega = golden_minimum(|w| matrix.singularity(w), (lo, hi), tolerance);
+                (omega, matrix.singularity(omega))
+            });
+            if omega > omega_max || ratio > 1e-8 {
                 continue;
             }
             modes.push(omega);
@@ -290,12 +301,17 @@ fn scan(
             .get(k)
             .is_some_and(|&m| m <= at(i + 1) + 2.0 * h);
         if signs[i] * signs[i + 1] < 0.0 && !known {
-            let omega = sign_change(|w| matrix.determinant_sign(w), (at(i), at(i + 1)), signs[i]);
-            if omega <= omega_max && matrix.singularity(omega) <= 1e-8 {
+            let (omega, ratio) = *memo.crossings.entry(i).or_insert_with(|| {
+                let sign = |w| matrix.determinant_sign(w);
+                let omega = sign_change(sign, (at(i), at(i + 1)), signs[i]);
+                (omega, matrix.singularity(omega))
+            });
+            if omega <= omega_max && ratio <= 1e-8 {
                 modes.push(omega);
             }
         }
     }
+    system.spectra().keep_memo(key, memo);
     modes.sort_by(f64::total_cmp);
     modes
 }
@@ -415,4 +431,35 @@ pub fn open_mode(system: &BarSystem, mode: usize) -> Result<LinearMode, Settings
         omega_max *= 2.0;
     }
     Err(SettingsError::ModeNotFound { mode, omega_max })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bar::Bar;
+    use crate::reference::{clamped_bar_with_obstacle, two_bars_in_contact};
+
+    /// A scan that extends an earlier scan of its system (reading the samples and roots it
+    /// kept) finds, bit for bit, what a scan of a new system up to the same bound finds, and
+    /// so does a shorter scan after them: on one bar and on two, open and closed, at both
+    /// resolutions.
+    #[test]
+    fn scans_that_extend_earlier_ones_find_what_new_scans_find() {
+        let one = || clamped_bar_with_obstacle(1e-3).unwrap();
+        let two = || two_bars_in_contact(Bar::new(0.8, 1.3, 2.5).unwrap(), 1e-3).unwrap();
+        let states = [ContactState::Open, ContactState::Closed];
+        for (build, state) in [one, two].into_iter().flat_map(|b| states.map(|s| (b, s))) {
+            for resolution in [Resolution::LABELS, Resolution::FULL] {
+                let grown = build();
+                let values = |system: &BarSystem, bound: f64| {
+                    natural_frequency_values(system, state, bound, resolution).unwrap()
+                };
+                values(&grown, 9.0);
+                let fresh = values(&build(), 23.0);
+                assert!(fresh.len() >= 5, "{fresh:?}");
+                assert_eq!(values(&grown, 23.0), fresh);
+                assert_eq!(values(&grown, 15.5), values(&build(), 15.5));
+            }
+        }
+    }
 }

@@ -53,7 +53,7 @@ fn add_term(
 }
 
 /// Linear rows and law observables of one harmonic.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct HarmonicRows {
     unknowns: usize,
     linear_count: usize,
@@ -64,6 +64,36 @@ pub struct HarmonicRows {
     force: Vec<f64>,
     d_force: Vec<f64>,
     regularised: bool,
+}
+
+/// A copy that reuses the storage of the rows it overwrites ([`Clone::clone_from`]): the rows
+/// of every harmonic are copied at each frequency a shared copy serves.
+impl Clone for HarmonicRows {
+    fn clone(&self) -> Self {
+        Self {
+            unknowns: self.unknowns,
+            linear_count: self.linear_count,
+            linear: self.linear.clone(),
+            d_linear: self.d_linear.clone(),
+            gap: self.gap.clone(),
+            d_gap: self.d_gap.clone(),
+            force: self.force.clone(),
+            d_force: self.d_force.clone(),
+            regularised: self.regularised,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.unknowns = source.unknowns;
+        self.linear_count = source.linear_count;
+        self.linear.clone_from(&source.linear);
+        self.d_linear.clone_from(&source.d_linear);
+        self.gap.clone_from(&source.gap);
+        self.d_gap.clone_from(&source.d_gap);
+        self.force.clone_from(&source.force);
+        self.d_force.clone_from(&source.d_force);
+        self.regularised = source.regularised;
+    }
 }
 
 /// Inputs of [`HarmonicRows::rebuild`] kept between frequencies: the laws' observables (fixed

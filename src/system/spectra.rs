@@ -10,6 +10,7 @@
 //! which a [`BarSystem`](crate::system::BarSystem) never changes after it is built, so its
 //! clones share one cache and a system with other conditions gets its own.
 
+use std::collections::BTreeMap;
 use std::sync::{Mutex, PoisonError};
 
 /// What a scan is asked besides its upper frequency: an opaque tag of the linear state and
@@ -24,6 +25,19 @@ struct Scan {
     values: Vec<f64>,
 }
 
+/// What the scans of one key computed at each index of their common grid of samples, kept so
+/// that a longer scan computes only what it adds: the samples `(ratio, sign)` in order from
+/// index 0, and the roots refined from an index (a minimum of the ratio at sample `i`, a
+/// change of sign between samples `i` and `i + 1`), each with the ratio at the root. Each
+/// entry is a function of its index alone (the samples of a key lie at the same
+/// frequencies), so a scan that reads it gets what computing it again gives, bit for bit.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ScanMemo {
+    pub(crate) samples: Vec<(f64, f64)>,
+    pub(crate) minima: BTreeMap<usize, (f64, f64)>,
+    pub(crate) crossings: BTreeMap<usize, (f64, f64)>,
+}
+
 /// Most scans kept per system: a long-lived system whose callers ask many upper frequencies
 /// forgets the oldest rather than growing.
 const KEPT: usize = 64;
@@ -32,6 +46,7 @@ const KEPT: usize = 64;
 #[derive(Default)]
 pub(crate) struct Spectra {
     scans: Mutex<Vec<Scan>>,
+    memos: Mutex<Vec<(ScanKey, ScanMemo)>>,
 }
 
 impl std::fmt::Debug for Spectra {
@@ -61,6 +76,27 @@ impl Spectra {
             .filter(|s| s.key == key && s.omega_max >= omega_max)
             .min_by(|a, b| a.omega_max.total_cmp(&b.omega_max))
             .map(|s| (s.omega_max, s.values.clone()))
+    }
+
+    /// What the scans asked `key` computed so far (empty if none ran).
+    pub(crate) fn memo(&self, key: ScanKey) -> ScanMemo {
+        let memos = self.memos.lock().unwrap_or_else(PoisonError::into_inner);
+        (memos.iter().find(|(k, _)| *k == key)).map_or_else(ScanMemo::default, |(_, m)| m.clone())
+    }
+
+    /// Adds what a scan asked `key` computed to what is kept: the longer run of samples, and
+    /// every root.
+    pub(crate) fn keep_memo(&self, key: ScanKey, memo: ScanMemo) {
+        let mut memos = self.memos.lock().unwrap_or_else(PoisonError::into_inner);
+        let Some((_, kept)) = memos.iter_mut().find(|(k, _)| *k == key) else {
+            memos.push((key, memo));
+            return;
+        };
+        if memo.samples.len() > kept.samples.len() {
+            kept.samples = memo.samples;
+        }
+        kept.minima.extend(memo.minima);
+        kept.crossings.extend(memo.crossings);
     }
 
     /// Keeps the values of a scan asked `key` up to `omega_max`.

@@ -249,52 +249,80 @@ pub(crate) fn contact_samples<B: Basis>(
 pub(crate) type ContactAndGap = (Vec<bool>, Vec<f64>);
 
 /// For each law, [`contact_samples`] and the gap history it was computed from.
+///
+/// The laws are sampled on the folded grid ([`Basis::folded_samples`]), where the solver
+/// samples them, and each instant of the period takes the values of its folded sample
+/// ([`Basis::folded_index`]): the gap and force there are those of a synthesis on the full
+/// grid bit for bit, and the law is pointwise, so the outcome is that of sampling the law at
+/// every instant at a fraction of the cost (half for the cosine basis).
 pub(crate) fn contact_and_gap_samples<B: Basis>(
     problem: &mut NonsmoothSystem<B>,
     x: &[f64],
     omega: f64,
 ) -> Result<Vec<ContactAndGap>, SettingsError> {
     check_motion(problem, x, omega)?;
+    let (folded, samples) = (problem.basis().folded_samples(), problem.basis().samples());
+    let laws = problem.system().contact_count();
+    // Every buffer is written whole before it is read, so the buffers of an earlier call
+    // serve as they are; only their growth is zeroed.
+    let mut scratch = LAW_SCRATCH.take();
+    let [gap, force, values, d_gap, d_force, coefficients] = &mut scratch;
+    for buffer in [&mut *gap, &mut *force] {
+        buffer.resize(laws * folded, 0.0);
+    }
+    for buffer in [&mut *values, &mut *d_gap, &mut *d_force] {
+        buffer.resize(folded, 0.0);
+    }
+    coefficients.resize(problem.basis().len(), 0.0);
     // The histories first: they move the problem to `omega`, the laws then borrow it.
-    let histories: Vec<(Vec<f64>, Vec<f64>)> = (0..problem.system().contact_count())
-        .map(|l| {
-            (
-                problem.gap_history(x, omega, l),
-                problem.force_history(x, omega, l),
-            )
-        })
-        .collect();
-    let values = histories.iter().flat_map(|(g, f)| g.iter().chain(f));
-    check_finite("a gap or contact force sample", omega, values)?;
-    let samples = problem.basis().samples();
-    // Every law writes each of its samples, so the buffers of an earlier call serve as they
-    // are; only their growth is zeroed.
-    let [mut values, mut d_gap, mut d_force] = LAW_SCRATCH.take();
-    for buffer in [&mut values, &mut d_gap, &mut d_force] {
-        buffer.resize(samples, 0.0);
+    let per_law = gap
+        .chunks_exact_mut(folded)
+        .zip(force.chunks_exact_mut(folded));
+    for (l, (g, f)) in per_law.enumerate() {
+        problem.folded_histories((x, omega, l), coefficients, (g, f));
+    }
+    // Law by law, its gaps then its forces: a sample past the middle of the period repeats
+    // one before it, so the first value that is not finite is the full grid's first.
+    let histories = gap.chunks_exact(folded).zip(force.chunks_exact(folded));
+    let finite = check_finite(
+        "a gap or contact force sample",
+        omega,
+        histories.flat_map(|(g, f)| g.iter().chain(f)),
+    );
+    if let Err(e) = finite {
+        LAW_SCRATCH.set(scratch);
+        return Err(e);
     }
     let a_c = problem.complementarity();
-    let laws = problem.system().laws().zip(histories);
-    let described = laws
-        .map(|(law, (gap, force))| {
+    let basis = problem.basis();
+    let histories = gap.chunks_exact(folded).zip(force.chunks_exact(folded));
+    let described = (problem.system().laws().zip(histories))
+        .map(|(law, (gaps, forces))| {
             let out = LawSamples {
-                values: &mut values,
-                d_gap: &mut d_gap,
-                d_force: &mut d_force,
+                values: &mut *values,
+                d_gap: &mut *d_gap,
+                d_force: &mut *d_force,
             };
-            law.sample(&gap, &force, a_c, 0.0, out);
-            (d_gap.iter().map(|w| *w != 0.0).collect(), gap)
+            law.sample(gaps, forces, a_c, 0.0, out);
+            (0..samples)
+                .map(|k| {
+                    let k = basis.folded_index(k);
+                    (d_gap[k] != 0.0, gaps[k])
+                })
+                .unzip()
         })
         .collect();
-    LAW_SCRATCH.set([values, d_gap, d_force]);
+    LAW_SCRATCH.set(scratch);
     Ok(described)
 }
 
 thread_local! {
-    /// The law values and derivatives of [`contact_and_gap_samples`], kept between calls on a
-    /// thread: a run describes every point it computes, and three zeroed buffers of `N`
-    /// samples per point were a few per cent of a labelled run.
-    static LAW_SCRATCH: Cell<[Vec<f64>; 3]> = const { Cell::new([Vec::new(), Vec::new(), Vec::new()]) };
+    /// The folded histories, law values and derivatives and coefficients of
+    /// [`contact_and_gap_samples`], kept between calls on a thread: a run describes every
+    /// point it computes, and zeroed buffers per point were a few per cent of a labelled run.
+    static LAW_SCRATCH: Cell<[Vec<f64>; 6]> = const {
+        Cell::new([Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new()])
+    };
 }
 
 /// The number of maximal runs of `true` in the periodic sequence `values` (the last value

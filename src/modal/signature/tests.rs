@@ -21,6 +21,15 @@ fn clamped_exact() -> (BarSystem, CosineBasis, Vec<f64>, f64) {
     (system, basis, x, 2.0 * PI / 3.6)
 }
 
+/// Two bars of different lengths, speeds and stiffnesses in contact, and `len` coefficients
+/// of theirs moving arbitrarily with amplitude `scale`.
+fn two_bars_moving(len: usize, scale: f64) -> (BarSystem, Vec<f64>) {
+    let second = Bar::new(0.8, 1.3, 2.5).unwrap();
+    let two = two_bars_in_contact(second, 1e-3).unwrap();
+    let wiggle = |i: usize| scale * (((7 * i) % 11) as f64 - 5.0);
+    (two, (0..len * 4).map(wiggle).collect())
+}
+
 /// `x` with the harmonics for which `keep(n)` is false set to zero (one bar).
 fn only(x: &[f64], keep: impl Fn(usize) -> bool) -> Vec<f64> {
     let mut y = x.to_vec();
@@ -50,10 +59,7 @@ fn periodic_runs_count_wrapping_runs_once() {
 #[test]
 fn harmonic_energies_sum_to_the_time_averaged_energy() {
     let (clamped, basis, exact, omega) = clamped_exact();
-    let second = Bar::new(0.8, 1.3, 2.5).unwrap();
-    let two = two_bars_in_contact(second, 1e-3).unwrap();
-    let wiggle = |i: usize| 1e-4 * (((7 * i) % 11) as f64 - 5.0);
-    let arbitrary: Vec<f64> = (0..basis.len() * 4).map(wiggle).collect();
+    let (two, arbitrary) = two_bars_moving(basis.len(), 1e-4);
     for (system, x) in [(&clamped, &exact), (&two, &arbitrary)] {
         let energies = harmonic_energies(system, &basis, x, omega).unwrap();
         assert_eq!(energies.len(), HARMONICS + 1);
@@ -243,4 +249,43 @@ fn contact_intervals_reject_bad_input() {
         contact_intervals(&mut problem, &x, f64::NAN),
         Err(SettingsError::NotPositive { .. })
     ));
+}
+
+/// The contact and gap samples, taken on the folded grid and spread over the period, are
+/// those of the laws sampled at every instant of a full-grid synthesis, bit for bit: on the
+/// clamped bar's exact mode (in contact over part of the period) and on two bars moving
+/// arbitrarily, with an even and an odd number of samples.
+#[test]
+fn folded_contact_samples_are_those_of_the_full_grid() {
+    let (clamped, _, exact, omega) = clamped_exact();
+    let (two, arbitrary) = two_bars_moving(HARMONICS + 1, 1e-3);
+    for samples_per_harmonic in [30, 7] {
+        let settings = HarmonicBalanceSettings {
+            harmonics: HARMONICS,
+            samples_per_harmonic,
+            ..Default::default()
+        };
+        for (system, x) in [(&clamped, &exact), (&two, &arbitrary)] {
+            let mut problem = NonsmoothSystem::new(system, settings).unwrap();
+            let described = contact_and_gap_samples(&mut problem, x, omega).unwrap();
+            let a_c = problem.complementarity();
+            let mut touched = 0;
+            for (l, (law, (contact, gap))) in system.laws().zip(&described).enumerate() {
+                let g = problem.gap_history(x, omega, l);
+                let f = problem.force_history(x, omega, l);
+                let [mut values, mut d_gap, mut d_force] = [0; 3].map(|_| vec![0.0; g.len()]);
+                let out = LawSamples {
+                    values: &mut values,
+                    d_gap: &mut d_gap,
+                    d_force: &mut d_force,
+                };
+                law.sample(&g, &f, a_c, 0.0, out);
+                let expected: Vec<bool> = d_gap.iter().map(|w| *w != 0.0).collect();
+                assert_eq!(gap, &g);
+                assert_eq!(contact, &expected);
+                touched += expected.iter().filter(|c| **c).count();
+            }
+            assert!(touched > 0, "some sample in contact");
+        }
+    }
 }

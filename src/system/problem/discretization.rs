@@ -343,6 +343,28 @@ impl<B: Basis> Discretization<B> {
         s
     }
 
+    /// The gap (`gap == true`) or force samples of law `l` on the folded grid
+    /// ([`Basis::folded_samples`]) into `out`, for the unknowns `x` and the rows of one
+    /// frequency, with `coefficients` (one per basis function) as scratch: the values of
+    /// [`Discretization::history`] at the folded samples, bit for bit (both synthesise the
+    /// same sums).
+    pub(super) fn folded_history(
+        &self,
+        (rows, x): (&[HarmonicRows], &[f64]),
+        (l, gap): (usize, bool),
+        coefficients: &mut [f64],
+        out: &mut [f64],
+    ) {
+        self.observable_coefficients(rows, x, (l, gap, false), coefficients);
+        self.basis.synthesize_folded(coefficients, out);
+        let offset = if gap {
+            self.offsets[l].0
+        } else {
+            self.offsets[l].1
+        };
+        out.iter_mut().for_each(|v| *v += offset);
+    }
+
     /// Energy weights at fundamental frequency `omega`: a harmonic
     /// `A cos(kx) + B sin(kx)/k` of bar `b` stores about `EA l (A^2 k^2 + B^2) / 4` of
     /// strain energy, so `w_A = EA l (k^2 + 1/l^2)` (the `1/l^2` keeps rigid displacements

@@ -22,6 +22,8 @@
 //! - `discretization.rs`: [`Discretization`] and its evaluations into given buffers;
 //! - `state.rs`: the rows at one frequency and the law samples, with the record of how the
 //!   samples were made (its docs state when a Jacobian-type evaluation reuses them);
+//! - `shared_rows.rs`: the rows of the last few frequencies, copied by the problems on the
+//!   same system instead of rebuilt;
 //! - `step.rs`: the structured (condensed) Newton step;
 //! - `band.rs`: the staircase Newton step of assemblies with several contacts, at a cost linear
 //!   in the number of bars of a chain.
@@ -29,6 +31,7 @@
 mod band;
 mod discretization;
 pub(crate) mod selection;
+mod shared_rows;
 mod staircase;
 mod state;
 mod step;
@@ -346,6 +349,27 @@ impl<B: Basis> NonsmoothSystem<B> {
     pub fn force_history(&mut self, x: &[f64], omega: f64, l: usize) -> Vec<f64> {
         self.prepare(omega);
         (self.description).history(&self.ws.frequency.rows, x, l, false)
+    }
+
+    /// The gap and force samples of law `l` at `omega` on the folded grid
+    /// ([`Basis::folded_samples`]; [`Basis::folded_index`] says which one each instant of
+    /// the period takes), into `gap` and `force`, with `coefficients` (one per basis
+    /// function) as scratch: the values of [`NonsmoothSystem::gap_history`] and
+    /// [`NonsmoothSystem::force_history`] without their repeats. The problem moves to
+    /// `omega`.
+    ///
+    /// # Panics
+    /// As [`NonsmoothSystem::gap_history`], and for buffers of other lengths.
+    pub(crate) fn folded_histories(
+        &mut self,
+        (x, omega, l): (&[f64], f64, usize),
+        coefficients: &mut [f64],
+        (gap, force): (&mut [f64], &mut [f64]),
+    ) {
+        self.prepare(omega);
+        let (d, rows) = (&self.description, &self.ws.frequency.rows);
+        d.folded_history((rows, x), (l, true), coefficients, gap);
+        d.folded_history((rows, x), (l, false), coefficients, force);
     }
 
     /// Pointwise law residual `r(theta_k)` of law `l` over one period at `omega`.

@@ -30,6 +30,7 @@
 //! move converged points near internal resonances, where the solution is barely isolated.
 
 use super::discretization::Discretization;
+use super::shared_rows;
 use super::staircase::staircase_of;
 use crate::bc::LawSamples;
 use crate::fourier::Basis;
@@ -39,7 +40,7 @@ use crate::system::rows::{HarmonicRows, RowsScratch};
 
 /// Relative singular-value threshold under which a harmonic's linear rows count as
 /// rank-deficient (see [`HarmonicRows::regularise`]).
-const RANK_TOLERANCE: f64 = 1e-9;
+pub(super) const RANK_TOLERANCE: f64 = 1e-9;
 
 /// The per-harmonic rows at the current fundamental frequency and their condensation.
 #[derive(Debug, Clone)]
@@ -75,7 +76,8 @@ impl Frequency {
     }
 
     /// Moves to fundamental frequency `omega`, rebuilding every harmonic's rows in their own
-    /// storage when it changed; whether it did.
+    /// storage when it changed (or copying those another problem on the system built there
+    /// last, `shared_rows.rs`); whether it did.
     pub(super) fn prepare<B: Basis>(&mut self, d: &Discretization<B>, omega: f64) -> bool {
         if omega == self.omega && !self.rows.is_empty() {
             return false;
@@ -85,6 +87,9 @@ impl Frequency {
         self.staircase = None;
         let (system, scratch) = (d.system(), &mut self.rows_scratch);
         let harmonics = d.basis().harmonics() + 1;
+        if shared_rows::copy_into(system, omega, harmonics, &mut self.rows) {
+            return true;
+        }
         self.rows.truncate(harmonics);
         for (h, rows) in self.rows.iter_mut().enumerate() {
             rows.rebuild(system, h as f64 * omega, scratch);
@@ -95,6 +100,7 @@ impl Frequency {
             rows.regularise(RANK_TOLERANCE);
             self.rows.push(rows);
         }
+        shared_rows::keep(system, omega, &self.rows);
         true
     }
 
