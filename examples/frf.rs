@@ -28,7 +28,8 @@
 //! its folds: the harmonic selection is held while a step is corrected and moved between
 //! points, where the point is solved again with the new selection, switching the harmonics it
 //! adds on one at a time; a point that cannot be moved there, or a step that collapses at a
-//! kink of the laws, moves on by up to three grid steps before the run ends (stalled). `--resonance-band C` holds at zero every harmonic `n >= 2` within `C / m` of a
+//! kink of the laws, moves on by a quarter of a grid step up to three grid steps before the
+//! run ends (stalled), as it does where it comes back to a point it passed. `--resonance-band C` holds at zero every harmonic `n >= 2` within `C / m` of a
 //! natural frequency (`HarmonicBalanceSettings::resonance_band`); its default here is
 //! `system::RESONANCE_BAND` = 0.1, not 0 as in `backbone`: the clamped bar's natural
 //! frequencies are odd multiples of the first, so near `omega_1` every odd harmonic sits on
