@@ -26,6 +26,8 @@ pub(super) struct Traced {
     pub(super) points: Vec<ResponsePoint>,
     pub(super) rejections: usize,
     pub(super) end: EndReason,
+    /// Where a sweep left its branch (none on an arclength run).
+    pub(super) jumps: Vec<f64>,
 }
 
 /// Follows the curve from `start` at the low end of `options.parameter_range`, measuring
@@ -102,6 +104,7 @@ fn run(
         points,
         rejections,
         end,
+        jumps: Vec::new(),
     })
 }
 
