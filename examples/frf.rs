@@ -7,7 +7,7 @@
 //!     [--assembly FILE] [--harmonics 20 --samples-per-harmonic 30 --complementarity 4]
 //!     [--resonance-band 0.1]
 //!     --forcing end:END:AMPLITUDE|base:END:AMPLITUDE [--forcing ...]
-//!     [--damping ETA] [--omega-range LO:HI] [--steps S] [--method sequential|arclength]
+//!     [--damping ETA] [--omega-range LO:HI] [--steps S] [--method sequential|down|arclength]
 //!     [--solver newton|dogleg] [--out FILE]
 //! ```
 //!
@@ -24,11 +24,14 @@
 //!
 //! `--method sequential` (the default) sweeps the frequency up as an experiment does: it
 //! follows the branch it is on, and where that branch ends (past a resonance peak) it drops
-//! to the open-contact response and goes on. `--method arclength` follows one curve through
+//! to the open-contact response and goes on; `--method down` sweeps down from the high end
+//! the same way. Each sweep prints the frequencies where it left its branch (`jump at omega
+//! = ...`). `--method arclength` follows one curve through
 //! its folds: the harmonic selection is held while a step is corrected and moved between
 //! points, where the point is solved again with the new selection, switching the harmonics it
 //! adds on one at a time; a point that cannot be moved there, or a step that collapses at a
-//! kink of the laws, moves on by up to three grid steps before the run ends (stalled). `--resonance-band C` holds at zero every harmonic `n >= 2` within `C / m` of a
+//! kink of the laws, moves on by a quarter of a grid step up to three grid steps before the
+//! run ends (stalled), as it does where it comes back to a point it passed. `--resonance-band C` holds at zero every harmonic `n >= 2` within `C / m` of a
 //! natural frequency (`HarmonicBalanceSettings::resonance_band`); its default here is
 //! `system::RESONANCE_BAND` = 0.1, not 0 as in `backbone`: the clamped bar's natural
 //! frequencies are odd multiples of the first, so near `omega_1` every odd harmonic sits on
@@ -70,7 +73,7 @@ const USAGE: &str = "usage: frf [--system ds|rs|two-bar] [--gap G] [--robin-stif
   [--length2 L --speed2 C --stiffness-ratio R] | [--assembly FILE.toml|FILE.json]
   [--harmonics M] [--samples-per-harmonic NH] [--complementarity AC] [--resonance-band C]
   --forcing end:END:AMPLITUDE|base:END:AMPLITUDE [--forcing ...] [--damping ETA]
-  [--omega-range LO:HI] [--steps S] [--method sequential|arclength] [--solver newton|dogleg] [--out FILE]";
+  [--omega-range LO:HI] [--steps S] [--method sequential|down|arclength] [--solver newton|dogleg] [--out FILE]";
 
 /// Largest `--harmonics` (a dense solve costs the cube of the unknowns).
 const MAX_HARMONICS: usize = 200;
@@ -196,6 +199,7 @@ fn parse() -> Result<Option<Args>, lexopt::Error> {
             Long("method") => {
                 method = match parser.value()?.string()?.as_str() {
                     "sequential" => ResponseMethod::Sequential,
+                    "down" => ResponseMethod::SweepDown,
                     "arclength" => ResponseMethod::Arclength,
                     other => return Err(format!("unknown method `{other}`").into()),
                 }
@@ -364,6 +368,9 @@ fn run(a: Args) -> Result<ExitCode, Box<dyn std::error::Error>> {
         response.end,
         response.rejected_steps
     );
+    for omega in &response.jumps {
+        eprintln!("jump at omega = {omega}");
+    }
     for f in response.folds() {
         eprintln!(
             "fold at omega = {} (amplitude {}, E/E_g {})",

@@ -117,7 +117,7 @@ const FLAGS: &[(&str, Value)] = &[
     ("selection", Value::Word(&["first", "lowest-energy"])),
     ("serial", Value::Switch),
     ("out", Value::File),
-    ("method", Value::Word(&["sequential", "arclength"])),
+    ("method", Value::Word(&["sequential", "down", "arclength"])),
     ("ds", Value::Real(1e-4, 0.1)),
     ("ds-min", Value::Real(1e-7, 1e-3)),
     ("ds-max", Value::Real(1e-2, 0.5)),
@@ -148,7 +148,7 @@ const FRF_FLAGS: &[(&str, Value)] = &[
     ("damping", Value::Real(1e-4, 0.1)),
     ("omega-range", Value::Range(0.3, 3.0)),
     ("steps", Value::Count(2, 40)),
-    ("method", Value::Word(&["sequential", "arclength"])),
+    ("method", Value::Word(&["sequential", "down", "arclength"])),
     ("solver", Value::Word(&["newton", "dogleg"])),
     ("out", Value::File),
 ];

@@ -426,9 +426,11 @@ fn the_resonance_peak_lies_on_the_backbone() {
 }
 
 /// The arclength curve of the clamped bar passes the frequency where the harmonic selection
-/// switches every harmonic back on above the linear resonance (the equations jump there):
-/// past it, its points in contact lie on the backbone of the same discretisation (energy
-/// within 5 %), and every point was measured with the selection it was solved with.
+/// switches every harmonic back on above the linear resonance (the equations jump there),
+/// and the kinks of the sampled laws where its corrector stalled (at `Omega = 1.637`): past
+/// the edge, its points in contact lie on the backbone of the same discretisation (energy
+/// within 5 %) up to `Omega = 1.68` at least, and every point was measured with the selection
+/// it was solved with.
 #[test]
 fn an_arclength_curve_passes_the_band_edge_onto_the_backbone() {
     let settings = with_band();
@@ -447,7 +449,7 @@ fn an_arclength_curve_passes_the_band_edge_onto_the_backbone() {
     // The band's upper edge about the first natural frequency pi / 2.
     let edge = std::f64::consts::FRAC_PI_2 * (1.0 + settings.resonance_band / 20.0);
     let past: Vec<_> = (response.converged())
-        .filter(|p| p.omega > edge && p.amplitude > 1.0 && p.dropped_harmonics.is_empty())
+        .filter(|p| p.omega > edge && p.amplitude > 1.0)
         .filter_map(|p| Some((p, on_backbone(p.omega)?)))
         .collect();
     assert!(
@@ -456,6 +458,8 @@ fn an_arclength_curve_passes_the_band_edge_onto_the_backbone() {
         past.len(),
         response.end
     );
+    let reached = past.iter().map(|(p, _)| p.omega).fold(0.0, f64::max);
+    assert!(reached > 1.68, "reached {reached}; end {:?}", response.end);
     for (p, backbone) in past {
         let ratio = p.energy_normalized / backbone;
         assert!(

@@ -6,8 +6,10 @@
 //! points: where an accepted point lies in another band than the one held, the point is solved
 //! again with the selection of its frequency ([`leap`]) and the curve goes on from there in
 //! the same direction ([`Arclength::continue_from`]). A move that fails keeps the held
-//! selection until the next point. A run whose step collapses (a kink of the contact laws)
-//! moves on the same way before it gives up.
+//! selection until the next point. A run whose step collapses (a kink of the contact laws,
+//! where the semismooth corrector stalls a little above its tolerance however small the
+//! step) moves on the same way before it gives up, and a run that comes back to a point it
+//! already passed ends there ([`EndReason::Stalled`]): it would go round the same loop again.
 
 use crate::continuation::{
     Arclength, ArclengthOptions, ContinuationProblem, EndReason, Point, Step,
@@ -24,6 +26,8 @@ pub(super) struct Traced {
     pub(super) points: Vec<ResponsePoint>,
     pub(super) rejections: usize,
     pub(super) end: EndReason,
+    /// Where a sweep left its branch (none on an arclength run).
+    pub(super) jumps: Vec<f64>,
 }
 
 /// Follows the curve from `start` at the low end of `options.parameter_range`, measuring
@@ -81,7 +85,14 @@ fn run(
             Step::Finished(end) => break end,
         };
         last = (driver.state().to_vec(), driver.tangent().to_vec());
-        points.push(measured(driver.problem_mut(), points.len(), &p, e_g));
+        let point = measured(driver.problem_mut(), points.len(), &p, e_g);
+        if let Some(earlier) = revisited(&points, &point) {
+            break EndReason::Stalled {
+                failures: points.len() - earlier,
+                parameter: point.omega,
+            };
+        }
+        points.push(point);
     };
     let omegas: Vec<f64> = points.iter().map(|p| p.omega).collect();
     let energies: Vec<f64> = points.iter().map(|p| p.energy).collect();
@@ -93,7 +104,21 @@ fn run(
         points,
         rejections,
         end,
+        jumps: Vec::new(),
     })
+}
+
+/// Points back from the newest that a run repeating itself may have left since it was at a
+/// point: a leap solved again at the same frequency lands on it once more.
+const RECENT: usize = 3;
+
+/// The index of an earlier point, older than the last [`RECENT`], that `p` repeats (its
+/// frequency and energy to `1e-9` relative): the run came back to where it was and, being
+/// deterministic, would go round the same loop again.
+fn revisited(points: &[ResponsePoint], p: &ResponsePoint) -> Option<usize> {
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+    let older = points.len().saturating_sub(RECENT);
+    (points[..older].iter()).position(|q| same(q.omega, p.omega) && same(q.energy, p.energy))
 }
 
 /// Whether the driver's tangent points back against `before` (an angle over 90 degrees in

@@ -25,7 +25,9 @@
 //! ([`Excitation`]). The contact laws are enforced in time as in
 //! [`NonsmoothSystem`](crate::system::NonsmoothSystem) (alternating frequency–time, the
 //! complementarity function sampled and projected). The excitation fixes the time origin,
-//! so the system needs no phase condition: [`ForcedSystem`] is square and regular.
+//! so the system needs no phase condition: [`ForcedSystem`] is square and regular. A bar held
+//! by contacts only would leave its mean position free while they are open: the mean of every
+//! law its rigid-body motion moves is tied by a spring of `1e-8 EA / l` across the gap.
 //!
 //! # What is checked
 //!
@@ -65,13 +67,16 @@
 mod arclength;
 mod excitation;
 mod folds;
+mod gaps;
 mod hold;
 mod leap;
 mod measures;
+mod open;
 mod point;
 mod response;
 pub(crate) mod rows;
 mod system;
+mod tether;
 pub mod waves;
 
 pub use excitation::{Damping, Excitation, ExcitationKind};

@@ -25,6 +25,9 @@ pub enum ResponseMethod {
     /// pass a fold, where the curve turns back in frequency.
     #[default]
     Sequential,
+    /// [`ResponseMethod::Sequential`] down the grid, from the high end of the range: the
+    /// sweep that finds the other jump of a curve that bends over.
+    SweepDown,
     /// Pseudo-arclength continuation in `(x, Omega)`, through folds, with the harmonic
     /// selection held while a step is corrected and moved between points (the equations
     /// jump where it changes); the folds are marked on the points.
@@ -39,7 +42,8 @@ pub struct ResponseRequest {
     pub settings: HarmonicBalanceSettings,
     /// Damping and excitations.
     pub forcing: Forcing,
-    /// Forcing frequencies `(lo, hi)`, `0 < lo < hi`: the curve starts at `lo`.
+    /// Forcing frequencies `(lo, hi)`, `0 < lo < hi`: the curve starts at `lo` (at `hi` for
+    /// [`ResponseMethod::SweepDown`]).
     pub omega_range: (f64, f64),
     /// Grid steps (sequential), or the number of steps the arclength is sized for: it takes
     /// steps of about `4 / steps` of the curve's scaled length, at most `4 steps` of them.
@@ -60,6 +64,9 @@ pub struct ForcedResponse {
     pub points: Vec<ResponsePoint>,
     /// Rejected corrector steps of an arclength run.
     pub rejected_steps: usize,
+    /// The frequencies where a sweep left the branch it followed, in order: its last
+    /// converged point before the steps that failed (empty for arclength).
+    pub jumps: Vec<f64>,
     /// Why the run ended.
     pub end: EndReason,
 }
@@ -108,8 +115,7 @@ pub fn forced_response(
     request: &ResponseRequest,
 ) -> Result<ForcedResponse, Error> {
     let (lo, hi) = request.omega_range;
-    // A sweep climbs from `lo`, as an experiment's does: a range given downwards is refused,
-    // not swept down.
+    // A range given downwards is refused: the method says which way a sweep goes.
     Range::bounds("forcing frequency range", (lo, hi)).check(Ends::Positive, Direction::Rising)?;
     if request.steps == 0 {
         return Err(ContinuationError::InvalidOption {
@@ -121,13 +127,17 @@ pub fn forced_response(
     let mut problem = ForcedSystem::new(system, request.settings, &request.forcing)?;
     let (e_g, _) = grazing_energy(system)?;
     let solver = request.solver;
-    problem.set_parameter(lo);
+    let down = request.method == ResponseMethod::SweepDown;
+    problem.set_parameter(if down { hi } else { lo });
     let start = problem.open_response()?;
     let traced = match request.method {
-        ResponseMethod::Sequential => {
+        ResponseMethod::Sequential | ResponseMethod::SweepDown => {
             let mut steps: Vec<Step> = Vec::new();
-            let values = linspace(lo, hi, request.steps)?;
-            let branch = sweep(&mut problem, &solver, start, &values, &mut |s: &Step| {
+            let mut values = linspace(lo, hi, request.steps)?;
+            if down {
+                values.reverse();
+            }
+            let (branch, jumps) = sweep(&mut problem, &solver, start, &values, &mut |s: &Step| {
                 steps.push(s.clone());
                 ControlFlow::Continue(())
             })?;
@@ -138,6 +148,7 @@ pub fn forced_response(
                 points,
                 rejections: branch.rejections,
                 end: branch.end,
+                jumps,
             }
         }
         ResponseMethod::Arclength => {
@@ -152,6 +163,7 @@ pub fn forced_response(
         grazing_energy: e_g,
         points: traced.points,
         rejected_steps: traced.rejections,
+        jumps: traced.jumps,
         end: traced.end,
     })
 }
@@ -195,14 +207,15 @@ fn arclength_options(
 /// the branch followed ends (a resonant branch past its peak, a fold), its steps fail over a
 /// span of frequencies ([`allowed_failures`]), and the sweep drops to the open-contact
 /// response at the next value and goes on from there. The branch's end reason is the last
-/// run's; its points and rejections are every run's.
+/// run's; its points and rejections are every run's. Also returns the frequencies of the last
+/// converged points of the runs that ended so (the sweep's jumps).
 fn sweep(
     problem: &mut ForcedSystem,
     solver: &Solver,
     start: Vec<f64>,
     values: &[f64],
     observer: &mut impl FnMut(&Step) -> ControlFlow<()>,
-) -> Result<Branch, Error> {
+) -> Result<(Branch, Vec<f64>), Error> {
     let grid_step = match values {
         [a, b, ..] => (b - a).abs(),
         _ => 0.0,
@@ -218,7 +231,7 @@ fn sweep(
         rejections: 0,
         end: EndReason::Completed,
     };
-    let (mut start, mut at) = (start, 0);
+    let (mut start, mut at, mut jumps) = (start, 0, Vec::new());
     loop {
         let mut seen = 0;
         let mut driver =
@@ -229,19 +242,23 @@ fn sweep(
             }
             observer(s)
         });
+        let left = (branch.points.iter().rev())
+            .find(|p| p.converged)
+            .map(|p| p.parameter);
         all.points.extend(branch.points);
         all.rejections += branch.rejections;
         all.end = branch.end;
         at += seen;
         if !matches!(all.end, EndReason::Stalled { .. }) || at >= values.len() {
-            return Ok(all);
+            return Ok((all, jumps));
         }
+        jumps.extend(left);
         problem.set_parameter(values[at]);
         match problem.open_response() {
             Ok(x) => start = x,
             // The open system is singular there (an undamped natural frequency): the sweep
             // ends stalled, with what it has.
-            Err(_) => return Ok(all),
+            Err(_) => return Ok((all, jumps)),
         }
     }
 }

@@ -1,18 +1,16 @@
 //! The forced, damped harmonic-balance system `F(x; Omega) = 0` in the full Fourier basis.
 
 use crate::bc::{LawSamples, Observable};
-use crate::check::check_frequency_named;
 use crate::continuation::ContinuationProblem;
-use crate::error::{Error, SettingsError, SolveError};
+use crate::error::{Error, SettingsError};
 use crate::forced::excitation::{Damping, Driven, Excitation};
 use crate::forced::rows::{real_form, DampedRows};
+use crate::forced::tether::{mean_observables, MEAN_TETHER};
 use crate::fourier::{check_memory, Basis, SineCosineBasis};
-use crate::linalg::{DenseMatrix, Lu};
+use crate::linalg::DenseMatrix;
 use crate::solve::{Problem, Structured};
 use crate::system::problem::selection::{Selection, Shape};
-use crate::system::problem::{
-    check_complementarity, law_grams, law_offsets, max_frequency, unit_gram,
-};
+use crate::system::problem::{check_complementarity, law_grams, law_offsets, unit_gram};
 use crate::system::{BarSystem, HarmonicBalanceSettings};
 use crate::ForcingError;
 
@@ -47,14 +45,16 @@ pub struct ForcedSystem {
     driven: Vec<Driven>,
     pub(super) omega: f64,
     /// Rows of harmonics `0..=m` at `omega`.
-    rows: Vec<DampedRows>,
+    pub(super) rows: Vec<DampedRows>,
     /// `(row, value, d value / d Omega)` of the right-hand side at harmonic 1.
-    rhs: Vec<(usize, f64, f64)>,
-    unknowns: usize,
-    linear_count: usize,
-    offsets: Vec<(f64, f64)>,
+    pub(super) rhs: Vec<(usize, f64, f64)>,
+    pub(super) unknowns: usize,
+    pub(super) linear_count: usize,
+    pub(super) offsets: Vec<(f64, f64)>,
     /// Each law's observables `(gap, force)` (fixed for a system).
     observables: Vec<(Observable, Observable)>,
+    /// The observables of harmonic 0, floating bars' laws tethered ([`mean_observables`]).
+    pub(super) mean_observables: Vec<(Observable, Observable)>,
     /// `G(1)`, for the law Gram matrices ([`law_grams`]).
     unit_gram: Vec<f64>,
     /// Harmonic selection, if asked ([`HarmonicBalanceSettings::resonance_band`]).
@@ -98,6 +98,7 @@ impl ForcedSystem {
         free.driven = (forcing.excitations.iter())
             .map(|&e| Driven::new(system, e))
             .collect::<Result<Vec<_>, _>>()?;
+        free.mean_observables = mean_observables(system, &free.observables, MEAN_TETHER);
         free.selection = Selection::for_band(settings.resonance_band, settings.harmonics)?
             .map(Selection::dropping_low_harmonics);
         Ok(free)
@@ -154,6 +155,7 @@ impl ForcedSystem {
             linear_count,
             offsets,
             observables: system.laws().map(|l| (l.gap(), l.force())).collect(),
+            mean_observables: system.laws().map(|l| (l.gap(), l.force())).collect(),
             unit_gram: unit_gram(&basis),
             basis,
             selection: None,
@@ -255,43 +257,6 @@ impl ForcedSystem {
         s
     }
 
-    /// The gap samples of law `l` over one period at `x` (the basis' `N` instants).
-    ///
-    /// # Errors
-    /// [`SettingsError::IndexOutOfRange`] for a law `l` the system does not have;
-    /// [`SettingsError::Length`] for an `x` that is not a state of the system;
-    /// [`SettingsError::NonFiniteResult`] for a history that overflows (a state near the ends
-    /// of `f64`).
-    pub fn gap_history(&self, x: &[f64], l: usize) -> Result<Vec<f64>, SettingsError> {
-        let count = self.offsets.len();
-        if l >= count {
-            let (what, index) = ("unilateral law", l);
-            return Err(SettingsError::IndexOutOfRange { what, index, count });
-        }
-        let expected = self.dimension();
-        if x.len() != expected {
-            let (what, got) = ("forced state", x.len());
-            return Err(SettingsError::Length {
-                what,
-                got,
-                expected,
-            });
-        }
-        let mut gap = vec![0.0; self.basis.samples()];
-        self.basis
-            .synthesize(&self.observable(x, l, true, false), &mut gap);
-        gap.iter_mut().for_each(|v| *v += self.offsets[l].0);
-        // A state near the ends of `f64` (the open response to an amplitude of `f64::MAX`)
-        // overflows the synthesis.
-        if gap.iter().any(|v| !v.is_finite()) {
-            return Err(SettingsError::NonFiniteResult {
-                what: "gap history",
-                omega: self.omega,
-            });
-        }
-        Ok(gap)
-    }
-
     /// The Gram matrices `(G(w_gap), G(w_force))` of law `l` from the samples `s`.
     fn grams(&self, s: &LawState, l: usize) -> (Vec<f64>, Vec<f64>) {
         let (n, len) = (self.basis.samples(), self.basis.len());
@@ -329,82 +294,6 @@ impl ForcedSystem {
         for &(r, value, d) in &self.rhs {
             f[rc + r] -= if derivative { d } else { value };
         }
-    }
-
-    /// The linear response at the current frequency: the solution with every contact open
-    /// (each law's force row held at zero instead of its law), the start of a response
-    /// curve far from contact. The excitation drives harmonic 1 alone, and without contact
-    /// the harmonics do not couple: every other harmonic is zero, and only harmonic 1's
-    /// cosine and sine are solved for (a constant rigid motion, singular here, stays zero).
-    ///
-    /// # Errors
-    /// [`SettingsError::NotFinite`] before a frequency is set
-    /// ([`ContinuationProblem::set_parameter`]); [`SettingsError::NotPositive`],
-    /// [`SettingsError::FrequencyTooSmall`] or [`SettingsError::FrequencyTooLarge`] for a
-    /// frequency set that is not positive and finite or out of the basis' range;
-    /// [`SettingsError::NonFiniteResult`] when amplitudes or damping near the ends of `f64`
-    /// overflow the response;
-    /// [`SolveError::SingularJacobian`](crate::SolveError::SingularJacobian) when the open
-    /// system is singular at harmonic 1 (an undamped natural frequency).
-    pub fn open_response(&self) -> Result<Vec<f64>, Error> {
-        if self.omega.is_nan() {
-            return Err(SettingsError::NotFinite {
-                what: "forcing frequency (none set yet: set_parameter gives it)",
-                value: self.omega,
-            }
-            .into());
-        }
-        self.check_forcing_frequency()?;
-        let (u, m) = (self.unknowns, self.basis.harmonics());
-        let rows = &self.rows[1];
-        // Harmonic 1's equations: the linear rows, then every law's force held at zero, for
-        // the cosine (unknowns 0..u of the block) and the sine (u..2u). A complex row `a`
-        // gives `[a_r, a_i]` on the cosine's and `[-a_i, a_r]` on the sine's (`real_form`).
-        let complex_rows: Vec<_> = (0..self.linear_count)
-            .map(|r| rows.linear.row(r).0)
-            .chain((0..self.offsets.len()).map(|l| rows.force.row(l).0))
-            .collect();
-        let mut block = DenseMatrix::zeros(2 * u, 2 * u);
-        for (r, a) in complex_rows.iter().enumerate() {
-            for (k, a) in a.iter().enumerate() {
-                block[(r, k)] = a.re;
-                block[(r, u + k)] = a.im;
-                block[(u + r, k)] = -a.im;
-                block[(u + r, u + k)] = a.re;
-            }
-        }
-        let mut b = vec![0.0; 2 * u];
-        for &(r, value, _) in &self.rhs {
-            b[r] += value;
-        }
-        let lu = Lu::factor(&block, 1e-14).map_err(|p| SolveError::SingularJacobian {
-            iteration: 0,
-            pivot: p.pivot,
-            ratio: p.ratio,
-        })?;
-        lu.solve_in_place(&mut b);
-        // Amplitudes or damping near the ends of `f64` (finite, so accepted) can overflow
-        // the solve.
-        if b.iter().any(|v| !v.is_finite()) {
-            return Err(SettingsError::NonFiniteResult {
-                what: "open-contact response",
-                omega: self.omega,
-            }
-            .into());
-        }
-        let mut x = vec![0.0; self.dimension()];
-        x[u..2 * u].copy_from_slice(&b[..u]);
-        x[(m + 1) * u..(m + 2) * u].copy_from_slice(&b[u..]);
-        Ok(x)
-    }
-
-    /// Checks the frequency set: positive and finite, not subnormal
-    /// ([`MIN_FREQUENCY`](crate::modal::MIN_FREQUENCY)), and not so high that the phase
-    /// `k l` of the highest harmonic over a bar passes [`MAX_PHASE`](crate::system::MAX_PHASE), where the rows'
-    /// sines and cosines carry no digit (they came out NaN at `1e300`).
-    fn check_forcing_frequency(&self) -> Result<(), SettingsError> {
-        let max = max_frequency(&self.system, self.basis.harmonics());
-        check_frequency_named("forcing frequency", self.omega, max).map(|_| ())
     }
 
     /// Adds `scale` times the derivative of `real_form(row, x_i, partner)` in `x` to row
@@ -574,7 +463,14 @@ impl ContinuationProblem for ForcedSystem {
         }
         let m = self.basis.harmonics();
         self.rows = (0..=m)
-            .map(|n| DampedRows::new(&self.system, &self.observables, n, omega, &self.damping))
+            .map(|n| {
+                let laws = if n == 0 {
+                    &self.mean_observables
+                } else {
+                    &self.observables
+                };
+                DampedRows::new(&self.system, laws, n, omega, &self.damping)
+            })
             .collect();
         self.rhs = (self.driven.iter())
             .map(|d| {
