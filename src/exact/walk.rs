@@ -287,18 +287,22 @@ impl Walker<'_> {
         last: &Orbit,
         before: Option<&Orbit>,
     ) -> Result<(Outcome, Vec<f64>, f64), LossReason> {
-        let (prediction, predicted_energy) = match before {
+        // The secant's step without the directions `M - I` annihilates at the last orbit:
+        // along them nothing fixes the step, and a step carried on from one point to the next
+        // drifts the branch off its family onto the orbits around it, the waves that return
+        // onto themselves over the period (`docs/validation.md`). The plain secant is the
+        // fallback.
+        let (prediction, secant, predicted_energy) = match before {
             Some(b) => {
                 let s = (period - last.period) / (last.period - b.period);
-                let x: Vec<f64> = last
-                    .x
-                    .iter()
-                    .zip(&b.x)
-                    .map(|(a, b)| a + s * (a - b))
-                    .collect();
-                (x, last.energy + s * (last.energy - b.energy))
+                let step: Vec<f64> = last.x.iter().zip(&b.x).map(|(a, b)| s * (a - b)).collect();
+                let kept = last.jacobian.without_null_directions(&step);
+                let along =
+                    |d: &[f64]| -> Vec<f64> { last.x.iter().zip(d).map(|(a, d)| a + d).collect() };
+                let energy = last.energy + s * (last.energy - b.energy);
+                (along(&kept), Some(along(&step)), energy)
             }
-            None => (last.x.clone(), last.energy * ratio.unwrap_or(1.0)),
+            None => (last.x.clone(), None, last.energy * ratio.unwrap_or(1.0)),
         };
         let predicted_change = (predicted_energy - last.energy).abs() / last.energy;
         let allowed = match (before, predicted_change > 0.0) {
@@ -342,13 +346,23 @@ impl Walker<'_> {
             }
             Ok(outcome)
         };
-        let first = attempt(&prediction, Some(last.jacobian.clone())).map_err(LossReason::Error)?;
-        let outcome = match judge_attempt(first) {
-            Ok(outcome) => outcome,
-            // Once more from the previous orbit, with a matrix of the new period.
-            Err(_) => judge_attempt(attempt(&last.x, None).map_err(LossReason::Error)?)?,
-        };
-        Ok((outcome, prediction, predicted_energy))
+        // The prediction, then the plain secant, with the last orbit's matrix; then once more
+        // from the last orbit, with a matrix of the new period. A march that fails on the
+        // way is one more failed attempt.
+        let starts = [
+            Some((&prediction, true)),
+            secant.as_ref().map(|x| (x, true)),
+            Some((&last.x, false)),
+        ];
+        let mut found = Err(LossReason::Unreached);
+        for (start, chord) in starts.into_iter().flatten() {
+            let jacobian = chord.then(|| last.jacobian.clone());
+            found = (attempt(start, jacobian).map_err(LossReason::Error)).and_then(judge_attempt);
+            if found.is_ok() {
+                break;
+            }
+        }
+        Ok((found?, prediction, predicted_energy))
     }
 
     /// The correction `outcome` from `start` (of energy `energy`), as [`Corrected`].

@@ -167,6 +167,20 @@ impl PseudoInverse {
         }))
     }
 
+    /// `d` without its components along the right singular vectors of singular values at or
+    /// below [`SINGULAR_CUTOFF`]: the directions `a` annihilates to rounding (the time shift,
+    /// and the waves that return onto themselves over the period), along which nothing
+    /// fixes a step.
+    pub(crate) fn without_null_directions(&self, d: &[f64]) -> Vec<f64> {
+        let weights: Vec<f64> = (0..self.s.len())
+            .map(|k| match self.s[k] > SINGULAR_CUTOFF * self.largest {
+                true => (0..self.v.nrows()).map(|j| self.v[(j, k)] * d[j]).sum(),
+                false => 0.0,
+            })
+            .collect();
+        self.combine(&weights)
+    }
+
     /// The minimum-norm `d` of `a d = b` over the singular values above [`SINGULAR_CUTOFF`].
     pub(crate) fn solve(&self, b: &[f64]) -> Vec<f64> {
         let weights: Vec<f64> = self
@@ -282,6 +296,25 @@ impl PeriodMap<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A rotated `diag(2, 1e-3, 1e-9)`: the step keeps its components along the first two
+    /// right singular vectors, the small one at `1e-3` included, and loses the one below
+    /// [`SINGULAR_CUTOFF`], kept by the decomposition but null to rounding.
+    #[test]
+    fn steps_lose_their_null_directions_only() {
+        let (c, s) = (0.6f64, 0.8f64);
+        // Columns of `v`: (c, s, 0), (-s, c, 0), (0, 0, 1); `a = diag(sigma) v^T`.
+        let sigma = [2.0, 1e-3, 1e-9];
+        let v = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        let a = Mat::<f64>::from_fn(3, 3, |i, j| sigma[i] * v[j][i]);
+        let inverse = PseudoInverse::new(&a).unwrap();
+        let d = [1.0, 2.0, 3.0];
+        let kept = inverse.without_null_directions(&d);
+        let expected = [1.0, 2.0, 0.0];
+        for (k, e) in kept.iter().zip(expected) {
+            assert!((k - e).abs() < 1e-12, "{kept:?}");
+        }
+    }
 
     /// `diag(1, 1e-3, 0)`: within a long radius the step is the minimum-norm solution over
     /// the two non-zero singular values; within a short one it has the radius' length, and
