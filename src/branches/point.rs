@@ -92,24 +92,12 @@ impl BackbonePoint {
     pub fn solved(x: Vec<f64>, omega: f64, energy: f64, e_g: f64, solved: &SolveInfo) -> Self {
         let energy_normalized = energy / e_g;
         Self {
-            step: 0,
-            period: period_of_frequency(omega),
-            omega,
             energy,
             energy_normalized,
             status: PointStatus::Converged.with_energy(energy, energy_normalized),
             residual_norm: solved.residual_norm,
             iterations: solved.iterations,
-            x,
-            step_size: 0.0,
-            events: Vec::new(),
-            branch: 0,
-            time_domain: None,
-            check: None,
-            character: None,
-            label: None,
-            stability: None,
-            hill: None,
+            ..Self::unannotated(Timescale::of_frequency(omega), x)
         }
     }
 
@@ -149,16 +137,33 @@ impl BackbonePoint {
         let status = status.with_energy(energy, energy_normalized);
         Self {
             step: p.step,
-            period: time.period,
-            omega: time.omega,
             energy,
             energy_normalized,
             status,
             residual_norm: p.residual_norm,
             iterations: p.iterations,
-            x: x.to_vec(),
             step_size: p.step_size,
             events: p.events.clone(),
+            ..Self::unannotated(time, x.to_vec())
+        }
+    }
+
+    /// The motion `x` at `time` before any solve or annotation: step 0, no energy (NaN), not
+    /// converged, no step, events, branch index or annotations; the constructors fill in what
+    /// they know.
+    fn unannotated(time: Timescale, x: Vec<f64>) -> Self {
+        Self {
+            step: 0,
+            period: time.period,
+            omega: time.omega,
+            energy: f64::NAN,
+            energy_normalized: f64::NAN,
+            status: PointStatus::Rejected,
+            residual_norm: f64::NAN,
+            iterations: 0,
+            x,
+            step_size: 0.0,
+            events: Vec::new(),
             branch: 0,
             time_domain: None,
             check: None,
